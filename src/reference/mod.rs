@@ -1,0 +1,12 @@
+//! Exact answers the renders are judged against.
+//!
+//! [`visibility::visible_fraction`] integrates the unoccluded part of a disk light seen from a
+//! receiver point to ~1e-10; [`on_axis`] gives the closed-form umbra and penumbra radii of a
+//! sphere above a plane under a coaxial disk light (../shared/papers/known-facts.md).
+
+pub mod on_axis;
+pub mod quadrature;
+pub mod visibility;
+
+pub use on_axis::OnAxis;
+pub use visibility::visible_fraction;

@@ -1,0 +1,303 @@
+//! The exact visible fraction of a disk light from a receiver point.
+//!
+//! V(P) = (1 / (pi a^2)) * integral over the disk of [Q visible from P] dA(Q). In polar
+//! coordinates about the light's centre, for each angle theta the set of visible radii rho is a
+//! union of intervals whose ends are roots of linear or quadratic polynomials in rho (receiver
+//! horizon, planes, and for each sphere: "Q inside the ball" and "closest point of segment PQ to
+//! the centre lies on the segment and within R"). Between consecutive roots the predicate is
+//! constant, so the inner integral of rho d rho is exact; the outer integral over theta is
+//! adaptive Gauss-Kronrod. This is the "adaptive 1-D quadrature of the chord overlap" of
+//! known-facts.md, generalised to any number of spheres and planes and to lights that touch or
+//! enter an occluder.
+
+use super::quadrature::integrate_panels;
+use crate::scene::{DiskLight, Plane, Sphere};
+use glam::DVec3;
+use std::f64::consts::{PI, TAU};
+
+/// Absolute tolerance on V requested from the quadrature.
+pub const TOLERANCE: f64 = 1e-10;
+
+/// Initial angular panels: a visible or occluded sliver narrower than 2 pi / (128 x 15) in angle
+/// could be missed; near a tangency its area scales as the cube of that width, ~4e-9 of the disk.
+const PANELS: u32 = 128;
+
+/// Exact fraction of `light` visible from point `p` with surface normal `n` (the receiver's own
+/// horizon counts as an occluder), with `spheres` and `planes` as occluders. Planes through `p`
+/// are the receiver itself and are skipped.
+pub fn visible_fraction(
+    p: DVec3,
+    n: DVec3,
+    light: &DiskLight,
+    spheres: &[Sphere],
+    planes: &[Plane],
+) -> f64 {
+    if light.normal.dot(p - light.center) <= 0.0 {
+        return 0.0; // behind the one-sided emitter
+    }
+    if spheres
+        .iter()
+        .any(|s| (p - s.center).length_squared() < s.radius * s.radius)
+    {
+        return 0.0;
+    }
+    let scale = (p - light.center).length().max(light.radius);
+    let occluding_planes: Vec<&Plane> = planes
+        .iter()
+        .filter(|pl| (p - pl.point).dot(pl.normal).abs() > 1e-12 * scale.max(pl.point.length()))
+        .collect();
+    if occluding_planes.is_empty() && unoccluded_and_above_horizon(p, n, light, spheres) {
+        return 1.0;
+    }
+    let (u, v) = light.basis();
+    let a = light.radius;
+    let chord = |theta: f64| {
+        visible_rho_integral(
+            p,
+            n,
+            light.center,
+            u * theta.cos() + v * theta.sin(),
+            a,
+            spheres,
+            &occluding_planes,
+        )
+    };
+    let total = integrate_panels(chord, 0.0, TAU, TOLERANCE * PI * a * a, PANELS);
+    (total / (PI * a * a)).clamp(0.0, 1.0)
+}
+
+/// Conservative test that nothing can hide any part of the light: the whole disk is above the
+/// receiver's horizon and every sphere's cone from `p` misses the light's bounding cone.
+fn unoccluded_and_above_horizon(p: DVec3, n: DVec3, light: &DiskLight, spheres: &[Sphere]) -> bool {
+    let to_light = light.center - p;
+    let dist = to_light.length();
+    let tilt = (1.0 - n.dot(light.normal).powi(2)).max(0.0).sqrt();
+    if n.dot(to_light) - light.radius * tilt <= 0.0 || dist <= light.radius {
+        return false;
+    }
+    let light_half_angle = (light.radius / dist).asin();
+    spheres.iter().all(|s| {
+        let f = s.center - p;
+        let sphere_half_angle = (s.radius / f.length()).min(1.0).asin();
+        f.angle_between(to_light) > sphere_half_angle + light_half_angle + 1e-9
+    })
+}
+
+/// Integral of rho d rho over the visible part of the ray {C + rho e : 0 <= rho <= a}.
+fn visible_rho_integral(
+    p: DVec3,
+    n: DVec3,
+    c: DVec3,
+    e: DVec3,
+    a: f64,
+    spheres: &[Sphere],
+    planes: &[&Plane],
+) -> f64 {
+    let w0 = c - p;
+    let mut cuts = vec![0.0, a];
+    let mut add = |c2: f64, c1: f64, c0: f64| {
+        for r in quadratic_roots(c2, c1, c0) {
+            if r > 0.0 && r < a {
+                cuts.push(r);
+            }
+        }
+    };
+    add(0.0, n.dot(e), n.dot(w0));
+    for s in spheres {
+        let f = s.center - p;
+        let k = f.length_squared() - s.radius * s.radius;
+        let (fe, fw0, we, ww0) = (f.dot(e), f.dot(w0), w0.dot(e), w0.length_squared());
+        let g = w0 - f;
+        add(
+            1.0,
+            2.0 * e.dot(g),
+            g.length_squared() - s.radius * s.radius,
+        );
+        add(0.0, fe, fw0);
+        add(1.0, 2.0 * we - fe, ww0 - fw0);
+        add(fe * fe - k, 2.0 * (fw0 * fe - k * we), fw0 * fw0 - k * ww0);
+    }
+    for pl in planes {
+        add(0.0, pl.normal.dot(e), pl.normal.dot(c - pl.point));
+    }
+    cuts.sort_by(f64::total_cmp);
+    let mut sum = 0.0;
+    for w in cuts.windows(2) {
+        let (r0, r1) = (w[0], w[1]);
+        if r1 > r0 && is_visible(p, n, c + e * (0.5 * (r0 + r1)), spheres, planes) {
+            sum += 0.5 * (r1 * r1 - r0 * r0);
+        }
+    }
+    sum
+}
+
+/// Whether light point `q` is visible from receiver `p` (normal `n`): above the horizon, and the
+/// closed segment pq misses every sphere and crosses no plane.
+pub fn is_visible(p: DVec3, n: DVec3, q: DVec3, spheres: &[Sphere], planes: &[&Plane]) -> bool {
+    let w = q - p;
+    if n.dot(w) <= 0.0 {
+        return false;
+    }
+    let ww = w.length_squared();
+    let blocked_by_sphere = spheres.iter().any(|sph| {
+        let f = sph.center - p;
+        let s = (f.dot(w) / ww).clamp(0.0, 1.0);
+        (f - w * s).length_squared() <= sph.radius * sph.radius
+    });
+    let blocked_by_plane = planes
+        .iter()
+        .any(|pl| (p - pl.point).dot(pl.normal) * (q - pl.point).dot(pl.normal) < 0.0);
+    !blocked_by_sphere && !blocked_by_plane
+}
+
+/// Real roots of c2 x^2 + c1 x + c0 (a linear equation when c2 == 0), without cancellation.
+pub fn quadratic_roots(c2: f64, c1: f64, c0: f64) -> Vec<f64> {
+    if c2 == 0.0 {
+        return if c1 != 0.0 { vec![-c0 / c1] } else { vec![] };
+    }
+    let disc = c1 * c1 - 4.0 * c2 * c0;
+    if disc < 0.0 {
+        return vec![];
+    }
+    let q = -0.5 * (c1 + disc.sqrt().copysign(c1));
+    if q == 0.0 {
+        return vec![0.0];
+    }
+    vec![q / c2, c0 / q]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn down_light(center: DVec3, radius: f64) -> DiskLight {
+        DiskLight {
+            center,
+            normal: DVec3::NEG_Z,
+            radius,
+            power: 1.0,
+            samples: 1,
+        }
+    }
+
+    /// Area of the intersection of two disks (radii r1, r2, centres d apart): the lens formula.
+    fn lens(r1: f64, r2: f64, d: f64) -> f64 {
+        if d >= r1 + r2 {
+            return 0.0;
+        }
+        if d <= (r1 - r2).abs() {
+            return PI * r1.min(r2).powi(2);
+        }
+        let a1 = r1 * r1 * ((d * d + r1 * r1 - r2 * r2) / (2.0 * d * r1)).acos();
+        let a2 = r2 * r2 * ((d * d + r2 * r2 - r1 * r1) / (2.0 * d * r2)).acos();
+        let k = 0.5 * ((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2)).sqrt();
+        a1 + a2 - k
+    }
+
+    #[test]
+    fn unoccluded_light_is_fully_visible() {
+        let l = down_light(DVec3::new(0.3, 0.1, 2.0), 0.5);
+        assert_eq!(visible_fraction(DVec3::ZERO, DVec3::Z, &l, &[], &[]), 1.0);
+    }
+
+    /// With the receiver directly below the sphere's centre, the occluder's cone meets the light
+    /// plane in a circle, so the occluded area is a circle-circle lens: a closed form, here with
+    /// the light off-centre so the overlap is partial.
+    #[test]
+    fn matches_lens_closed_form_below_the_sphere() {
+        let (h_light, h_sphere, r_sphere) = (4.0, 1.5, 0.5);
+        let sphere = Sphere {
+            center: DVec3::new(0.0, 0.0, h_sphere),
+            radius: r_sphere,
+            albedo: 1.0,
+        };
+        // Tangent cone from the origin: half angle asin(R / h); cut at z = H: radius H tan(.)
+        let beta = (r_sphere / h_sphere).asin();
+        let rb = h_light * beta.tan();
+        for (offset, radius) in [(0.9, 0.6), (1.3, 0.6), (0.2, 1.5), (2.0, 0.3), (0.0, 0.5)] {
+            let light = down_light(DVec3::new(offset, 0.0, h_light), radius);
+            let v = visible_fraction(
+                DVec3::ZERO,
+                DVec3::Z,
+                &light,
+                std::slice::from_ref(&sphere),
+                &[],
+            );
+            let expected = 1.0 - lens(radius, rb, offset) / (PI * radius * radius);
+            assert!(
+                (v - expected).abs() < 1e-9,
+                "offset {offset} radius {radius}: {v} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn light_inside_or_touching_an_occluder() {
+        let sphere = Sphere {
+            center: DVec3::new(0.0, 0.0, 2.0),
+            radius: 1.0,
+            albedo: 1.0,
+        };
+        let inside = down_light(DVec3::new(0.0, 0.0, 2.2), 0.3);
+        let p = DVec3::new(3.0, 0.0, 0.0);
+        assert_eq!(
+            visible_fraction(p, DVec3::Z, &inside, std::slice::from_ref(&sphere), &[]),
+            0.0
+        );
+        // A light whose plane cuts the sphere's top: the receiver far to the side still sees it
+        // partly, and the answer is continuous as the light slides into the sphere.
+        let mut prev = None;
+        for dz in [0.05, 0.0, -0.05] {
+            let l = down_light(DVec3::new(0.0, 0.0, 3.0 + dz), 0.4);
+            let v = visible_fraction(
+                DVec3::new(1.5, 0.0, 0.0),
+                DVec3::Z,
+                &l,
+                std::slice::from_ref(&sphere),
+                &[],
+            );
+            assert!((0.0..=1.0).contains(&v));
+            if let Some(p) = prev {
+                assert!(
+                    v <= p + 1e-12,
+                    "sinking the light into the sphere can only hide more"
+                );
+            }
+            prev = Some(v);
+        }
+    }
+
+    #[test]
+    fn horizon_cuts_a_light_standing_on_the_receiver_plane() {
+        // A vertical light centred on the receiver's plane: exactly half is below the horizon.
+        let l = DiskLight {
+            center: DVec3::new(0.0, 5.0, 0.0),
+            normal: DVec3::NEG_Y,
+            radius: 0.5,
+            power: 1.0,
+            samples: 1,
+        };
+        let v = visible_fraction(DVec3::ZERO, DVec3::Z, &l, &[], &[]);
+        assert!((v - 0.5).abs() < 1e-10, "{v}");
+    }
+
+    #[test]
+    fn light_facing_away_is_invisible() {
+        let l = DiskLight {
+            center: DVec3::new(0.0, 0.0, 2.0),
+            normal: DVec3::Z,
+            radius: 0.5,
+            power: 1.0,
+            samples: 1,
+        };
+        assert_eq!(visible_fraction(DVec3::ZERO, DVec3::Z, &l, &[], &[]), 0.0);
+    }
+
+    #[test]
+    fn roots_without_cancellation() {
+        let r = quadratic_roots(1.0, -1e8, 1.0);
+        assert!(r.iter().any(|&x| (x - 1e-8).abs() < 1e-22));
+        assert!(quadratic_roots(1.0, 0.0, 1.0).is_empty());
+        assert_eq!(quadratic_roots(0.0, 2.0, -1.0), vec![0.5]);
+    }
+}

@@ -1,0 +1,194 @@
+//! GPU-side struct layouts, `#[repr(C)]` and Pod, their sizes pinned at compile time to match
+//! the WGSL structs in `shaders/render.wgsl` (vec3<f32> has 16-byte alignment there).
+
+use crate::render::{Sampling, View};
+use crate::sampling::{shared_points, Pattern};
+use crate::scene::{Light, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+
+/// Uniform block of one frame.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct Params {
+    pub width: u32,
+    pub height: u32,
+    pub sphere_count: u32,
+    pub plane_count: u32,
+    pub light_count: u32,
+    pub scheme: u32,
+    pub shared_pattern: u32,
+    pub seed: u32,
+    pub cam_origin: [f32; 3],
+    pub ortho: u32,
+    pub cam_right: [f32; 3],
+    pub half_x: f32,
+    pub cam_up: [f32; 3],
+    pub half_y: f32,
+    pub cam_forward: [f32; 3],
+    pub _pad: f32,
+}
+
+/// A sphere.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct GpuSphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub albedo: f32,
+    pub _pad: [f32; 3],
+}
+
+/// A plane.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct GpuPlane {
+    pub point: [f32; 3],
+    pub albedo: f32,
+    pub normal: [f32; 3],
+    pub _pad: f32,
+}
+
+/// A light; `kind` 0 = point, 1 = disk; (u, v) span the disk's plane.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct GpuLight {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub normal: [f32; 3],
+    pub power: f32,
+    pub u: [f32; 3],
+    pub kind: u32,
+    pub v: [f32; 3],
+    pub samples: u32,
+    pub shared_offset: u32,
+    pub _pad: [u32; 3],
+}
+
+/// Per-pass uniform: which light a shadow dispatch serves.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct PassInfo {
+    pub light: u32,
+    pub _pad: [u32; 3],
+}
+
+/// Bytes per pixel of the hit buffer (WGSL `Hit`).
+pub const HIT_BYTES: u64 = 32;
+
+const _: () = assert!(std::mem::size_of::<Params>() == 96);
+const _: () = assert!(std::mem::size_of::<GpuSphere>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuPlane>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuLight>() == 80);
+const _: () = assert!(std::mem::size_of::<PassInfo>() == 16);
+
+fn local(p: DVec3, origin: DVec3) -> [f32; 3] {
+    (p - origin).as_vec3().to_array()
+}
+
+fn dir(p: DVec3) -> [f32; 3] {
+    p.as_vec3().to_array()
+}
+
+/// Everything uploaded for one frame, in coordinates relative to `origin` (the camera's look-at
+/// point, chosen in f64), so f32 keeps its precision wherever the scene is placed.
+pub struct Packed {
+    pub params: Params,
+    pub spheres: Vec<GpuSphere>,
+    pub planes: Vec<GpuPlane>,
+    pub lights: Vec<GpuLight>,
+    pub shared: Vec<[f32; 2]>,
+}
+
+/// Packs a scene, view and sampling choice into GPU structs.
+pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
+    let origin = view.camera.look_at;
+    let (frame, (hx, hy), ortho) = view.camera.gpu_terms(view.width, view.height);
+    let params = Params {
+        width: view.width,
+        height: view.height,
+        sphere_count: scene.spheres.len() as u32,
+        plane_count: scene.planes.len() as u32,
+        light_count: scene.lights.len() as u32,
+        scheme: sampling.scheme.gpu_id(),
+        shared_pattern: (sampling.pattern == Pattern::Shared) as u32,
+        seed: sampling.seed,
+        cam_origin: local(view.camera.position, origin),
+        ortho: ortho as u32,
+        cam_right: dir(frame.right),
+        half_x: hx as f32,
+        cam_up: dir(frame.up),
+        half_y: hy as f32,
+        cam_forward: dir(frame.forward),
+        _pad: 0.0,
+    };
+    let spheres = scene
+        .spheres
+        .iter()
+        .map(|s| GpuSphere {
+            center: local(s.center, origin),
+            radius: s.radius as f32,
+            albedo: s.albedo as f32,
+            _pad: [0.0; 3],
+        })
+        .collect();
+    let planes = scene
+        .planes
+        .iter()
+        .map(|p| GpuPlane {
+            // The point of the plane nearest the new origin: small coordinates, same plane.
+            point: dir(-p.normal * (origin - p.point).dot(p.normal)),
+            albedo: p.albedo as f32,
+            normal: dir(p.normal),
+            _pad: 0.0,
+        })
+        .collect();
+    let mut shared = Vec::new();
+    let mut lights = Vec::new();
+    for (i, l) in scene.lights.iter().enumerate() {
+        let offset = shared.len() as u32;
+        lights.push(match l {
+            Light::Point { position, power } => GpuLight {
+                center: local(*position, origin),
+                radius: 0.0,
+                normal: [0.0; 3],
+                power: *power as f32,
+                u: [0.0; 3],
+                kind: 0,
+                v: [0.0; 3],
+                samples: 1,
+                shared_offset: offset,
+                _pad: [0; 3],
+            },
+            Light::Disk(d) => {
+                let (u, v) = d.basis();
+                if sampling.pattern == Pattern::Shared {
+                    shared.extend(
+                        shared_points(sampling.scheme, d.samples, sampling.seed, i as u32)
+                            .iter()
+                            .map(|p| p.as_vec2().to_array()),
+                    );
+                }
+                GpuLight {
+                    center: local(d.center, origin),
+                    radius: d.radius as f32,
+                    normal: dir(d.normal),
+                    power: d.power as f32,
+                    u: dir(u),
+                    kind: 1,
+                    v: dir(v),
+                    samples: d.samples,
+                    shared_offset: offset,
+                    _pad: [0; 3],
+                }
+            }
+        });
+    }
+    Packed {
+        params,
+        spheres,
+        planes,
+        lights,
+        shared,
+    }
+}

@@ -1,0 +1,576 @@
+//! The wgpu compute backend: headless, on any adapter wgpu supports (Mesa's lavapipe in CI).
+//!
+//! Setup (adapter, device with the adapter's real limits, pipelines) happens once in
+//! [`GpuBackend::new`]; each frame uploads the packed scene, runs the plan's passes (primary,
+//! then one shadow dispatch per light) with a timestamp pair around each pass when the adapter
+//! supports timestamp queries, and reads the outputs back.
+
+mod layout;
+
+use super::plan::{RenderPlan, MAX_LIGHTS};
+use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
+use crate::sampling::DiskScheme;
+use anyhow::{anyhow, bail, Context};
+use bytemuck::Pod;
+use layout::{pack, Packed, PassInfo, HIT_BYTES};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use wgpu::util::DeviceExt;
+
+/// How long one frame may run before it is reported as a GPU timeout.
+pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
+
+const SHADER: &str = concat!(
+    include_str!("shaders/sampling.wgsl"),
+    include_str!("shaders/geometry.wgsl"),
+    include_str!("shaders/render.wgsl"),
+);
+
+/// What to install when no adapter is found, for the error message.
+pub const NO_ADAPTER_HELP: &str =
+    "no GPU adapter found; on Debian install the software Vulkan driver with \
+     `apt-get install mesa-vulkan-drivers`, or run with the CPU backend (`--backend cpu`)";
+
+/// The wgpu renderer.
+pub struct GpuBackend {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: AdapterInfo,
+    timestamps: bool,
+    lost: Arc<AtomicBool>,
+    layout0: wgpu::BindGroupLayout,
+    layout1: wgpu::BindGroupLayout,
+    primary: wgpu::ComputePipeline,
+    shadow: wgpu::ComputePipeline,
+    dump: wgpu::ComputePipeline,
+}
+
+/// Per-frame GPU resources.
+struct FrameResources {
+    bind0: wgpu::BindGroup,
+    passes: Vec<wgpu::BindGroup>,
+    hits: wgpu::Buffer,
+    visibility: wgpu::Buffer,
+    radiance: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+}
+
+impl GpuBackend {
+    /// Opens the first adapter wgpu finds (high-performance preferred, software allowed).
+    pub fn new() -> anyhow::Result<GpuBackend> {
+        pollster::block_on(Self::open())
+    }
+
+    async fn open() -> anyhow::Result<GpuBackend> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| anyhow!("{NO_ADAPTER_HELP} ({e})"))?;
+        let ai = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("penumbra"),
+                required_features: features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .context("requesting a device from the GPU adapter")?;
+        let lost = Arc::new(AtomicBool::new(false));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |_, _| flag.store(true, Ordering::SeqCst));
+        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
+            eprintln!("penumbra: uncaptured GPU error: {e}")
+        }));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("render.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let uniform = |binding: u32| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let mut entries = vec![uniform(0)];
+        entries.extend((1..=4).map(|b| storage(b, true)));
+        entries.extend((5..=8).map(|b| storage(b, false)));
+        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &entries,
+        });
+        let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pass"),
+            entries: &[uniform(0)],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("render"),
+            bind_group_layouts: &[Some(&layout0), Some(&layout1)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (primary, shadow, dump) = (
+            pipeline("primary"),
+            pipeline("shadow"),
+            pipeline("dump_samples"),
+        );
+        let info = AdapterInfo {
+            backend: "gpu".into(),
+            name: ai.name.clone(),
+            driver: format!("{} {}", ai.driver, ai.driver_info)
+                .trim()
+                .to_string(),
+            api: format!("{:?}", ai.backend),
+        };
+        Ok(GpuBackend {
+            device,
+            queue,
+            info,
+            timestamps,
+            lost,
+            layout0,
+            layout1,
+            primary,
+            shadow,
+            dump,
+        })
+    }
+
+    /// Whether frame times come from GPU timestamps (else a labelled wall-clock fallback).
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
+    }
+
+    fn storage<T: Pod>(&self, label: &str, data: &[T], zeroed: T) -> wgpu::Buffer {
+        // WGSL runtime-sized arrays need a non-empty binding.
+        let one = [zeroed];
+        let data: &[T] = if data.is_empty() { &one } else { data };
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    }
+
+    fn output(&self, label: &str, size: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    fn check_limits(&self, view: View, lights: usize) -> anyhow::Result<()> {
+        let limits = self.device.limits();
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        for (what, bytes) in [
+            ("hit buffer", view.pixels() as u64 * HIT_BYTES),
+            (
+                "visibility buffer",
+                (view.pixels() * lights.max(1)) as u64 * 4,
+            ),
+        ] {
+            if bytes > max {
+                bail!(
+                    "{}x{} needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
+                    view.width,
+                    view.height,
+                    bytes - max
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn resources(&self, packed: &Packed, view: View) -> FrameResources {
+        let params = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("params"),
+                contents: bytemuck::bytes_of(&packed.params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let spheres = self.storage("spheres", &packed.spheres, bytemuck::Zeroable::zeroed());
+        let planes = self.storage("planes", &packed.planes, bytemuck::Zeroable::zeroed());
+        let lights = self.storage("lights", &packed.lights, bytemuck::Zeroable::zeroed());
+        let shared = self.storage("shared points", &packed.shared, [0f32; 2]);
+        let pixels = view.pixels() as u64;
+        let hits = self.output("hits", pixels * HIT_BYTES);
+        let visibility = self.output("visibility", pixels * packed.lights.len().max(1) as u64 * 4);
+        let radiance = self.output("radiance", pixels * 4);
+        let counters = self.output("ray counters", (MAX_LIGHTS * 2 * 4) as u64);
+        let buffers = [
+            &params,
+            &spheres,
+            &planes,
+            &lights,
+            &shared,
+            &hits,
+            &visibility,
+            &radiance,
+            &counters,
+        ];
+        let entries: Vec<_> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind0 = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.layout0,
+            entries: &entries,
+        });
+        let passes = (0..packed.lights.len().max(1))
+            .map(|light| {
+                let info = self
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("pass info"),
+                        contents: bytemuck::bytes_of(&PassInfo {
+                            light: light as u32,
+                            _pad: [0; 3],
+                        }),
+                        usage: wgpu::BufferUsages::UNIFORM,
+                    });
+                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("pass"),
+                    layout: &self.layout1,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: info.as_entire_binding(),
+                    }],
+                })
+            })
+            .collect();
+        let queries = self.timestamps.then(|| {
+            let count = 2 * (packed.lights.len() as u32 + 1);
+            let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count,
+            });
+            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size: count as u64 * 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        FrameResources {
+            bind0,
+            passes,
+            hits,
+            visibility,
+            radiance,
+            counters,
+            queries,
+        }
+    }
+
+    /// Records the plan's passes into `encoder`: primary, then one shadow dispatch per light.
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        r: &FrameResources,
+        view: View,
+        lights: usize,
+    ) {
+        encoder.clear_buffer(&r.counters, 0, None);
+        let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
+        for pass in 0..=lights {
+            let timestamp_writes =
+                r.queries
+                    .as_ref()
+                    .map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(2 * pass as u32),
+                        end_of_pass_write_index: Some(2 * pass as u32 + 1),
+                    });
+            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: None,
+                timestamp_writes,
+            });
+            cp.set_pipeline(if pass == 0 {
+                &self.primary
+            } else {
+                &self.shadow
+            });
+            cp.set_bind_group(0, &r.bind0, &[]);
+            cp.set_bind_group(1, &r.passes[pass.saturating_sub(1)], &[]);
+            cp.dispatch_workgroups(groups.0, groups.1, 1);
+        }
+    }
+
+    /// Submits, waits with [`FRAME_TIMEOUT`], and turns validation errors, a lost device or a
+    /// timeout into errors.
+    fn submit(
+        &self,
+        encoder: wgpu::CommandEncoder,
+        scope: wgpu::ErrorScopeGuard,
+    ) -> anyhow::Result<()> {
+        let index = self.queue.submit([encoder.finish()]);
+        let polled = self.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(index),
+            timeout: Some(FRAME_TIMEOUT),
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            bail!("GPU validation error: {e}");
+        }
+        if self.lost.load(Ordering::SeqCst) {
+            bail!("the GPU device was lost during the frame");
+        }
+        polled.map_err(|e| anyhow!("GPU frame did not finish within {FRAME_TIMEOUT:?}: {e}"))?;
+        Ok(())
+    }
+
+    fn read(&self, src: &wgpu::Buffer, size: u64) -> anyhow::Result<Vec<u8>> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+        self.submit(
+            encoder,
+            self.device.push_error_scope(wgpu::ErrorFilter::Validation),
+        )?;
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: Some(FRAME_TIMEOUT),
+            })
+            .map_err(|e| anyhow!("mapping a GPU buffer: {e}"))?;
+        rx.recv()?
+            .map_err(|e| anyhow!("mapping a GPU buffer: {e}"))?;
+        let bytes = staging
+            .get_mapped_range(..)
+            .map_err(|e| anyhow!("reading a GPU buffer: {e:?}"))?
+            .to_vec();
+        staging.unmap();
+        Ok(bytes)
+    }
+
+    fn frame_seconds(&self, r: &FrameResources) -> anyhow::Result<Option<f64>> {
+        let Some((set, resolve)) = &r.queries else {
+            return Ok(None);
+        };
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.resolve_query_set(set, 0..set_count(resolve), resolve, 0);
+        self.submit(
+            encoder,
+            self.device.push_error_scope(wgpu::ErrorFilter::Validation),
+        )?;
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(resolve, resolve.size())?);
+        let (first, last) = (ticks[0], ticks[ticks.len() - 1]);
+        let period = self.queue.get_timestamp_period() as f64;
+        Ok(Some(last.saturating_sub(first) as f64 * period * 1e-9))
+    }
+
+    /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
+    /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
+    pub fn disk_points(
+        &mut self,
+        scheme: DiskScheme,
+        n: u32,
+        seed: u32,
+        pixel: u32,
+    ) -> anyhow::Result<Vec<[f32; 2]>> {
+        let scene = crate::scene::Scene {
+            cameras: Default::default(),
+            spheres: vec![],
+            planes: vec![],
+            lights: vec![],
+        };
+        let cam = dummy_camera();
+        let view = View {
+            camera: &cam,
+            width: n,
+            height: 1,
+        };
+        let mut packed = pack(
+            &scene,
+            view,
+            Sampling {
+                scheme,
+                pattern: crate::sampling::Pattern::PerPixel,
+                seed,
+            },
+        );
+        packed.params.height = pixel;
+        let r = self.resources(
+            &packed,
+            View {
+                camera: &cam,
+                width: n,
+                height: 2,
+            },
+        );
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: None,
+                timestamp_writes: None,
+            });
+            cp.set_pipeline(&self.dump);
+            cp.set_bind_group(0, &r.bind0, &[]);
+            cp.set_bind_group(1, &r.passes[0], &[]);
+            cp.dispatch_workgroups(n.div_ceil(64), 1, 1);
+        }
+        self.submit(encoder, scope)?;
+        let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
+        Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
+    }
+}
+
+/// Timestamps a resolve buffer holds.
+fn set_count(resolve: &wgpu::Buffer) -> u32 {
+    (resolve.size() / 8) as u32
+}
+
+fn dummy_camera() -> crate::scene::camera::Camera {
+    use glam::DVec3;
+    crate::scene::camera::Camera {
+        position: DVec3::Z,
+        look_at: DVec3::ZERO,
+        up: DVec3::Y,
+        projection: crate::scene::camera::Projection::Orthographic { width: 1.0 },
+    }
+}
+
+impl Backend for GpuBackend {
+    fn adapter(&self) -> &AdapterInfo {
+        &self.info
+    }
+
+    fn render(
+        &mut self,
+        scene: &crate::scene::Scene,
+        view: View,
+        sampling: Sampling,
+    ) -> anyhow::Result<Frame> {
+        RenderPlan::new(scene, view)?;
+        self.check_limits(view, scene.lights.len())?;
+        let packed = pack(scene, view, sampling);
+        let lights = scene.lights.len();
+        let r = self.resources(&packed, view);
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.encode(&mut encoder, &r, view, lights);
+        self.submit(encoder, scope)?;
+        let pixels = view.pixels();
+        let hits: Vec<u32> =
+            bytemuck::pod_collect_to_vec(&self.read(&r.hits, pixels as u64 * HIT_BYTES)?);
+        let vis: Vec<f32> = if lights > 0 {
+            bytemuck::pod_collect_to_vec(&self.read(&r.visibility, (pixels * lights) as u64 * 4)?)
+        } else {
+            vec![]
+        };
+        let radiance: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&self.read(&r.radiance, pixels as u64 * 4)?);
+        let counters: Vec<u32> =
+            bytemuck::pod_collect_to_vec(&self.read(&r.counters, (MAX_LIGHTS * 8) as u64)?);
+        let mut rays = RayCounts {
+            primary: pixels as u64,
+            shadow: [0; MAX_LIGHTS],
+        };
+        for (i, s) in rays.shadow.iter_mut().enumerate() {
+            *s = counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
+        }
+        Ok(Frame {
+            width: view.width,
+            height: view.height,
+            radiance,
+            visibility: vis.chunks(pixels.max(1)).map(<[f32]>::to_vec).collect(),
+            hit: hits.chunks(8).map(|h| h[3]).collect(),
+            rays,
+        })
+    }
+
+    fn time(
+        &mut self,
+        scene: &crate::scene::Scene,
+        view: View,
+        sampling: Sampling,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<Timing> {
+        RenderPlan::new(scene, view)?;
+        self.check_limits(view, scene.lights.len())?;
+        let packed = pack(scene, view, sampling);
+        let lights = scene.lights.len();
+        let r = self.resources(&packed, view);
+        let mut seconds = Vec::new();
+        for i in 0..warmup + repeats {
+            let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, &r, view, lights);
+            let start = Instant::now();
+            self.submit(encoder, scope)?;
+            let wall = start.elapsed().as_secs_f64();
+            let t = self.frame_seconds(&r)?.unwrap_or(wall);
+            if i >= warmup {
+                seconds.push(t);
+            }
+        }
+        Ok(Timing {
+            seconds,
+            clock: if self.timestamps {
+                Clock::GpuTimestamp
+            } else {
+                Clock::WallClock
+            },
+        })
+    }
+}

@@ -1,0 +1,251 @@
+// The render plan's passes: `primary` (camera rays, closest hit) and `shadow` (one dispatch per
+// light, any-hit with early exit). Mirrors src/render/cpu.rs and src/render/shading.rs in f32,
+// in coordinates re-based on the camera's look-at point so that large translations cost nothing.
+
+struct Params {
+    width: u32,
+    height: u32,
+    sphere_count: u32,
+    plane_count: u32,
+    light_count: u32,
+    scheme: u32,
+    shared_pattern: u32,
+    seed: u32,
+    cam_origin: vec3<f32>,
+    ortho: u32,
+    cam_right: vec3<f32>,
+    half_x: f32,
+    cam_up: vec3<f32>,
+    half_y: f32,
+    cam_forward: vec3<f32>,
+    _pad: f32,
+}
+
+struct Sphere {
+    center: vec3<f32>,
+    radius: f32,
+    albedo: f32,
+    _p0: f32,
+    _p1: f32,
+    _p2: f32,
+}
+
+struct Plane {
+    point: vec3<f32>,
+    albedo: f32,
+    normal: vec3<f32>,
+    _pad: f32,
+}
+
+struct Light {
+    center: vec3<f32>,
+    radius: f32,
+    normal: vec3<f32>,
+    power: f32,
+    u: vec3<f32>,
+    kind: u32,
+    v: vec3<f32>,
+    samples: u32,
+    shared_offset: u32,
+    _p0: u32,
+    _p1: u32,
+    _p2: u32,
+}
+
+struct Hit {
+    position: vec3<f32>,
+    object: u32,
+    normal: vec3<f32>,
+    albedo: f32,
+}
+
+struct PassInfo {
+    light: u32,
+    _p0: u32,
+    _p1: u32,
+    _p2: u32,
+}
+
+const LIGHT_POINT: u32 = 0u;
+const NO_RECEIVER: f32 = -1.0;
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(2) var<storage, read> planes: array<Plane>;
+@group(0) @binding(3) var<storage, read> lights: array<Light>;
+@group(0) @binding(4) var<storage, read> shared_points: array<vec2<f32>>;
+@group(0) @binding(5) var<storage, read_write> hits: array<Hit>;
+@group(0) @binding(6) var<storage, read_write> visibility: array<f32>;
+@group(0) @binding(7) var<storage, read_write> radiance: array<f32>;
+@group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>>;
+@group(1) @binding(0) var<uniform> pass_info: PassInfo;
+
+fn plane_t(origin: vec3<f32>, dir: vec3<f32>, pl: Plane) -> f32 {
+    let denom = dot(dir, pl.normal);
+    if (denom == 0.0) {
+        return -1.0;
+    }
+    return dot(pl.point - origin, pl.normal) / denom;
+}
+
+fn occluded(origin: vec3<f32>, d: vec3<f32>) -> bool {
+    let len = length(d);
+    let dir = d / len;
+    for (var i = 0u; i < params.sphere_count; i++) {
+        let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
+        if (r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
+            return true;
+        }
+    }
+    for (var i = 0u; i < params.plane_count; i++) {
+        let t = plane_t(origin, dir, planes[i]);
+        if (t > 0.0 && t < len) {
+            return true;
+        }
+    }
+    return false;
+}
+
+@compute @workgroup_size(8, 8)
+fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    let sx = (2.0 * (f32(gid.x) + 0.5) / f32(params.width) - 1.0) * params.half_x;
+    let sy = (1.0 - 2.0 * (f32(gid.y) + 0.5) / f32(params.height)) * params.half_y;
+    var origin = params.cam_origin;
+    var dir = params.cam_forward;
+    if (params.ortho != 0u) {
+        origin = params.cam_origin + sx * params.cam_right + sy * params.cam_up;
+    } else {
+        dir = normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
+    }
+    var best_t = 3.4e38;
+    var best = NO_HIT;
+    for (var i = 0u; i < params.sphere_count; i++) {
+        let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
+        let t = select(r.y, r.x, r.x > 0.0);
+        if (r.z > 0.0 && t > 0.0 && t < best_t) {
+            best_t = t;
+            best = i;
+        }
+    }
+    for (var i = 0u; i < params.plane_count; i++) {
+        let t = plane_t(origin, dir, planes[i]);
+        if (t > 0.0 && t < best_t) {
+            best_t = t;
+            best = params.sphere_count + i;
+        }
+    }
+    radiance[pixel] = 0.0;
+    var hit: Hit;
+    hit.object = best;
+    if (best != NO_HIT) {
+        let raw = origin + best_t * dir;
+        if (best < params.sphere_count) {
+            let s = spheres[best];
+            let n = normalize(raw - s.center);
+            hit.position = s.center + n * s.radius;
+            hit.normal = n;
+            hit.albedo = s.albedo;
+        } else {
+            let pl = planes[best - params.sphere_count];
+            hit.position = raw - pl.normal * dot(raw - pl.point, pl.normal);
+            hit.normal = pl.normal;
+            hit.albedo = pl.albedo;
+        }
+        if (dot(hit.normal, dir) > 0.0) {
+            hit.normal = -hit.normal;
+        }
+    }
+    hits[pixel] = hit;
+}
+
+fn add_rays(light: u32, n: u32) {
+    if (n == 0u) {
+        return;
+    }
+    let old = atomicAdd(&counters[2u * light], n);
+    if (old + n < old) {
+        atomicAdd(&counters[2u * light + 1u], 1u);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    let li = pass_info.light;
+    let out = li * params.width * params.height + pixel;
+    let hit = hits[pixel];
+    if (hit.object == NO_HIT) {
+        visibility[out] = NO_RECEIVER;
+        return;
+    }
+    let light = lights[li];
+    let p = hit.position;
+    let n = hit.normal;
+    let origin = offset_origin(p, n);
+    var vis = 0.0;
+    var irradiance = 0.0;
+    var rays = 0u;
+    if (light.kind == LIGHT_POINT) {
+        let d = light.center - p;
+        if (dot(n, d) > 0.0) {
+            rays = 1u;
+            if (!occluded(origin, light.center - origin)) {
+                vis = 1.0;
+                irradiance = light.power / (4.0 * PI) * dot(n, normalize(d)) / dot(d, d);
+            }
+        }
+    } else {
+        let tilt = sqrt(max(1.0 - dot(n, light.normal) * dot(n, light.normal), 0.0));
+        let reachable = dot(light.normal, p - light.center) > 0.0 && dot(n, light.center - p) + light.radius * tilt > 0.0;
+        if (reachable) {
+            let stream = stream_pixel(params.seed, li, pixel);
+            var visible = 0u;
+            var sum = 0.0;
+            for (var k = 0u; k < light.samples; k++) {
+                var s: vec2<f32>;
+                if (params.shared_pattern != 0u) {
+                    s = shared_points[light.shared_offset + k];
+                } else {
+                    s = disk_point(params.scheme, light.samples, k, stream);
+                }
+                let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
+                let d = q - p;
+                if (dot(n, d) <= 0.0 || dot(light.normal, d) >= 0.0) {
+                    continue;
+                }
+                rays += 1u;
+                if (!occluded(origin, q - origin)) {
+                    visible += 1u;
+                    let d2 = dot(d, d);
+                    sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
+                }
+            }
+            vis = f32(visible) / f32(light.samples);
+            irradiance = light.power / (PI * f32(light.samples)) * sum;
+        }
+    }
+    visibility[out] = vis;
+    radiance[pixel] += hit.albedo / PI * irradiance;
+    add_rays(li, rays);
+}
+
+// Test hook: the unit-disk points a scheme gives pixel `seed`'s stream, for the CPU/GPU
+// sampler agreement test. Writes params.width points into `shared_points`' twin `visibility`.
+@compute @workgroup_size(64)
+fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= params.width) {
+        return;
+    }
+    let stream = stream_pixel(params.seed, 0u, params.height);
+    let s = disk_point(params.scheme, params.width, k, stream);
+    visibility[2u * k] = s.x;
+    visibility[2u * k + 1u] = s.y;
+}

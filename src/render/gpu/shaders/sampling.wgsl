@@ -1,0 +1,138 @@
+// Disk sampling schemes and counter-based random numbers: the WGSL twin of src/sampling/.
+// Every function here must return, bit for bit in its integer part, what the Rust one does.
+
+const SCHEME_UNIFORM: u32 = 0u;
+const SCHEME_PAPER: u32 = 1u;
+const SCHEME_PAPER_LITERAL: u32 = 2u;
+const SCHEME_JITTERED: u32 = 3u;
+const SCHEME_SOBOL: u32 = 4u;
+const SCHEME_SPIRAL: u32 = 5u;
+
+const TAU: f32 = 6.283185307179586;
+const PI: f32 = 3.141592653589793;
+const GOLDEN_TURN: u32 = 0x61c88647u;
+
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+fn stream_pixel(seed: u32, light: u32, pixel: u32) -> u32 {
+    let base = pcg(seed ^ pcg(light + 0x68e31da4u));
+    return pcg(base ^ pcg(pixel + 0x1b56c4e9u));
+}
+
+fn stream_u32(stream: u32, index: u32) -> u32 {
+    return pcg(stream ^ pcg(index + 0x9e3779b9u));
+}
+
+fn to_unit(x: u32) -> f32 {
+    return f32(x >> 8u) * (1.0 / 16777216.0);
+}
+
+fn stream_unit(stream: u32, index: u32) -> f32 {
+    return to_unit(stream_u32(stream, index));
+}
+
+fn polar(r: f32, theta: f32) -> vec2<f32> {
+    return vec2<f32>(r * cos(theta), r * sin(theta));
+}
+
+fn concentric(u: f32, v: f32) -> vec2<f32> {
+    let a = 2.0 * u - 1.0;
+    let b = 2.0 * v - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        return vec2<f32>(0.0);
+    }
+    if (abs(a) > abs(b)) {
+        return polar(a, 0.25 * PI * (b / a));
+    }
+    return polar(b, 0.5 * PI - 0.25 * PI * (a / b));
+}
+
+fn strata_rows(n: u32) -> u32 {
+    var rows = u32(floor(sqrt(f32(n))));
+    // f32 sqrt can land one above the integer root; step down like the f64 version would.
+    if (rows * rows > n) {
+        rows = rows - 1u;
+    }
+    while (rows > 1u && n % rows != 0u) {
+        rows = rows - 1u;
+    }
+    return max(rows, 1u);
+}
+
+fn sobol_dim1(index_in: u32) -> u32 {
+    var index = index_in;
+    var v = 1u << 31u;
+    var x = 0u;
+    while (index != 0u) {
+        if ((index & 1u) != 0u) {
+            x = x ^ v;
+        }
+        index = index >> 1u;
+        v = v ^ (v >> 1u);
+    }
+    return x;
+}
+
+fn laine_karras(x_in: u32, seed: u32) -> u32 {
+    var x = x_in;
+    x = x ^ (x * 0x3d20adeau);
+    x = x + seed;
+    x = x * ((seed >> 16u) | 1u);
+    x = x ^ (x * 0x05526c56u);
+    x = x ^ (x * 0x53a22864u);
+    return x;
+}
+
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    return reverseBits(laine_karras(reverseBits(x), seed));
+}
+
+fn scrambled_sobol_2d(index: u32, seed: u32) -> vec2<u32> {
+    let shuffled = owen_scramble(index, pcg(seed ^ 0xa511e9b3u));
+    let x = owen_scramble(reverseBits(shuffled), pcg(seed ^ 0x63d83595u));
+    let y = owen_scramble(sobol_dim1(shuffled), pcg(seed ^ 0x2c1b3c6du));
+    return vec2<u32>(x, y);
+}
+
+// Sample k of n on the unit disk (see DiskScheme::point).
+fn disk_point(scheme: u32, n: u32, k: u32, stream: u32) -> vec2<f32> {
+    switch scheme {
+        case 0u: {
+            let u = stream_unit(stream, 2u * k);
+            let v = stream_unit(stream, 2u * k + 1u);
+            return polar(sqrt(u), TAU * v);
+        }
+        case 1u, 2u: {
+            if (k == 0u) {
+                return vec2<f32>(0.0);
+            }
+            let theta = TAU * f32(k) / f32(n - 1u);
+            let r = 0.7 * sqrt(stream_unit(stream, 2u * k));
+            if (scheme == SCHEME_PAPER) {
+                return polar(0.3 + r, theta);
+            }
+            return vec2<f32>(0.3) + polar(r, theta);
+        }
+        case 3u: {
+            let rows = strata_rows(n);
+            let cols = n / rows;
+            let u = (f32(k % cols) + stream_unit(stream, 2u * k)) / f32(cols);
+            let v = (f32(k / cols) + stream_unit(stream, 2u * k + 1u)) / f32(rows);
+            return concentric(u, v);
+        }
+        case 4u: {
+            let s = scrambled_sobol_2d(k, stream_u32(stream, 0x7fffffffu));
+            return concentric(to_unit(s.x), to_unit(s.y));
+        }
+        default: {
+            let turn = k * GOLDEN_TURN + stream_u32(stream, 0x7ffffffeu);
+            let offset = stream_unit(stream, 0x7ffffffdu);
+            let r = sqrt((f32(k) + offset) / f32(n));
+            return polar(r, TAU * to_unit(turn));
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! Rendering: one [`Backend`] trait, a wgpu compute implementation ([`gpu`]) and an f64 CPU
+//! reference ([`cpu`]) that follow the same [`plan::RenderPlan`] and the same sample streams.
+//!
+//! A frame holds, per pixel, the radiance of the first surface seen and, per light, its
+//! visibility: the fraction of that light's shadow-ray targets that are above the receiver's
+//! horizon, in front of the one-sided emitter, and unoccluded.
+
+pub mod cpu;
+pub mod gpu;
+pub mod plan;
+mod shading;
+
+use crate::sampling::{DiskScheme, Pattern};
+use crate::scene::{camera::Camera, Scene};
+use serde::Serialize;
+
+pub use plan::RenderPlan;
+
+/// Visibility value written where the camera ray hits nothing (no receiver to shade).
+pub const NO_RECEIVER: f32 = -1.0;
+/// Object id written where the camera ray hits nothing.
+pub const NO_HIT: u32 = u32::MAX;
+
+/// How shadow-ray targets are chosen for one render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Sampling {
+    /// Disk sampling scheme.
+    pub scheme: DiskScheme,
+    /// Per-pixel or shared random numbers.
+    pub pattern: Pattern,
+    /// Seed of every random number in the frame.
+    pub seed: u32,
+}
+
+/// What to render: a camera and an image size.
+#[derive(Clone, Copy, Debug)]
+pub struct View<'a> {
+    /// The camera.
+    pub camera: &'a Camera,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl View<'_> {
+    /// Pixel count.
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+}
+
+/// Rays a frame actually traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct RayCounts {
+    /// Camera rays (one per pixel).
+    pub primary: u64,
+    /// Shadow rays per light, in scene order.
+    pub shadow: [u64; plan::MAX_LIGHTS],
+}
+
+impl RayCounts {
+    /// All shadow rays.
+    pub fn shadow_total(&self) -> u64 {
+        self.shadow.iter().sum()
+    }
+}
+
+/// A rendered frame.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Outgoing radiance (W m^-2 sr^-1) of the surface seen, row-major, top row first.
+    pub radiance: Vec<f32>,
+    /// Per light, per pixel visibility in [0, 1], or [`NO_RECEIVER`].
+    pub visibility: Vec<Vec<f32>>,
+    /// Per pixel, the object id hit by the camera ray, or [`NO_HIT`].
+    pub hit: Vec<u32>,
+    /// Rays traced.
+    pub rays: RayCounts,
+}
+
+/// How a frame time was measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Clock {
+    /// GPU timestamp queries around the passes.
+    GpuTimestamp,
+    /// Host wall clock around submit and wait (includes driver overhead).
+    WallClock,
+}
+
+/// Repeated frame times after warm-up.
+#[derive(Clone, Debug)]
+pub struct Timing {
+    /// Seconds per frame, one per timed repeat.
+    pub seconds: Vec<f64>,
+    /// Where the times came from.
+    pub clock: Clock,
+}
+
+/// Identity of the device that produced a result, written into every record.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct AdapterInfo {
+    /// `gpu` or `cpu`.
+    pub backend: String,
+    /// Adapter name, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    pub name: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Graphics API under wgpu (Vulkan, Metal, ...), or the CPU thread count.
+    pub api: String,
+}
+
+/// A renderer of scenes into frames.
+pub trait Backend {
+    /// Which device this is.
+    fn adapter(&self) -> &AdapterInfo;
+
+    /// Renders one frame and reads it back.
+    fn render(&mut self, scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame>;
+
+    /// Renders `warmup + repeats` frames without reading them back and times the last `repeats`.
+    fn time(
+        &mut self,
+        scene: &Scene,
+        view: View,
+        sampling: Sampling,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<Timing>;
+}

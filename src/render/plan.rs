@@ -1,0 +1,103 @@
+//! The render plan: which passes and how many rays a scene calls for, derived from the scene
+//! rather than fixed in a shader ("simulate only the effects a scene calls for").
+
+use super::View;
+use crate::scene::{Light, Scene};
+use serde::Serialize;
+use std::fmt;
+
+/// Lights a frame may hold (ray counters are sized for this).
+pub const MAX_LIGHTS: usize = 8;
+
+/// One pass of the plan.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "pass", rename_all = "kebab-case")]
+pub enum Pass {
+    /// Camera rays against the scene's shapes: closest hit.
+    Primary {
+        /// One ray per pixel.
+        rays: u64,
+        /// Shape kinds intersected (only those present in the scene).
+        shapes: Vec<&'static str>,
+    },
+    /// Shadow rays from every receiver point towards one light: any-hit with early exit.
+    Shadow {
+        /// Light index in the scene.
+        light: usize,
+        /// `point` or `disk`.
+        kind: &'static str,
+        /// Rays per receiver point that faces the light (1 for a point light).
+        rays_per_receiver: u32,
+        /// Upper bound on rays: receivers facing away from the light issue none.
+        max_rays: u64,
+    },
+}
+
+/// The passes one frame runs, in order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RenderPlan {
+    /// Passes in execution order.
+    pub passes: Vec<Pass>,
+}
+
+impl RenderPlan {
+    /// The plan for `scene` seen through `view`: a primary pass over the shapes the scene has,
+    /// then one shadow pass per light with that light's ray count; nothing else.
+    pub fn new(scene: &Scene, view: View) -> anyhow::Result<RenderPlan> {
+        anyhow::ensure!(
+            scene.lights.len() <= MAX_LIGHTS,
+            "the scene has {} lights; at most {MAX_LIGHTS} are supported",
+            scene.lights.len()
+        );
+        let pixels = view.pixels() as u64;
+        let mut shapes = Vec::new();
+        if !scene.spheres.is_empty() {
+            shapes.push("sphere");
+        }
+        if !scene.planes.is_empty() {
+            shapes.push("plane");
+        }
+        let mut passes = vec![Pass::Primary {
+            rays: pixels,
+            shapes,
+        }];
+        for (i, light) in scene.lights.iter().enumerate() {
+            let n = light.samples();
+            passes.push(Pass::Shadow {
+                light: i,
+                kind: match light {
+                    Light::Point { .. } => "point",
+                    Light::Disk(_) => "disk",
+                },
+                rays_per_receiver: n,
+                max_rays: pixels * n as u64,
+            });
+        }
+        Ok(RenderPlan { passes })
+    }
+
+    /// Most rays a frame can trace.
+    pub fn max_rays(&self) -> u64 {
+        self.passes
+            .iter()
+            .map(|p| match p {
+                Pass::Primary { rays, .. } => *rays,
+                Pass::Shadow { max_rays, .. } => *max_rays,
+            })
+            .sum()
+    }
+}
+
+impl fmt::Display for RenderPlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for p in &self.passes {
+            match p {
+                Pass::Primary { rays, shapes } => writeln!(f, "primary: {rays} rays vs [{}]", shapes.join(", "))?,
+                Pass::Shadow { light, kind, rays_per_receiver, max_rays } => {
+                    writeln!(f, "shadow light {light} ({kind}): {rays_per_receiver} rays/receiver, <= {max_rays} rays")?
+                }
+            }
+        }
+        Ok(())
+    }
+}

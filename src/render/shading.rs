@@ -1,0 +1,111 @@
+//! Per-receiver shadow-ray logic of the CPU backend, in f64. `shaders/render.wgsl` follows it
+//! line for line in f32; change both together.
+
+use crate::geometry::{offset_origin, plane_t, sphere_roots};
+use crate::sampling::{DiskScheme, Stream};
+use crate::scene::{DiskLight, Light, Scene};
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+/// What one receiver point gets from one light.
+pub struct LightSample {
+    /// Fraction of shadow-ray targets visible.
+    pub visibility: f64,
+    /// Irradiance estimate, W m^-2.
+    pub irradiance: f64,
+    /// Shadow rays traced.
+    pub rays: u64,
+}
+
+/// Any-hit test of the segment origin -> origin + d (exclusive of both ends) against the scene.
+pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3) -> bool {
+    let len = d.length();
+    let dir = d / len;
+    let inside = |t: f64| t > 0.0 && t < len;
+    scene
+        .spheres
+        .iter()
+        .any(|s| sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1)))
+        || scene
+            .planes
+            .iter()
+            .any(|p| plane_t(origin, dir, p).is_some_and(inside))
+}
+
+/// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:
+/// then the receiver issues no shadow rays to it.
+pub fn disk_unreachable(p: DVec3, n: DVec3, l: &DiskLight) -> bool {
+    let tilt = (1.0 - n.dot(l.normal).powi(2)).max(0.0).sqrt();
+    l.normal.dot(p - l.center) <= 0.0 || n.dot(l.center - p) + l.radius * tilt <= 0.0
+}
+
+/// Shadow rays from receiver (p, n) to `light`. `shared` holds the precomputed unit-disk points
+/// when every pixel uses the same set; otherwise `scheme` draws from `stream`.
+pub fn shade_light(
+    scene: &Scene,
+    p: DVec3,
+    n: DVec3,
+    light: &Light,
+    scheme: DiskScheme,
+    stream: Stream,
+    shared: Option<&[DVec2]>,
+) -> LightSample {
+    let origin = offset_origin(p, n);
+    match light {
+        Light::Point { position, power } => {
+            let d = *position - p;
+            if n.dot(d) <= 0.0 {
+                return LightSample {
+                    visibility: 0.0,
+                    irradiance: 0.0,
+                    rays: 0,
+                };
+            }
+            let visible = !occluded(scene, origin, *position - origin);
+            let irradiance = if visible {
+                power / (4.0 * PI) * n.dot(d.normalize()) / d.length_squared()
+            } else {
+                0.0
+            };
+            LightSample {
+                visibility: visible as u8 as f64,
+                irradiance,
+                rays: 1,
+            }
+        }
+        Light::Disk(l) => {
+            if disk_unreachable(p, n, l) {
+                return LightSample {
+                    visibility: 0.0,
+                    irradiance: 0.0,
+                    rays: 0,
+                };
+            }
+            let (u, v) = l.basis();
+            let (mut visible, mut rays, mut sum) = (0u32, 0u64, 0.0);
+            for k in 0..l.samples {
+                let s = match shared {
+                    Some(points) => points[k as usize],
+                    None => scheme.point(l.samples, k, stream),
+                };
+                let q = l.center + l.radius * (s.x * u + s.y * v);
+                let d = q - p;
+                if n.dot(d) <= 0.0 || l.normal.dot(d) >= 0.0 {
+                    continue;
+                }
+                rays += 1;
+                if !occluded(scene, origin, q - origin) {
+                    visible += 1;
+                    let d2 = d.length_squared();
+                    sum += n.dot(d) * -l.normal.dot(d) / (d2 * d2);
+                }
+            }
+            let n_f = l.samples as f64;
+            LightSample {
+                visibility: visible as f64 / n_f,
+                irradiance: l.power / (PI * n_f) * sum,
+                rays,
+            }
+        }
+    }
+}

@@ -1,0 +1,295 @@
+//! Where shadow rays land on a disk light: the schemes compared by the sweep.
+//!
+//! Each scheme maps (sample count n, sample index k, random stream) to a point on the unit disk;
+//! the renderer scales it by the light's radius and places it in the light's plane. A scheme is
+//! evaluated one sample at a time so that the GPU can do the same without storage.
+//!
+//! Adding a scheme: a variant in [`DiskScheme`] with its name in [`DiskScheme::ALL`], its point
+//! function in [`DiskScheme::point`], and the same function in
+//! `render/gpu/shaders/sampling.wgsl` under the matching `SCHEME_*` id. The property tests in
+//! `tests/sampling_properties.rs` and the CPU/GPU agreement test then cover it.
+
+pub mod rng;
+pub mod sobol;
+
+use glam::DVec2;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
+use std::fmt;
+use std::str::FromStr;
+
+pub use rng::Stream;
+
+/// How the n shadow-ray targets of one receiver point are chosen on the unit disk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum DiskScheme {
+    /// Eq. (1) of the soft-shadow paper: r = sqrt(u), theta = 2 pi v. Area-uniform, independent.
+    Uniform,
+    /// Eq. (2) + (3) as the text intends: the centre, then n - 1 points at evenly spaced angles
+    /// theta_i = 2 pi i / (n - 1) with radii 0.3 + 0.7 sqrt(a), a uniform in [0, 1].
+    Paper,
+    /// Eq. (3) exactly as printed: x = 0.3 + 0.7 sqrt(a) cos(theta), y = 0.3 + 0.7 sqrt(a) sin(theta),
+    /// which shifts every non-centre point by (0.3, 0.3), partly off the light.
+    PaperLiteral,
+    /// Jittered (stratified) samples on a rows x cols grid of the unit square, mapped by the
+    /// concentric map (Shirley & Chiu 1997). rows is the largest divisor of n not above sqrt(n),
+    /// so every stratum has equal area and the estimator stays unbiased for any n.
+    Jittered,
+    /// Owen-scrambled Sobol' (Burley 2020) through the concentric map.
+    Sobol,
+    /// Golden-angle spiral with one random rotation and one random radial offset per pattern:
+    /// sample k is uniform over the k-th of n equal-area annuli, so it is unbiased.
+    Spiral,
+}
+
+impl DiskScheme {
+    /// Every scheme, in report order.
+    pub const ALL: [DiskScheme; 6] = [
+        DiskScheme::Uniform,
+        DiskScheme::Paper,
+        DiskScheme::PaperLiteral,
+        DiskScheme::Jittered,
+        DiskScheme::Sobol,
+        DiskScheme::Spiral,
+    ];
+
+    /// The name used in experiment files and CSV columns.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiskScheme::Uniform => "uniform",
+            DiskScheme::Paper => "paper",
+            DiskScheme::PaperLiteral => "paper-literal",
+            DiskScheme::Jittered => "jittered",
+            DiskScheme::Sobol => "sobol",
+            DiskScheme::Spiral => "spiral",
+        }
+    }
+
+    /// Numeric id shared with the WGSL `SCHEME_*` constants.
+    pub fn gpu_id(self) -> u32 {
+        self as u32
+    }
+
+    /// Whether each sample is area-uniform on the disk, making the equal-weight estimator of
+    /// visibility unbiased. The paper's schemes are not: they weight the rim more (known-facts.md).
+    pub fn is_area_uniform(self) -> bool {
+        !matches!(self, DiskScheme::Paper | DiskScheme::PaperLiteral)
+    }
+
+    /// Sample `k` of `n` on the unit disk, drawing its randomness from `stream`.
+    pub fn point(self, n: u32, k: u32, stream: Stream) -> DVec2 {
+        debug_assert!(k < n);
+        match self {
+            DiskScheme::Uniform => {
+                let (u, v) = (stream.unit(2 * k), stream.unit(2 * k + 1));
+                polar(u.sqrt(), TAU * v)
+            }
+            DiskScheme::Paper | DiskScheme::PaperLiteral => {
+                if k == 0 {
+                    return DVec2::ZERO;
+                }
+                let theta = TAU * k as f64 / (n - 1) as f64;
+                let r = 0.7 * stream.unit(2 * k).sqrt();
+                if self == DiskScheme::Paper {
+                    polar(0.3 + r, theta)
+                } else {
+                    DVec2::splat(0.3) + polar(r, theta)
+                }
+            }
+            DiskScheme::Jittered => {
+                let (rows, cols) = strata(n);
+                let (i, j) = (k % cols, k / cols);
+                let u = (i as f64 + stream.unit(2 * k)) / cols as f64;
+                let v = (j as f64 + stream.unit(2 * k + 1)) / rows as f64;
+                concentric(u, v)
+            }
+            DiskScheme::Sobol => {
+                let (x, y) = sobol::scrambled_sobol_2d(k, stream.u32(0x7fff_ffff));
+                concentric(rng::to_unit(x), rng::to_unit(y))
+            }
+            DiskScheme::Spiral => {
+                // The angle as a 32-bit fixed-point fraction of a turn: exact on both backends.
+                let turn = k
+                    .wrapping_mul(GOLDEN_TURN)
+                    .wrapping_add(stream.u32(0x7fff_fffe));
+                let offset = stream.unit(0x7fff_fffd);
+                let r = ((k as f64 + offset) / n as f64).sqrt();
+                polar(r, TAU * rng::to_unit(turn))
+            }
+        }
+    }
+
+    /// All `n` samples of one pattern.
+    pub fn points(self, n: u32, stream: Stream) -> Vec<DVec2> {
+        (0..n).map(|k| self.point(n, k, stream)).collect()
+    }
+}
+
+/// The golden angle pi (3 - sqrt 5) as a 32-bit fraction of a turn, round(2^32 (3 - sqrt 5) / 2):
+/// successive spiral points never line up radially (Vogel 1979).
+pub const GOLDEN_TURN: u32 = 0x61c8_8647;
+
+/// Grid of equal strata for n jittered samples: (rows, cols), rows <= cols, rows * cols = n.
+pub fn strata(n: u32) -> (u32, u32) {
+    let mut rows = (n as f64).sqrt().floor() as u32;
+    while rows > 1 && n % rows != 0 {
+        rows -= 1;
+    }
+    let rows = rows.max(1);
+    (rows, n / rows)
+}
+
+fn polar(r: f64, theta: f64) -> DVec2 {
+    DVec2::new(r * theta.cos(), r * theta.sin())
+}
+
+/// Shirley & Chiu's concentric map from the unit square to the unit disk: area-preserving and
+/// keeps strata compact, unlike eq. (1)'s polar map.
+pub fn concentric(u: f64, v: f64) -> DVec2 {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return DVec2::ZERO;
+    }
+    if a.abs() > b.abs() {
+        polar(a, FRAC_PI_4 * (b / a))
+    } else {
+        polar(b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+    }
+}
+
+/// Whether a scheme's random numbers are fresh per pixel or one set is shared by all pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Pattern {
+    /// A new stream for every pixel: noise, no structure.
+    PerPixel,
+    /// One precomputed set in a GPU buffer for every pixel, as the paper did ("pre-computed in
+    /// advance and stored in a buffer"): no per-pixel noise, but banding and bias shared by all.
+    Shared,
+}
+
+impl Pattern {
+    /// Both patterns, in report order.
+    pub const ALL: [Pattern; 2] = [Pattern::PerPixel, Pattern::Shared];
+
+    /// The name used in experiment files and CSV columns.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pattern::PerPixel => "per-pixel",
+            Pattern::Shared => "shared",
+        }
+    }
+}
+
+macro_rules! named_enum {
+    ($ty:ty, $what:literal) => {
+        impl fmt::Display for $ty {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+        impl FromStr for $ty {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                <$ty>::ALL
+                    .iter()
+                    .copied()
+                    .find(|x| x.name() == s)
+                    .ok_or_else(|| {
+                        let names: Vec<_> = <$ty>::ALL.iter().map(|x| x.name()).collect();
+                        format!(
+                            "unknown {} `{s}`; expected one of {}",
+                            $what,
+                            names.join(", ")
+                        )
+                    })
+            }
+        }
+        impl<'de> serde::Deserialize<'de> for $ty {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let s = String::deserialize(d)?;
+                s.parse().map_err(serde::de::Error::custom)
+            }
+        }
+        impl serde::Serialize for $ty {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.serialize_str(self.name())
+            }
+        }
+    };
+}
+named_enum!(DiskScheme, "sampling scheme");
+named_enum!(Pattern, "pattern");
+
+/// Points on the disk of radius `radius` centred at the origin of the light's plane, for the
+/// shared pattern (the paper's precomputed buffer).
+pub fn shared_points(scheme: DiskScheme, n: u32, seed: u32, light: u32) -> Vec<DVec2> {
+    scheme.points(n, Stream::new(seed, light, None))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strata_cover_n_exactly() {
+        for n in 1..=300 {
+            let (r, c) = strata(n);
+            assert_eq!(r * c, n);
+            assert!(r <= c);
+        }
+        assert_eq!(strata(16), (4, 4));
+        assert_eq!(strata(32), (4, 8));
+        assert_eq!(strata(7), (1, 7));
+    }
+
+    #[test]
+    fn concentric_map_hits_corners_and_centre() {
+        assert_eq!(concentric(0.5, 0.5), DVec2::ZERO);
+        assert!((concentric(1.0, 0.5) - DVec2::new(1.0, 0.0)).length() < 1e-15);
+        assert!((concentric(1.0, 1.0).length() - 1.0).abs() < 1e-15);
+        assert!((concentric(0.5, 0.0) - DVec2::new(0.0, -1.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn paper_scheme_small_counts_are_defined() {
+        let s = Stream::new(1, 0, Some(0));
+        assert_eq!(DiskScheme::Paper.points(1, s), vec![DVec2::ZERO]);
+        let two = DiskScheme::Paper.points(2, s);
+        assert_eq!(two[0], DVec2::ZERO);
+        assert!(two[1].length() >= 0.3 - 1e-12 && two[1].length() <= 1.0);
+        // theta_1 = 360 / (2 - 1) degrees: on the +x axis.
+        assert!(two[1].y.abs() < 1e-12 && two[1].x > 0.0);
+    }
+
+    #[test]
+    fn paper_angles_are_evenly_spaced() {
+        let s = Stream::new(5, 0, Some(9));
+        let p = DiskScheme::Paper.points(16, s);
+        for (k, q) in p.iter().enumerate().skip(1) {
+            let expected = TAU * k as f64 / 15.0;
+            let d = (q.y.atan2(q.x) - expected).rem_euclid(TAU);
+            assert!(d < 1e-9 || TAU - d < 1e-9, "k={k}");
+        }
+    }
+
+    #[test]
+    fn literal_reading_is_the_intended_one_shifted() {
+        let s = Stream::new(2, 1, Some(3));
+        let a = DiskScheme::Paper.points(16, s);
+        let b = DiskScheme::PaperLiteral.points(16, s);
+        assert_eq!(b[0], DVec2::ZERO);
+        for k in 1..16 {
+            // Same angle and random a; radius 0.3 + r versus centre (0.3, 0.3) with radius r.
+            let r = a[k].length() - 0.3;
+            assert!(((b[k] - DVec2::splat(0.3)).length() - r).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn names_round_trip_and_unknown_names_are_listed() {
+        for s in DiskScheme::ALL {
+            assert_eq!(s.name().parse::<DiskScheme>().unwrap(), s);
+        }
+        let e = "halton".parse::<DiskScheme>().unwrap_err();
+        assert!(e.contains("halton") && e.contains("paper-literal"), "{e}");
+    }
+}

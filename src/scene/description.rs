@@ -1,0 +1,110 @@
+//! The scene file as written: serde structures with unknown keys rejected.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// A scene file: cameras, analytic shapes and lights.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Named cameras; experiments pick one for measuring and one for pictures.
+    pub cameras: BTreeMap<String, CameraDesc>,
+    /// Analytic spheres.
+    #[serde(default)]
+    pub spheres: Vec<SphereDesc>,
+    /// Infinite planes (the ground).
+    #[serde(default)]
+    pub planes: Vec<PlaneDesc>,
+    /// Light sources.
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
+}
+
+/// A camera as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// `perspective` or `orthographic`.
+    pub projection: ProjectionDesc,
+    /// Eye, or centre of the orthographic image plane, in metres.
+    pub position: [f64; 3],
+    /// Point looked at.
+    pub look_at: [f64; 3],
+    /// Up direction.
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+    /// Vertical field of view in degrees (perspective only).
+    pub fov_y: Option<f64>,
+    /// Horizontal extent in metres (orthographic only).
+    pub width: Option<f64>,
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+/// Camera projection names.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProjectionDesc {
+    /// Pinhole.
+    Perspective,
+    /// Parallel rays.
+    Orthographic,
+}
+
+/// A sphere as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDesc {
+    /// Centre, metres.
+    pub center: [f64; 3],
+    /// Radius, metres.
+    pub radius: f64,
+    /// Lambertian albedo in [0, 1].
+    #[serde(default = "default_albedo")]
+    pub albedo: f64,
+}
+
+/// A plane as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneDesc {
+    /// Any point on the plane.
+    pub point: [f64; 3],
+    /// Normal (need not be unit length); the lit side.
+    pub normal: [f64; 3],
+    /// Lambertian albedo in [0, 1].
+    #[serde(default = "default_albedo")]
+    pub albedo: f64,
+}
+
+fn default_albedo() -> f64 {
+    0.8
+}
+
+/// A light as written; `type` selects the kind.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum LightDesc {
+    /// An ideal point light: one shadow ray.
+    Point {
+        /// Position, metres.
+        position: [f64; 3],
+        /// Radiant power, watts.
+        power: f64,
+    },
+    /// A one-sided Lambertian disk emitting along `normal`.
+    Disk {
+        /// Centre, metres.
+        center: [f64; 3],
+        /// Emitting direction.
+        normal: [f64; 3],
+        /// Radius, metres (the paper's bulb: 0.02).
+        radius: f64,
+        /// Radiant power, watts.
+        power: f64,
+        /// Shadow rays per receiver point.
+        samples: u32,
+    },
+}
