@@ -67,7 +67,7 @@ pub fn format_path(path: &[Seg]) -> String {
 /// Builds a key path from `"lights"`, `0usize`, `"radius"`-style pieces.
 #[macro_export]
 macro_rules! key_path {
-    ($($seg:expr),* $(,)?) => { vec![$($crate::config::IntoSeg::into_seg($seg)),*] };
+    ($($seg:expr),* $(,)?) => { [$($crate::config::IntoSeg::into_seg($seg)),*] };
 }
 
 /// Conversion used by [`key_path!`].
@@ -125,12 +125,7 @@ impl Source {
         self.error_at_span(span, format_path(path), message.into())
     }
 
-    fn error_at_span(
-        &self,
-        span: Option<Range<usize>>,
-        key: String,
-        message: String,
-    ) -> ConfigError {
+    fn error_at_span(&self, span: Option<Range<usize>>, key: String, message: String) -> ConfigError {
         ConfigError {
             file: self.path.clone(),
             position: span.map(|s| line_col(&self.text, s.start)),
@@ -260,17 +255,12 @@ mod tests {
         let s = src("name = \"a\"\n[[lights]]\nradius = 1.0\n[[lights]]\nradios = 2.0\n");
         let e = s.parse::<Doc>().unwrap_err();
         assert_eq!(e.position.map(|p| p.0), Some(5), "{e}");
-        assert!(
-            e.key.contains("radios") && e.message.contains("unknown field"),
-            "{e}"
-        );
+        assert!(e.key.contains("radios") && e.message.contains("unknown field"), "{e}");
     }
 
     #[test]
     fn syntax_error_is_located() {
-        let e = src("name = \"a\"\nlights = [\n")
-            .parse::<Doc>()
-            .unwrap_err();
+        let e = src("name = \"a\"\nlights = [\n").parse::<Doc>().unwrap_err();
         assert!(e.position.is_some(), "{e}");
     }
 
@@ -279,9 +269,6 @@ mod tests {
         let s = src("name = \"a\"\n[[lights]]\nradius = 1.0\n[[lights]]\nradius = -2.0\n");
         let e = s.error(&key_path!["lights", 1usize, "radius"], "must be positive");
         assert_eq!(e.position, Some((5, 1)));
-        assert_eq!(
-            e.to_string(),
-            "x.toml:5:1: key `lights[1].radius`: must be positive"
-        );
+        assert_eq!(e.to_string(), "x.toml:5:1: key `lights[1].radius`: must be positive");
     }
 }

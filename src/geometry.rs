@@ -86,10 +86,7 @@ mod tests {
             };
             let p = offset_origin(pl.point, pl.normal);
             assert!((p - pl.point).dot(pl.normal) > 0.0, "scale {scale}");
-            assert!(
-                (p - pl.point).length() < 1e-9 * scale.max(1.0),
-                "scale {scale}"
-            );
+            assert!((p - pl.point).length() < 1e-9 * scale.max(1.0), "scale {scale}");
         }
     }
 }

@@ -15,8 +15,11 @@
 //! ```
 
 pub mod config;
+pub mod experiment;
 pub mod geometry;
+pub mod metrics;
 pub mod reference;
 pub mod render;
+pub mod report;
 pub mod sampling;
 pub mod scene;

@@ -50,10 +50,7 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
                 "{camera} {scheme}: {hit_diff} pixels hit different objects"
             );
             let (mean, max, differing) = compare(&g, &c);
-            assert!(
-                mean < 1e-3,
-                "{camera} {scheme}/{pattern}: mean |dV| = {mean}"
-            );
+            assert!(mean < 1e-3, "{camera} {scheme}/{pattern}: mean |dV| = {mean}");
             assert!(
                 max <= 1.0 / 16.0 + 1e-6,
                 "{camera} {scheme}/{pattern}: max |dV| = {max}"
@@ -64,22 +61,14 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
             );
             assert_eq!(g.rays.primary, c.rays.primary);
             let (gr, cr) = (g.rays.shadow_total() as f64, c.rays.shadow_total() as f64);
-            assert!(
-                (gr - cr).abs() <= 1e-3 * cr,
-                "{camera}: shadow rays {gr} vs {cr}"
-            );
-            let lit: Vec<_> = (0..g.radiance.len())
-                .filter(|&i| c.radiance[i] > 0.0)
-                .collect();
+            assert!((gr - cr).abs() <= 1e-3 * cr, "{camera}: shadow rays {gr} vs {cr}");
+            let lit: Vec<_> = (0..g.radiance.len()).filter(|&i| c.radiance[i] > 0.0).collect();
             let rel = lit
                 .iter()
                 .map(|&i| ((g.radiance[i] - c.radiance[i]) / c.radiance[i]).abs() as f64)
                 .sum::<f64>()
                 / lit.len() as f64;
-            assert!(
-                rel < 2e-3,
-                "{camera}: mean relative radiance difference {rel}"
-            );
+            assert!(rel < 2e-3, "{camera}: mean relative radiance difference {rel}");
         }
     }
 }

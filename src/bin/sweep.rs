@@ -1,1 +1,122 @@
-fn main() {}
+//! `sweep EXPERIMENT.toml`: runs an experiment's sweep and writes its results folder.
+
+use anyhow::Context;
+use clap::Parser;
+use penumbra::experiment::{pictures::render_pictures, run_sweep, spec::BackendChoice, Spec};
+use penumbra::render::{cpu::CpuBackend, gpu::GpuBackend, Backend};
+use penumbra::report::markdown::verdict_radius;
+use penumbra::report::write::{write_all, Results};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Sweep sampling scheme x pattern x shadow-ray count x light radius x seed, measure every run
+/// against a ground truth checked against the exact answer, and write CSV, plots and a report.
+#[derive(Parser)]
+#[command(version)]
+struct Args {
+    /// Experiment file, e.g. experiments/sphere.toml.
+    experiment: PathBuf,
+    /// Results folder (default: results/NAME, NAME from the experiment file).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Discard the journal of an interrupted sweep and redo every run.
+    #[arg(long)]
+    fresh: bool,
+    /// Override the experiment's backend: auto, gpu or cpu.
+    #[arg(long)]
+    backend: Option<String>,
+}
+
+fn open_backend(choice: BackendChoice) -> anyhow::Result<Box<dyn Backend>> {
+    match choice {
+        BackendChoice::Cpu => Ok(Box::new(CpuBackend::default())),
+        BackendChoice::Gpu => Ok(Box::new(GpuBackend::new()?)),
+        BackendChoice::Auto => match GpuBackend::new() {
+            Ok(g) => Ok(Box::new(g)),
+            Err(e) => {
+                eprintln!("warning: {e:#}\nwarning: falling back to the f64 CPU backend (slow; results record it)");
+                Ok(Box::new(CpuBackend::default()))
+            }
+        },
+    }
+}
+
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let spec = Spec::load(&args.experiment)?;
+    let choice = match args.backend.as_deref() {
+        None => spec.backend,
+        Some("auto") => BackendChoice::Auto,
+        Some("gpu") => BackendChoice::Gpu,
+        Some("cpu") => BackendChoice::Cpu,
+        Some(other) => anyhow::bail!("--backend must be auto, gpu or cpu, got `{other}`"),
+    };
+    let out = args.out.unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    let mut backend = open_backend(choice)?;
+    let adapter = backend.adapter().clone();
+    eprintln!(
+        "{}: {} runs on {} ({}, {})",
+        spec.name,
+        spec.axes.schemes.len()
+            * spec.axes.patterns.len()
+            * spec.axes.samples.len()
+            * spec.axes.light_radii.len()
+            * spec.axes.seeds.len(),
+        adapter.name,
+        adapter.backend,
+        adapter.api
+    );
+    let outcome = run_sweep(
+        &spec,
+        backend.as_mut(),
+        &out.join(".journal"),
+        &out.join("cache"),
+        args.fresh,
+    )?;
+    eprint!("render plan of a run:\n{}", outcome.plan);
+    let pictures =
+        render_pictures(&spec, backend.as_mut(), verdict_radius(&spec)).context("rendering the figures' pictures")?;
+    let seconds = started.elapsed().as_secs_f64();
+    let results = Results {
+        spec: &spec,
+        outcome: &outcome,
+        pictures: &pictures,
+        adapter: &adapter,
+        seconds,
+        peak_rss: peak_rss(),
+    };
+    write_all(&results, &out)?;
+    eprintln!(
+        "{} runs ({} failed, {} groups resumed) in {seconds:.1} s; peak RSS {:.0} MiB; wrote {}",
+        outcome.records.len(),
+        outcome.failures,
+        outcome.resumed,
+        results.peak_rss.unwrap_or(0) as f64 / 1048576.0,
+        out.join("report.md").display()
+    );
+    if outcome.failures > 0 {
+        anyhow::bail!(
+            "{} runs failed; see the `error` column of {}",
+            outcome.failures,
+            out.join("runs.csv").display()
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run(Args::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

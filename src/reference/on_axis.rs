@@ -42,9 +42,7 @@ impl OnAxis {
         let light_height = (l.center - pl.point).dot(pl.normal);
         let sphere_height = (s.center - pl.point).dot(pl.normal);
         let aligned = l.normal.dot(pl.normal) < -1.0 + tol;
-        let axis_offset = (s.center - l.center)
-            .reject_from_normalized(pl.normal)
-            .length();
+        let axis_offset = (s.center - l.center).reject_from_normalized(pl.normal).length();
         let above = light_height > sphere_height + s.radius && sphere_height > s.radius;
         if !(aligned && axis_offset <= tol * light_height && above) {
             return None;
@@ -62,10 +60,7 @@ impl OnAxis {
 
     fn angles(&self) -> (f64, f64) {
         let (a, dh) = (self.light_radius, self.light_height - self.sphere_height);
-        (
-            (a / dh).atan(),
-            (self.sphere_radius / (a * a + dh * dh).sqrt()).asin(),
-        )
+        ((a / dh).atan(), (self.sphere_radius / (a * a + dh * dh).sqrt()).asin())
     }
 
     /// Umbra radius r_u; negative when there is no umbra.
@@ -122,16 +117,8 @@ mod tests {
     fn known_facts_example() {
         let (l, s, p) = example();
         let o = OnAxis::from_parts(&l, &s, &p).unwrap();
-        assert!(
-            (o.umbra_radius() - 1.000).abs() < 5e-4,
-            "{}",
-            o.umbra_radius()
-        );
-        assert!(
-            (o.penumbra_radius() - 1.917).abs() < 5e-4,
-            "{}",
-            o.penumbra_radius()
-        );
+        assert!((o.umbra_radius() - 1.000).abs() < 5e-4, "{}", o.umbra_radius());
+        assert!((o.penumbra_radius() - 1.917).abs() < 5e-4, "{}", o.penumbra_radius());
     }
 
     /// The closed-form radii and the quadrature agree: V is 0 just inside r_u, 1 just outside
@@ -145,20 +132,14 @@ mod tests {
             s.center.z = h;
             s.radius = r;
             let o = OnAxis::from_parts(&l, &s, &p).unwrap();
-            let v = |x: f64| {
-                visible_fraction(o.point_at(x), DVec3::Z, &l, std::slice::from_ref(&s), &[])
-            };
+            let v = |x: f64| visible_fraction(o.point_at(x), DVec3::Z, &l, std::slice::from_ref(&s), &[]);
             let (ru, rp) = (o.umbra_radius(), o.penumbra_radius());
             let d = 1e-6 * rp;
             if ru > d {
                 assert!(v(ru - d) < 1e-6, "a={a}: V(r_u-) = {}", v(ru - d));
                 assert!(v(ru + 1e-3 * (rp - ru)) > 0.0);
             }
-            assert!(
-                (v(rp + d) - 1.0).abs() < 1e-9,
-                "a={a}: V(r_p+) = {}",
-                v(rp + d)
-            );
+            assert!((v(rp + d) - 1.0).abs() < 1e-9, "a={a}: V(r_p+) = {}", v(rp + d));
             assert!(v(rp - 1e-3 * (rp - ru.max(0.0))) < 1.0);
             let mid = v(0.5 * (ru.max(0.0) + rp));
             assert!(mid > 0.0 && mid < 1.0);

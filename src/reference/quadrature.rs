@@ -19,7 +19,7 @@ const WGK: [f64; 8] = [
     0.169_004_726_639_267_9,
     0.190_350_578_064_785_4,
     0.204_432_940_075_298_9,
-    0.209_482_141_084_728_0,
+    0.209_482_141_084_728,
 ];
 const WG: [f64; 4] = [
     0.129_484_966_168_869_7,
@@ -61,14 +61,7 @@ pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels
 /// Integral of `f` over [a, b] to absolute tolerance `tol` (bisecting panels whose error
 /// estimate exceeds their share), stopping at depth 40.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
-    fn rec(
-        f: &impl Fn(f64) -> f64,
-        a: f64,
-        b: f64,
-        tol: f64,
-        whole: (f64, f64),
-        depth: u32,
-    ) -> f64 {
+    fn rec(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> f64 {
         if whole.1 <= tol || depth >= 40 {
             return whole.0;
         }

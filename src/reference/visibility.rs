@@ -25,13 +25,7 @@ const PANELS: u32 = 128;
 /// Exact fraction of `light` visible from point `p` with surface normal `n` (the receiver's own
 /// horizon counts as an occluder), with `spheres` and `planes` as occluders. Planes through `p`
 /// are the receiver itself and are skipped.
-pub fn visible_fraction(
-    p: DVec3,
-    n: DVec3,
-    light: &DiskLight,
-    spheres: &[Sphere],
-    planes: &[Plane],
-) -> f64 {
+pub fn visible_fraction(p: DVec3, n: DVec3, light: &DiskLight, spheres: &[Sphere], planes: &[Plane]) -> f64 {
     if light.normal.dot(p - light.center) <= 0.0 {
         return 0.0; // behind the one-sided emitter
     }
@@ -84,15 +78,7 @@ fn unoccluded_and_above_horizon(p: DVec3, n: DVec3, light: &DiskLight, spheres: 
 }
 
 /// Integral of rho d rho over the visible part of the ray {C + rho e : 0 <= rho <= a}.
-fn visible_rho_integral(
-    p: DVec3,
-    n: DVec3,
-    c: DVec3,
-    e: DVec3,
-    a: f64,
-    spheres: &[Sphere],
-    planes: &[&Plane],
-) -> f64 {
+fn visible_rho_integral(p: DVec3, n: DVec3, c: DVec3, e: DVec3, a: f64, spheres: &[Sphere], planes: &[&Plane]) -> f64 {
     let w0 = c - p;
     let mut cuts = vec![0.0, a];
     let mut add = |c2: f64, c1: f64, c0: f64| {
@@ -108,11 +94,7 @@ fn visible_rho_integral(
         let k = f.length_squared() - s.radius * s.radius;
         let (fe, fw0, we, ww0) = (f.dot(e), f.dot(w0), w0.dot(e), w0.length_squared());
         let g = w0 - f;
-        add(
-            1.0,
-            2.0 * e.dot(g),
-            g.length_squared() - s.radius * s.radius,
-        );
+        add(1.0, 2.0 * e.dot(g), g.length_squared() - s.radius * s.radius);
         add(0.0, fe, fw0);
         add(1.0, 2.0 * we - fe, ww0 - fw0);
         add(fe * fe - k, 2.0 * (fw0 * fe - k * we), fw0 * fw0 - k * ww0);
@@ -216,13 +198,7 @@ mod tests {
         let rb = h_light * beta.tan();
         for (offset, radius) in [(0.9, 0.6), (1.3, 0.6), (0.2, 1.5), (2.0, 0.3), (0.0, 0.5)] {
             let light = down_light(DVec3::new(offset, 0.0, h_light), radius);
-            let v = visible_fraction(
-                DVec3::ZERO,
-                DVec3::Z,
-                &light,
-                std::slice::from_ref(&sphere),
-                &[],
-            );
+            let v = visible_fraction(DVec3::ZERO, DVec3::Z, &light, std::slice::from_ref(&sphere), &[]);
             let expected = 1.0 - lens(radius, rb, offset) / (PI * radius * radius);
             assert!(
                 (v - expected).abs() < 1e-9,
@@ -258,10 +234,7 @@ mod tests {
             );
             assert!((0.0..=1.0).contains(&v));
             if let Some(p) = prev {
-                assert!(
-                    v <= p + 1e-12,
-                    "sinking the light into the sphere can only hide more"
-                );
+                assert!(v <= p + 1e-12, "sinking the light into the sphere can only hide more");
             }
             prev = Some(v);
         }

@@ -2,9 +2,7 @@
 //! in tests. Same plan, same sample streams, double precision, rayon over rows.
 
 use super::shading::{occluded, shade_light};
-use super::{
-    AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER,
-};
+use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::geometry::{plane_t, reproject_plane, reproject_sphere, sphere_roots};
 use crate::render::plan::{RenderPlan, MAX_LIGHTS};
 use crate::sampling::{shared_points, Pattern, Stream};
@@ -94,8 +92,7 @@ impl Backend for CpuBackend {
                 let mut rays = [0u64; MAX_LIGHTS];
                 for x in 0..view.width {
                     let ray = view.camera.ray(x, y, view.width, view.height);
-                    let Some((p, n, albedo, id)) = closest_hit(scene, ray.origin, ray.direction)
-                    else {
+                    let Some((p, n, albedo, id)) = closest_hit(scene, ray.origin, ray.direction) else {
                         continue;
                     };
                     let pixel = y * view.width + x;
@@ -103,15 +100,7 @@ impl Backend for CpuBackend {
                     let mut irradiance = 0.0;
                     for (li, light) in scene.lights.iter().enumerate() {
                         let stream = Stream::new(sampling.seed, li as u32, Some(pixel));
-                        let s = shade_light(
-                            scene,
-                            p,
-                            n,
-                            light,
-                            sampling.scheme,
-                            stream,
-                            shared[li].as_deref(),
-                        );
+                        let s = shade_light(scene, p, n, light, sampling.scheme, stream, shared[li].as_deref());
                         vis[li * w + x as usize] = s.visibility as f32;
                         irradiance += s.irradiance;
                         rays[li] += s.rays;
@@ -176,12 +165,8 @@ pub fn segment_blocked(scene: &Scene, from: DVec3, normal: DVec3, target: DVec3)
 
 /// Lights of the scene that are disks, with their indices.
 pub fn disk_lights(scene: &Scene) -> impl Iterator<Item = (usize, &crate::scene::DiskLight)> {
-    scene
-        .lights
-        .iter()
-        .enumerate()
-        .filter_map(|(i, l)| match l {
-            Light::Disk(d) => Some((i, d)),
-            Light::Point { .. } => None,
-        })
+    scene.lights.iter().enumerate().filter_map(|(i, l)| match l {
+        Light::Disk(d) => Some((i, d)),
+        Light::Point { .. } => None,
+    })
 }

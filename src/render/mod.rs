@@ -93,6 +93,16 @@ pub enum Clock {
     WallClock,
 }
 
+impl Clock {
+    /// The label written into results.
+    pub fn name(self) -> &'static str {
+        match self {
+            Clock::GpuTimestamp => "gpu-timestamp",
+            Clock::WallClock => "wall-clock",
+        }
+    }
+}
+
 /// Repeated frame times after warm-up.
 #[derive(Clone, Debug)]
 pub struct Timing {

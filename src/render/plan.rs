@@ -57,10 +57,7 @@ impl RenderPlan {
         if !scene.planes.is_empty() {
             shapes.push("plane");
         }
-        let mut passes = vec![Pass::Primary {
-            rays: pixels,
-            shapes,
-        }];
+        let mut passes = vec![Pass::Primary { rays: pixels, shapes }];
         for (i, light) in scene.lights.iter().enumerate() {
             let n = light.samples();
             passes.push(Pass::Shadow {
@@ -93,9 +90,15 @@ impl fmt::Display for RenderPlan {
         for p in &self.passes {
             match p {
                 Pass::Primary { rays, shapes } => writeln!(f, "primary: {rays} rays vs [{}]", shapes.join(", "))?,
-                Pass::Shadow { light, kind, rays_per_receiver, max_rays } => {
-                    writeln!(f, "shadow light {light} ({kind}): {rays_per_receiver} rays/receiver, <= {max_rays} rays")?
-                }
+                Pass::Shadow {
+                    light,
+                    kind,
+                    rays_per_receiver,
+                    max_rays,
+                } => writeln!(
+                    f,
+                    "shadow light {light} ({kind}): {rays_per_receiver} rays/receiver, <= {max_rays} rays"
+                )?,
             }
         }
         Ok(())

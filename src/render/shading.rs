@@ -26,10 +26,7 @@ pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3) -> bool {
         .spheres
         .iter()
         .any(|s| sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1)))
-        || scene
-            .planes
-            .iter()
-            .any(|p| plane_t(origin, dir, p).is_some_and(inside))
+        || scene.planes.iter().any(|p| plane_t(origin, dir, p).is_some_and(inside))
 }
 
 /// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:

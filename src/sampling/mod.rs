@@ -108,9 +108,7 @@ impl DiskScheme {
             }
             DiskScheme::Spiral => {
                 // The angle as a 32-bit fixed-point fraction of a turn: exact on both backends.
-                let turn = k
-                    .wrapping_mul(GOLDEN_TURN)
-                    .wrapping_add(stream.u32(0x7fff_fffe));
+                let turn = k.wrapping_mul(GOLDEN_TURN).wrapping_add(stream.u32(0x7fff_fffe));
                 let offset = stream.unit(0x7fff_fffd);
                 let r = ((k as f64 + offset) / n as f64).sqrt();
                 polar(r, TAU * rng::to_unit(turn))
@@ -189,18 +187,10 @@ macro_rules! named_enum {
         impl FromStr for $ty {
             type Err = String;
             fn from_str(s: &str) -> Result<Self, String> {
-                <$ty>::ALL
-                    .iter()
-                    .copied()
-                    .find(|x| x.name() == s)
-                    .ok_or_else(|| {
-                        let names: Vec<_> = <$ty>::ALL.iter().map(|x| x.name()).collect();
-                        format!(
-                            "unknown {} `{s}`; expected one of {}",
-                            $what,
-                            names.join(", ")
-                        )
-                    })
+                <$ty>::ALL.iter().copied().find(|x| x.name() == s).ok_or_else(|| {
+                    let names: Vec<_> = <$ty>::ALL.iter().map(|x| x.name()).collect();
+                    format!("unknown {} `{s}`; expected one of {}", $what, names.join(", "))
+                })
             }
         }
         impl<'de> serde::Deserialize<'de> for $ty {

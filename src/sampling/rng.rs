@@ -85,10 +85,6 @@ mod tests {
         m2 /= n as f64;
         // Standard errors: 1/sqrt(12 n) ~ 6.5e-4 for the mean; 5 sigma bounds.
         assert!((m - 0.5).abs() < 3.3e-3, "mean {m}");
-        assert!(
-            (m2 - m * m - 1.0 / 12.0).abs() < 3e-3,
-            "variance {}",
-            m2 - m * m
-        );
+        assert!((m2 - m * m - 1.0 / 12.0).abs() < 3e-3, "variance {}", m2 - m * m);
     }
 }

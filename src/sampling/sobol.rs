@@ -73,28 +73,16 @@ mod tests {
     fn first_points_are_the_textbook_ones() {
         let p: Vec<_> = (0..4).map(|i| (sobol_dim0(i), sobol_dim1(i))).collect();
         let h = 1u32 << 31;
-        assert_eq!(
-            p,
-            vec![
-                (0, 0),
-                (h, h),
-                (h >> 1, h + (h >> 1)),
-                (h + (h >> 1), h >> 1)
-            ]
-        );
+        assert_eq!(p, vec![(0, 0), (h, h), (h >> 1, h + (h >> 1)), (h + (h >> 1), h >> 1)]);
     }
 
     #[test]
     fn unscrambled_and_scrambled_prefixes_are_nets() {
         for m in 0..=8 {
-            let plain: Vec<_> = (0..1u32 << m)
-                .map(|i| (sobol_dim0(i), sobol_dim1(i)))
-                .collect();
+            let plain: Vec<_> = (0..1u32 << m).map(|i| (sobol_dim0(i), sobol_dim1(i))).collect();
             assert_net(&plain, m);
             for seed in [1u32, 99, 0xdead_beef] {
-                let s: Vec<_> = (0..1u32 << m)
-                    .map(|i| scrambled_sobol_2d(i, seed))
-                    .collect();
+                let s: Vec<_> = (0..1u32 << m).map(|i| scrambled_sobol_2d(i, seed)).collect();
                 assert_net(&s, m);
             }
         }

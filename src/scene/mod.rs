@@ -123,25 +123,16 @@ impl Scene {
             let projection = match c.projection {
                 ProjectionDesc::Perspective => {
                     let fov = c.fov_y.ok_or_else(|| {
-                        source.error(
-                            &at("projection"),
-                            "a perspective camera needs `fov_y` (degrees)",
-                        )
+                        source.error(&at("projection"), "a perspective camera needs `fov_y` (degrees)")
                     })?;
                     if !(fov > 0.0 && fov < 180.0) {
-                        return Err(source.error(
-                            &at("fov_y"),
-                            format!("must be in (0, 180) degrees, got {fov}"),
-                        ));
+                        return Err(source.error(&at("fov_y"), format!("must be in (0, 180) degrees, got {fov}")));
                     }
                     Projection::Perspective { fov_y_deg: fov }
                 }
                 ProjectionDesc::Orthographic => {
                     let w = c.width.ok_or_else(|| {
-                        source.error(
-                            &at("projection"),
-                            "an orthographic camera needs `width` (metres)",
-                        )
+                        source.error(&at("projection"), "an orthographic camera needs `width` (metres)")
                     })?;
                     v.positive(w, &at("width"))?;
                     Projection::Orthographic { width: w }
@@ -154,7 +145,10 @@ impl Scene {
                 projection,
             };
             if camera.frame().is_none() {
-                return Err(source.error(&at("up"), "`up` must not be parallel to the viewing direction, and `look_at` must differ from `position`"));
+                return Err(source.error(
+                    &at("up"),
+                    "`up` must not be parallel to the viewing direction, and `look_at` must differ from `position`",
+                ));
             }
             cameras.insert(name.clone(), camera);
         }
@@ -284,9 +278,7 @@ impl Validator<'_> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
-            Err(self
-                .source
-                .error(at, format!("must be positive and finite, got {x}")))
+            Err(self.source.error(at, format!("must be positive and finite, got {x}")))
         }
     }
 
@@ -304,9 +296,7 @@ impl Validator<'_> {
         if (0.0..=1.0).contains(&x) {
             Ok(x)
         } else {
-            Err(self
-                .source
-                .error(at, format!("albedo must be in [0, 1], got {x}")))
+            Err(self.source.error(at, format!("albedo must be in [0, 1], got {x}")))
         }
     }
 
@@ -314,10 +304,9 @@ impl Validator<'_> {
         if (1..=MAX_SAMPLES).contains(&n) {
             Ok(n)
         } else {
-            Err(self.source.error(
-                at,
-                format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}"),
-            ))
+            Err(self
+                .source
+                .error(at, format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}")))
         }
     }
 }
@@ -328,12 +317,7 @@ mod tests {
 
     #[test]
     fn light_basis_is_orthonormal_and_right_handed() {
-        for n in [
-            DVec3::Z,
-            DVec3::NEG_Z,
-            DVec3::new(0.3, -0.4, 0.2).normalize(),
-            DVec3::X,
-        ] {
+        for n in [DVec3::Z, DVec3::NEG_Z, DVec3::new(0.3, -0.4, 0.2).normalize(), DVec3::X] {
             let d = DiskLight {
                 center: DVec3::ZERO,
                 normal: n,

@@ -19,8 +19,7 @@ pub fn gpu() -> Option<std::sync::MutexGuard<'static, GpuBackend>> {
             None
         }
     });
-    slot.as_ref()
-        .map(|m| m.lock().unwrap_or_else(|p| p.into_inner()))
+    slot.as_ref().map(|m| m.lock().unwrap_or_else(|p| p.into_inner()))
 }
 
 /// Path of a file in the repository.

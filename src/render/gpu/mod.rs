@@ -28,8 +28,7 @@ const SHADER: &str = concat!(
 );
 
 /// What to install when no adapter is found, for the error message.
-pub const NO_ADAPTER_HELP: &str =
-    "no GPU adapter found; on Debian install the software Vulkan driver with \
+pub const NO_ADAPTER_HELP: &str = "no GPU adapter found; on Debian install the software Vulkan driver with \
      `apt-get install mesa-vulkan-drivers`, or run with the CPU backend (`--backend cpu`)";
 
 /// The wgpu renderer.
@@ -144,17 +143,11 @@ impl GpuBackend {
                 cache: None,
             })
         };
-        let (primary, shadow, dump) = (
-            pipeline("primary"),
-            pipeline("shadow"),
-            pipeline("dump_samples"),
-        );
+        let (primary, shadow, dump) = (pipeline("primary"), pipeline("shadow"), pipeline("dump_samples"));
         let info = AdapterInfo {
             backend: "gpu".into(),
             name: ai.name.clone(),
-            driver: format!("{} {}", ai.driver, ai.driver_info)
-                .trim()
-                .to_string(),
+            driver: format!("{} {}", ai.driver, ai.driver_info).trim().to_string(),
             api: format!("{:?}", ai.backend),
         };
         Ok(GpuBackend {
@@ -180,36 +173,28 @@ impl GpuBackend {
         // WGSL runtime-sized arrays need a non-empty binding.
         let one = [zeroed];
         let data: &[T] = if data.is_empty() { &one } else { data };
-        self.device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(data),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
     }
 
     fn output(&self, label: &str, size: u64) -> wgpu::Buffer {
         self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.max(16),
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         })
     }
 
     fn check_limits(&self, view: View, lights: usize) -> anyhow::Result<()> {
         let limits = self.device.limits();
-        let max = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         for (what, bytes) in [
             ("hit buffer", view.pixels() as u64 * HIT_BYTES),
-            (
-                "visibility buffer",
-                (view.pixels() * lights.max(1)) as u64 * 4,
-            ),
+            ("visibility buffer", (view.pixels() * lights.max(1)) as u64 * 4),
         ] {
             if bytes > max {
                 bail!(
@@ -224,13 +209,11 @@ impl GpuBackend {
     }
 
     fn resources(&self, packed: &Packed, view: View) -> FrameResources {
-        let params = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("params"),
-                contents: bytemuck::bytes_of(&packed.params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
+        let params = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(&packed.params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let spheres = self.storage("spheres", &packed.spheres, bytemuck::Zeroable::zeroed());
         let planes = self.storage("planes", &packed.planes, bytemuck::Zeroable::zeroed());
         let lights = self.storage("lights", &packed.lights, bytemuck::Zeroable::zeroed());
@@ -266,16 +249,14 @@ impl GpuBackend {
         });
         let passes = (0..packed.lights.len().max(1))
             .map(|light| {
-                let info = self
-                    .device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("pass info"),
-                        contents: bytemuck::bytes_of(&PassInfo {
-                            light: light as u32,
-                            _pad: [0; 3],
-                        }),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
+                let info = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("pass info"),
+                    contents: bytemuck::bytes_of(&PassInfo {
+                        light: light as u32,
+                        _pad: [0; 3],
+                    }),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
                 self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("pass"),
                     layout: &self.layout1,
@@ -313,33 +294,20 @@ impl GpuBackend {
     }
 
     /// Records the plan's passes into `encoder`: primary, then one shadow dispatch per light.
-    fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        r: &FrameResources,
-        view: View,
-        lights: usize,
-    ) {
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, lights: usize) {
         encoder.clear_buffer(&r.counters, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
         for pass in 0..=lights {
-            let timestamp_writes =
-                r.queries
-                    .as_ref()
-                    .map(|(set, _)| wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(2 * pass as u32),
-                        end_of_pass_write_index: Some(2 * pass as u32 + 1),
-                    });
+            let timestamp_writes = r.queries.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(2 * pass as u32),
+                end_of_pass_write_index: Some(2 * pass as u32 + 1),
+            });
             let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: None,
                 timestamp_writes,
             });
-            cp.set_pipeline(if pass == 0 {
-                &self.primary
-            } else {
-                &self.shadow
-            });
+            cp.set_pipeline(if pass == 0 { &self.primary } else { &self.shadow });
             cp.set_bind_group(0, &r.bind0, &[]);
             cp.set_bind_group(1, &r.passes[pass.saturating_sub(1)], &[]);
             cp.dispatch_workgroups(groups.0, groups.1, 1);
@@ -348,11 +316,7 @@ impl GpuBackend {
 
     /// Submits, waits with [`FRAME_TIMEOUT`], and turns validation errors, a lost device or a
     /// timeout into errors.
-    fn submit(
-        &self,
-        encoder: wgpu::CommandEncoder,
-        scope: wgpu::ErrorScopeGuard,
-    ) -> anyhow::Result<()> {
+    fn submit(&self, encoder: wgpu::CommandEncoder, scope: wgpu::ErrorScopeGuard) -> anyhow::Result<()> {
         let index = self.queue.submit([encoder.finish()]);
         let polled = self.device.poll(wgpu::PollType::Wait {
             submission_index: Some(index),
@@ -377,10 +341,7 @@ impl GpuBackend {
         });
         let mut encoder = self.device.create_command_encoder(&Default::default());
         encoder.copy_buffer_to_buffer(src, 0, &staging, 0, size);
-        self.submit(
-            encoder,
-            self.device.push_error_scope(wgpu::ErrorFilter::Validation),
-        )?;
+        self.submit(encoder, self.device.push_error_scope(wgpu::ErrorFilter::Validation))?;
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, .., move |r| {
             let _ = tx.send(r);
@@ -391,8 +352,7 @@ impl GpuBackend {
                 timeout: Some(FRAME_TIMEOUT),
             })
             .map_err(|e| anyhow!("mapping a GPU buffer: {e}"))?;
-        rx.recv()?
-            .map_err(|e| anyhow!("mapping a GPU buffer: {e}"))?;
+        rx.recv()?.map_err(|e| anyhow!("mapping a GPU buffer: {e}"))?;
         let bytes = staging
             .get_mapped_range(..)
             .map_err(|e| anyhow!("reading a GPU buffer: {e:?}"))?
@@ -407,10 +367,7 @@ impl GpuBackend {
         };
         let mut encoder = self.device.create_command_encoder(&Default::default());
         encoder.resolve_query_set(set, 0..set_count(resolve), resolve, 0);
-        self.submit(
-            encoder,
-            self.device.push_error_scope(wgpu::ErrorFilter::Validation),
-        )?;
+        self.submit(encoder, self.device.push_error_scope(wgpu::ErrorFilter::Validation))?;
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(resolve, resolve.size())?);
         let (first, last) = (ticks[0], ticks[ticks.len() - 1]);
         let period = self.queue.get_timestamp_period() as f64;
@@ -419,13 +376,7 @@ impl GpuBackend {
 
     /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
     /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
-    pub fn disk_points(
-        &mut self,
-        scheme: DiskScheme,
-        n: u32,
-        seed: u32,
-        pixel: u32,
-    ) -> anyhow::Result<Vec<[f32; 2]>> {
+    pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
         let scene = crate::scene::Scene {
             cameras: Default::default(),
             spheres: vec![],
@@ -494,12 +445,7 @@ impl Backend for GpuBackend {
         &self.info
     }
 
-    fn render(
-        &mut self,
-        scene: &crate::scene::Scene,
-        view: View,
-        sampling: Sampling,
-    ) -> anyhow::Result<Frame> {
+    fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         RenderPlan::new(scene, view)?;
         self.check_limits(view, scene.lights.len())?;
         let packed = pack(scene, view, sampling);
@@ -510,17 +456,14 @@ impl Backend for GpuBackend {
         self.encode(&mut encoder, &r, view, lights);
         self.submit(encoder, scope)?;
         let pixels = view.pixels();
-        let hits: Vec<u32> =
-            bytemuck::pod_collect_to_vec(&self.read(&r.hits, pixels as u64 * HIT_BYTES)?);
+        let hits: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.hits, pixels as u64 * HIT_BYTES)?);
         let vis: Vec<f32> = if lights > 0 {
             bytemuck::pod_collect_to_vec(&self.read(&r.visibility, (pixels * lights) as u64 * 4)?)
         } else {
             vec![]
         };
-        let radiance: Vec<f32> =
-            bytemuck::pod_collect_to_vec(&self.read(&r.radiance, pixels as u64 * 4)?);
-        let counters: Vec<u32> =
-            bytemuck::pod_collect_to_vec(&self.read(&r.counters, (MAX_LIGHTS * 8) as u64)?);
+        let radiance: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.radiance, pixels as u64 * 4)?);
+        let counters: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.counters, (MAX_LIGHTS * 8) as u64)?);
         let mut rays = RayCounts {
             primary: pixels as u64,
             shadow: [0; MAX_LIGHTS],

@@ -1,0 +1,157 @@
+//! Per light radius: the ground-truth render, the exact visibility of every receiver pixel, and
+//! how far the ground truth is from the exact answer (the check that lets it judge the runs).
+
+use super::spec::Spec;
+use crate::metrics::{ErrorMetrics, PenumbraMask, RadialProfile, Receivers};
+use crate::reference::{visible_fraction, OnAxis};
+use crate::render::{Backend, Sampling, View};
+use crate::sampling::{DiskScheme, Pattern};
+use crate::scene::{Light, Scene};
+use anyhow::Context;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// Seed of the ground-truth render (independent of the sweep's seeds).
+pub const GROUND_TRUTH_SEED: u32 = 0x6a09_e667;
+
+/// Everything the runs of one light radius are judged against.
+pub struct Reference {
+    /// Light radius (m).
+    pub light_radius: f64,
+    /// Ground-truth visibility of the measured light (jittered, thousands of rays per pixel).
+    pub ground_truth: Vec<f32>,
+    /// Exact visibility of receiver pixels ([`crate::render::NO_RECEIVER`] elsewhere).
+    pub exact: Vec<f32>,
+    /// Receiver pixels and their radii.
+    pub receivers: Receivers,
+    /// Penumbra pixels of the ground truth.
+    pub mask: PenumbraMask,
+    /// Closed-form radii, when the scene is on-axis.
+    pub on_axis: Option<OnAxis>,
+    /// Radial profile of the exact image.
+    pub exact_profile: RadialProfile,
+    /// Ground truth against exact over all receiver pixels (max_abs) and the penumbra (rmse, bias).
+    pub gt_vs_exact: ErrorMetrics,
+    /// Largest |ground truth - exact| over every receiver pixel.
+    pub gt_max_abs_all: f64,
+    /// Radial profile of the ground truth.
+    pub gt_profile: RadialProfile,
+}
+
+impl Reference {
+    /// Renders (or loads from `cache`) the ground truth for `radius` and computes the exact image.
+    pub fn build(spec: &Spec, backend: &mut dyn Backend, radius: f64, cache: &Path) -> anyhow::Result<Reference> {
+        let scene = spec.scene_with(radius, spec.ground_truth.samples);
+        let m = &spec.measure;
+        let camera = &scene.cameras[&m.camera];
+        let view = View {
+            camera,
+            width: m.width,
+            height: m.height,
+        };
+        let key = format!(
+            "{};r={radius:e};{}",
+            super::run::context_key(spec),
+            backend.adapter().name
+        );
+        let file = cache.join(format!("ground-truth-{:016x}.bin", super::run::fnv1a(key.as_bytes())));
+        let (ground_truth, hit) = match load_cached(&file, view) {
+            Some(cached) => cached,
+            None => {
+                let sampling = Sampling {
+                    scheme: DiskScheme::Jittered,
+                    pattern: Pattern::PerPixel,
+                    seed: GROUND_TRUTH_SEED,
+                };
+                let mut f = backend
+                    .render(&scene, view, sampling)
+                    .context("rendering the ground truth")?;
+                let rendered = (f.visibility.swap_remove(m.light), f.hit);
+                save_cached(&file, &rendered)?;
+                rendered
+            }
+        };
+        let on_axis = OnAxis::detect(&scene, m.light, m.plane);
+        let centre = on_axis.as_ref().map_or(camera.look_at, |o| o.foot);
+        let bin = match camera.projection {
+            crate::scene::camera::Projection::Orthographic { width } => width / m.width as f64,
+            crate::scene::camera::Projection::Perspective { .. } => {
+                unreachable!("validated orthographic")
+            }
+        };
+        let receivers = Receivers::new(&scene, view, m.plane, &hit, centre, bin);
+        let exact = exact_image(&scene, view, m.light, m.plane, &receivers);
+        let mask = PenumbraMask::from_reference(&ground_truth);
+        let gt_vs_exact = ErrorMetrics::measure(&ground_truth, &exact, &mask);
+        let gt_max_abs_all = receivers
+            .pixels
+            .iter()
+            .map(|&(i, _)| (ground_truth[i] - exact[i]).abs() as f64)
+            .fold(0.0, f64::max);
+        Ok(Reference {
+            light_radius: radius,
+            exact_profile: RadialProfile::new(&receivers, &exact),
+            gt_profile: RadialProfile::new(&receivers, &ground_truth),
+            ground_truth,
+            exact,
+            receivers,
+            mask,
+            on_axis,
+            gt_vs_exact,
+            gt_max_abs_all,
+        })
+    }
+}
+
+/// Exact visibility of `light` at every receiver pixel (rayon; the penumbra dominates the cost).
+pub fn exact_image(scene: &Scene, view: View, light: usize, plane: usize, receivers: &Receivers) -> Vec<f32> {
+    let Light::Disk(l) = &scene.lights[light] else {
+        panic!("validated disk light")
+    };
+    let pl = &scene.planes[plane];
+    let points: Vec<(usize, glam::DVec3)> = receivers
+        .pixels
+        .iter()
+        .map(|&(i, _)| {
+            let (x, y) = ((i % view.width as usize) as u32, (i / view.width as usize) as u32);
+            let ray = view.camera.ray(x, y, view.width, view.height);
+            let t = crate::geometry::plane_t(ray.origin, ray.direction, pl).unwrap_or(0.0);
+            (i, crate::geometry::reproject_plane(ray.origin + ray.direction * t, pl))
+        })
+        .collect();
+    let values: Vec<(usize, f32)> = points
+        .par_iter()
+        .map(|&(i, p)| {
+            (
+                i,
+                visible_fraction(p, pl.normal, l, &scene.spheres, &scene.planes) as f32,
+            )
+        })
+        .collect();
+    let mut image = vec![crate::render::NO_RECEIVER; view.pixels()];
+    for (i, v) in values {
+        image[i] = v;
+    }
+    image
+}
+
+const MAGIC: &[u8; 8] = b"PNBRGT01";
+
+/// Cached (visibility of the measured light, object ids) of a ground-truth render.
+fn load_cached(path: &Path, view: View) -> Option<(Vec<f32>, Vec<u32>)> {
+    let bytes = std::fs::read(path).ok()?;
+    let n = view.pixels();
+    if bytes.len() != 8 + 8 * n || &bytes[..8] != MAGIC {
+        return None;
+    }
+    let vis: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes[8..8 + 4 * n]);
+    let hit: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n..]);
+    Some((vis, hit))
+}
+
+fn save_cached(path: &Path, (vis, hit): &(Vec<f32>, Vec<u32>)) -> anyhow::Result<()> {
+    let mut bytes = MAGIC.to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(vis));
+    bytes.extend_from_slice(bytemuck::cast_slice(hit));
+    crate::report::files::write_atomic(path, &bytes)
+}

@@ -1,0 +1,157 @@
+//! Runs (one point of the swept product) and records (a run plus everything measured on it):
+//! plain data, one record per row of runs.csv in tidy form.
+
+use super::spec::Spec;
+use crate::sampling::{DiskScheme, Pattern};
+
+/// One point of the sweep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    /// Disk sampling scheme.
+    pub scheme: DiskScheme,
+    /// Per-pixel or shared.
+    pub pattern: Pattern,
+    /// Shadow rays per receiver point.
+    pub samples: u32,
+    /// Light radius, metres.
+    pub light_radius: f64,
+    /// Seed.
+    pub seed: u32,
+}
+
+/// Runs that differ only by seed: their images give the per-pixel bias/variance split.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    /// The runs, one per seed, in the experiment's seed order.
+    pub runs: Vec<Run>,
+}
+
+impl Group {
+    /// The group's runs share everything but the seed; this is the first.
+    pub fn head(&self) -> &Run {
+        &self.runs[0]
+    }
+}
+
+/// The sweep in canonical order: light radius, then scheme, pattern, samples; seeds innermost,
+/// grouped. The order fixes the row order of runs.csv whatever order work was done in.
+pub fn expand(spec: &Spec) -> Vec<Group> {
+    let a = &spec.axes;
+    let mut groups = Vec::new();
+    for &light_radius in &a.light_radii {
+        for &scheme in &a.schemes {
+            for &pattern in &a.patterns {
+                for &samples in &a.samples {
+                    let runs = a
+                        .seeds
+                        .iter()
+                        .map(|&seed| Run {
+                            scheme,
+                            pattern,
+                            samples,
+                            light_radius,
+                            seed,
+                        })
+                        .collect();
+                    groups.push(Group { runs });
+                }
+            }
+        }
+    }
+    groups
+}
+
+/// 64-bit FNV-1a: a stable hash (std's hasher may change between releases).
+pub fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// Everything besides the run's own axes that determines its result.
+pub fn context_key(spec: &Spec) -> String {
+    format!(
+        "scene={:016x};measure={:?};gt={};light={};plane={}",
+        fnv1a(spec.scene_text.as_bytes()),
+        (&spec.measure.camera, spec.measure.width, spec.measure.height),
+        spec.ground_truth.samples,
+        spec.measure.light,
+        spec.measure.plane
+    )
+}
+
+impl Run {
+    /// Hash of the run's configuration (scene text, measuring view, ground truth and axes),
+    /// keying resumed work: a changed scene or view gives new keys.
+    pub fn key(&self, context: &str) -> String {
+        let text = format!(
+            "{context};{};{};{};{:e};{}",
+            self.scheme, self.pattern, self.samples, self.light_radius, self.seed
+        );
+        format!("{:016x}", fnv1a(text.as_bytes()))
+    }
+}
+
+/// Formats a float for CSV: shortest round-trip representation, empty for NaN.
+pub fn num(x: f64) -> String {
+    if x.is_nan() {
+        String::new()
+    } else {
+        format!("{x}")
+    }
+}
+
+/// Columns of runs.csv, in order. Each is defined in `metrics` or README.md.
+pub const RUN_COLUMNS: [&str; 33] = [
+    "run_key",
+    "status",
+    "scheme",
+    "pattern",
+    "samples",
+    "light_radius",
+    "seed",
+    "width",
+    "height",
+    "exact_umbra_radius",
+    "exact_penumbra_radius",
+    "exact_extent_width",
+    "exact_width_10_90",
+    "extent_inner",
+    "extent_outer",
+    "extent_width",
+    "width_10_90",
+    "profile_bias",
+    "profile_abs_bias",
+    "rmse",
+    "relmse",
+    "bias",
+    "rmse_exact",
+    "primary_rays",
+    "shadow_rays",
+    "frame_ms",
+    "rays_per_s",
+    "clock",
+    "backend",
+    "adapter",
+    "driver",
+    "api",
+    "error",
+];
+
+/// One row of runs.csv, as strings in [`RUN_COLUMNS`] order (kept as text so a resumed sweep
+/// reproduces earlier rows byte for byte).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Record(pub Vec<String>);
+
+impl Record {
+    /// The value of `column`.
+    pub fn get(&self, column: &str) -> &str {
+        let i = RUN_COLUMNS.iter().position(|c| *c == column).expect("known column");
+        &self.0[i]
+    }
+
+    /// The value of `column` as a number (NaN when empty).
+    pub fn num(&self, column: &str) -> f64 {
+        self.get(column).parse().unwrap_or(f64::NAN)
+    }
+}

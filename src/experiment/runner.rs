@@ -1,0 +1,344 @@
+//! The sweep: for each light radius build the reference once, then render every run, measure
+//! it, and stream the records to a journal so an interrupted sweep resumes where it stopped.
+
+use super::journal::Journal;
+use super::reference::Reference;
+use super::run::{context_key, expand, num, Group, Record, Run};
+use super::spec::Spec;
+use crate::metrics::{stats, ErrorMetrics, RadialProfile};
+use crate::render::{Backend, Frame, RenderPlan, Sampling, View};
+use crate::sampling::{DiskScheme, Pattern};
+use anyhow::Context;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Per-pixel statistics over the seeds of one group, inside the ground truth's penumbra:
+/// MSE = bias^2 + variance (known-facts.md, "Bias vs variance").
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupStats {
+    /// Key of the group's first run.
+    pub key: String,
+    /// The group's axes (seed of the first run).
+    pub run: Run,
+    /// Seeds that rendered.
+    pub seeds: usize,
+    /// mean_p (mean_s V - GT)^2 - variance / K: squared bias, corrected for the seed mean's noise.
+    pub bias2: f64,
+    /// mean_p of the per-pixel sample variance over seeds.
+    pub variance: f64,
+}
+
+/// What a finished sweep hands to the report.
+pub struct Outcome {
+    /// One record per run, in canonical order.
+    pub records: Vec<Record>,
+    /// Bias/variance per group.
+    pub groups: Vec<GroupStats>,
+    /// The references, one per light radius.
+    pub references: Vec<Reference>,
+    /// Seed-averaged radial profiles at the figure sample count: (scheme, pattern, radius index).
+    pub profiles: BTreeMap<(DiskScheme, Pattern, usize), RadialProfile>,
+    /// Measuring-view visibility of the first seed at the figure sample count.
+    pub keep: BTreeMap<(DiskScheme, Pattern, usize), Vec<f32>>,
+    /// The render plan of the first run, logged with the results.
+    pub plan: RenderPlan,
+    /// Runs that failed.
+    pub failures: usize,
+    /// Groups taken from the journal rather than rendered.
+    pub resumed: usize,
+}
+
+/// Shadow-ray count whose images and profiles are kept for figures (the paper's 16, or the
+/// nearest swept count).
+pub fn figure_samples(spec: &Spec) -> u32 {
+    let want = spec.figures.as_ref().map_or(16, |f| f.samples);
+    *spec
+        .axes
+        .samples
+        .iter()
+        .min_by_key(|&&n| (n as i64 - want as i64).abs())
+        .expect("validated non-empty")
+}
+
+/// Runs the sweep. `journal_dir` holds the resumable journal; `fresh` discards it first.
+pub fn run_sweep(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    journal_dir: &Path,
+    cache: &Path,
+    fresh: bool,
+) -> anyhow::Result<Outcome> {
+    let context = context_key(spec);
+    let groups = expand(spec);
+    let mut journal = Journal::open(journal_dir, fresh)?;
+    let fig_n = figure_samples(spec);
+    let total: u64 = groups.iter().map(|g| g.runs.len() as u64).sum();
+    let bar = indicatif::ProgressBar::new(total).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, ~{eta} left  {msg}")
+            .expect("valid template"),
+    );
+    let mut out = Outcome {
+        records: Vec::new(),
+        groups: Vec::new(),
+        references: Vec::new(),
+        profiles: BTreeMap::new(),
+        keep: BTreeMap::new(),
+        plan: {
+            let s = spec.scene_with(spec.axes.light_radii[0], spec.axes.samples[0]);
+            RenderPlan::new(
+                &s,
+                View {
+                    camera: &s.cameras[&spec.measure.camera],
+                    width: spec.measure.width,
+                    height: spec.measure.height,
+                },
+            )?
+        },
+        failures: 0,
+        resumed: 0,
+    };
+    for (ri, &radius) in spec.axes.light_radii.iter().enumerate() {
+        bar.set_message(format!("reference for light radius {radius} m"));
+        let reference = Reference::build(spec, backend, radius, cache)?;
+        for group in groups.iter().filter(|g| g.head().light_radius == radius) {
+            let head = *group.head();
+            let gkey = head.key(&context);
+            let needed_for_figures = head.samples == fig_n;
+            if !needed_for_figures {
+                if let Some((records, stats)) = journal.completed(&gkey, group, &context) {
+                    out.records.extend(records);
+                    out.groups.push(stats);
+                    out.resumed += 1;
+                    bar.inc(group.runs.len() as u64);
+                    continue;
+                }
+            }
+            bar.set_message(format!(
+                "{} {} n={} r={}",
+                head.scheme, head.pattern, head.samples, radius
+            ));
+            let (records, stats, images) = run_group(spec, backend, group, &reference, &context, &bar);
+            if needed_for_figures {
+                keep_for_figures(&mut out, &reference, head, ri, &images);
+            }
+            let failed = records.iter().filter(|r| r.get("status") != "ok").count();
+            out.failures += failed;
+            if failed == 0 {
+                journal.append(&records, &stats)?;
+            }
+            out.records.extend(records);
+            out.groups.push(stats);
+        }
+        out.references.push(reference);
+    }
+    bar.finish_and_clear();
+    Ok(out)
+}
+
+fn keep_for_figures(out: &mut Outcome, reference: &Reference, head: Run, ri: usize, images: &[Vec<f32>]) {
+    let Some(first) = images.first() else { return };
+    let key = (head.scheme, head.pattern, ri);
+    out.keep.insert(key, first.clone());
+    let mut avg = RadialProfile::new(&reference.receivers, first);
+    let profiles: Vec<_> = images
+        .iter()
+        .map(|im| RadialProfile::new(&reference.receivers, im))
+        .collect();
+    for (b, m) in avg.mean.iter_mut().enumerate() {
+        *m = profiles.iter().map(|p| p.mean[b]).sum::<f64>() / profiles.len() as f64;
+    }
+    out.profiles.insert(key, avg);
+}
+
+/// Renders, times and measures every seed of a group; a failed render becomes a failed record
+/// and the sweep goes on.
+fn run_group(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    group: &Group,
+    reference: &Reference,
+    context: &str,
+    bar: &indicatif::ProgressBar,
+) -> (Vec<Record>, GroupStats, Vec<Vec<f32>>) {
+    let mut records = Vec::new();
+    let mut images = Vec::new();
+    for run in &group.runs {
+        let result = measure_run(spec, backend, run, reference);
+        match result {
+            Ok((record, image)) => {
+                records.push(record);
+                images.push(image);
+            }
+            Err(e) => {
+                bar.println(format!(
+                    "run failed ({} {} n={} r={} seed={}): {e:#}",
+                    run.scheme, run.pattern, run.samples, run.light_radius, run.seed
+                ));
+                records.push(failed_record(spec, backend, run, context, &format!("{e:#}")));
+            }
+        }
+        bar.inc(1);
+    }
+    let stats = group_stats(group, reference, &images, context);
+    (records, stats, images)
+}
+
+fn group_stats(group: &Group, reference: &Reference, images: &[Vec<f32>], context: &str) -> GroupStats {
+    let k = images.len();
+    let (mut bias2, mut variance) = (0.0, 0.0);
+    for &i in &reference.mask.pixels {
+        let vals: Vec<f64> = images.iter().map(|im| im[i] as f64).collect();
+        let mean = vals.iter().sum::<f64>() / k.max(1) as f64;
+        let var = if k > 1 {
+            vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1) as f64
+        } else {
+            f64::NAN
+        };
+        bias2 += (mean - reference.ground_truth[i] as f64).powi(2) - var / k as f64;
+        variance += var;
+    }
+    let n = reference.mask.pixels.len() as f64;
+    GroupStats {
+        key: group.head().key(context),
+        run: *group.head(),
+        seeds: k,
+        bias2: bias2 / n,
+        variance: variance / n,
+    }
+}
+
+/// Columns of a record between the run's identity (9) and the adapter's (5).
+const METRIC_COLUMNS: usize = super::run::RUN_COLUMNS.len() - 14;
+
+fn assemble(
+    spec: &Spec,
+    backend: &dyn Backend,
+    run: &Run,
+    context: &str,
+    status: &str,
+    metrics: &[String],
+    error: &str,
+) -> Record {
+    debug_assert_eq!(metrics.len(), METRIC_COLUMNS);
+    let a = backend.adapter();
+    let mut row = vec![
+        run.key(context),
+        status.to_string(),
+        run.scheme.to_string(),
+        run.pattern.to_string(),
+        run.samples.to_string(),
+        num(run.light_radius),
+        run.seed.to_string(),
+        spec.measure.width.to_string(),
+        spec.measure.height.to_string(),
+    ];
+    row.extend_from_slice(metrics);
+    row.extend([
+        a.backend.clone(),
+        a.name.clone(),
+        a.driver.clone(),
+        a.api.clone(),
+        error.to_string(),
+    ]);
+    Record(row)
+}
+
+fn failed_record(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, error: &str) -> Record {
+    assemble(
+        spec,
+        backend,
+        run,
+        context,
+        "failed",
+        &vec![String::new(); METRIC_COLUMNS],
+        error,
+    )
+}
+
+fn measure_run(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    run: &Run,
+    reference: &Reference,
+) -> anyhow::Result<(Record, Vec<f32>)> {
+    let scene = spec.scene_with(run.light_radius, run.samples);
+    let m = &spec.measure;
+    let view = View {
+        camera: &scene.cameras[&m.camera],
+        width: m.width,
+        height: m.height,
+    };
+    let sampling = Sampling {
+        scheme: run.scheme,
+        pattern: run.pattern,
+        seed: run.seed,
+    };
+    let Frame {
+        mut visibility, rays, ..
+    } = backend.render(&scene, view, sampling).context("render")?;
+    let image = visibility.swap_remove(m.light);
+    let t = &spec.timing;
+    let (seconds, clock) = if t.repeats > 0 {
+        let timing = backend
+            .time(&scene, view, sampling, t.warmup, t.repeats)
+            .context("timing")?;
+        (stats::median(&timing.seconds), timing.clock.name().to_string())
+    } else {
+        (f64::NAN, String::new())
+    };
+    let profile = RadialProfile::new(&reference.receivers, &image);
+    let (inner, outer) = profile.extent();
+    let (ex_in, ex_out) = reference.exact_profile.extent();
+    let (bias, abs_bias) = profile_bias(&profile, reference);
+    let vs_gt = ErrorMetrics::measure(&image, &reference.ground_truth, &reference.mask);
+    let vs_exact = ErrorMetrics::measure(&image, &reference.exact, &reference.mask);
+    let (ru, rp) = reference
+        .on_axis
+        .as_ref()
+        .map_or((f64::NAN, f64::NAN), |o| (o.umbra_radius(), o.penumbra_radius()));
+    let total_rays = rays.primary + rays.shadow_total();
+    let metrics = vec![
+        num(ru),
+        num(rp),
+        num(ex_out - ex_in),
+        num(reference.exact_profile.width_10_90()),
+        num(inner),
+        num(outer),
+        num(outer - inner),
+        num(profile.width_10_90()),
+        num(bias),
+        num(abs_bias),
+        num(vs_gt.rmse),
+        num(vs_gt.relmse),
+        num(vs_gt.bias),
+        num(vs_exact.rmse),
+        rays.primary.to_string(),
+        rays.shadow_total().to_string(),
+        num(seconds * 1e3),
+        num(total_rays as f64 / seconds),
+        clock,
+    ];
+    Ok((
+        assemble(spec, backend, run, &context_key(spec), "ok", &metrics, ""),
+        image,
+    ))
+}
+
+/// Signed and absolute mean of (profile - exact profile) over bins inside the exact penumbra
+/// (between the exact image's inner and outer extent).
+pub fn profile_bias(profile: &RadialProfile, reference: &Reference) -> (f64, f64) {
+    let (lo, hi) = reference.exact_profile.extent();
+    let diffs: Vec<f64> = (0..profile.radius.len())
+        .filter(|&b| profile.radius[b] >= lo && profile.radius[b] <= hi)
+        .map(|b| profile.mean[b] - reference.exact_profile.mean[b])
+        .filter(|d| !d.is_nan())
+        .collect();
+    if diffs.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = diffs.len() as f64;
+    (
+        diffs.iter().sum::<f64>() / n,
+        diffs.iter().map(|d| d.abs()).sum::<f64>() / n,
+    )
+}

@@ -1,0 +1,299 @@
+//! The experiment file: which scene, what to measure, which axes to sweep. Validated into a
+//! [`Spec`] with every error located in the file.
+
+use crate::config::{ConfigError, Source};
+use crate::key_path;
+use crate::sampling::{DiskScheme, Pattern};
+use crate::scene::camera::Projection;
+use crate::scene::{Light, Scene, MAX_SAMPLES};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Which renderer runs the sweep.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackendChoice {
+    /// The GPU when an adapter exists, else the CPU with a warning.
+    Auto,
+    /// The GPU or an error.
+    Gpu,
+    /// The f64 CPU reference.
+    Cpu,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    name: String,
+    scene: PathBuf,
+    #[serde(default = "default_backend")]
+    backend: BackendChoice,
+    measure: Measure,
+    sweep: Axes,
+    ground_truth: GroundTruth,
+    #[serde(default)]
+    timing: TimingSpec,
+    figures: Option<Figures>,
+}
+
+fn default_backend() -> BackendChoice {
+    BackendChoice::Auto
+}
+
+/// The measuring view: an orthographic camera over the receiver plane.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Measure {
+    /// Camera name in the scene; must be orthographic.
+    pub camera: String,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Index of the disk light whose radius and shadow-ray count are swept.
+    #[serde(default)]
+    pub light: usize,
+    /// Index of the receiver plane.
+    #[serde(default)]
+    pub plane: usize,
+}
+
+/// The swept axes; the sweep is their cartesian product.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Axes {
+    /// Disk sampling schemes.
+    pub schemes: Vec<DiskScheme>,
+    /// Per-pixel or shared patterns.
+    pub patterns: Vec<Pattern>,
+    /// Shadow-ray counts.
+    pub samples: Vec<u32>,
+    /// Light radii, metres.
+    pub light_radii: Vec<f64>,
+    /// Seeds.
+    pub seeds: Vec<u32>,
+}
+
+/// The high-sample reference image.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GroundTruth {
+    /// Jittered shadow rays per pixel (thousands).
+    pub samples: u32,
+}
+
+/// Frame timing.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TimingSpec {
+    /// Untimed frames before the timed ones (beyond the frame read back for metrics).
+    pub warmup: u32,
+    /// Timed frames; their median is reported. 0 disables timing (runs.csv is then
+    /// byte-reproducible: times are the only values that vary between identical runs).
+    pub repeats: u32,
+}
+
+impl Default for TimingSpec {
+    fn default() -> Self {
+        TimingSpec { warmup: 1, repeats: 3 }
+    }
+}
+
+/// Fig. 2-style pictures: the same view rendered with several schemes at one shadow-ray count.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Figures {
+    /// Camera name in the scene.
+    pub camera: String,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Shadow rays per pixel of the compared images (the paper: 16).
+    pub samples: u32,
+    /// Shadow rays per pixel of the reference picture.
+    pub ground_truth_samples: u32,
+}
+
+/// A validated experiment.
+#[derive(Clone, Debug)]
+pub struct Spec {
+    /// Experiment name (the results folder's name).
+    pub name: String,
+    /// The experiment file.
+    pub path: PathBuf,
+    /// The scene file.
+    pub scene_path: PathBuf,
+    /// The scene's text, hashed into run keys so that editing the scene invalidates results.
+    pub scene_text: String,
+    /// The scene.
+    pub scene: Scene,
+    /// Renderer choice.
+    pub backend: BackendChoice,
+    /// Measuring view.
+    pub measure: Measure,
+    /// Swept axes.
+    pub axes: Axes,
+    /// Ground-truth settings.
+    pub ground_truth: GroundTruth,
+    /// Timing settings.
+    pub timing: TimingSpec,
+    /// Optional pictures.
+    pub figures: Option<Figures>,
+}
+
+impl Spec {
+    /// Reads and validates an experiment file and the scene it names (relative to it).
+    pub fn load(path: &Path) -> Result<Spec, ConfigError> {
+        let source = Source::read(path)?;
+        let f: File = source.parse()?;
+        let err = |p: &[crate::config::Seg], m: String| source.error(p, m);
+        let scene_path = path.parent().unwrap_or(Path::new(".")).join(&f.scene);
+        if !scene_path.is_file() {
+            return Err(err(
+                &key_path!["scene"],
+                format!("scene file {} does not exist", scene_path.display()),
+            ));
+        }
+        let scene = Scene::load(&scene_path)?;
+        let scene_text = std::fs::read_to_string(&scene_path).unwrap_or_default();
+        if f.name.is_empty()
+            || !f
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
+            return Err(err(
+                &key_path!["name"],
+                "must be non-empty letters, digits, '-' or '_'".into(),
+            ));
+        }
+        let m = &f.measure;
+        match scene.cameras.get(&m.camera) {
+            None => {
+                return Err(err(
+                    &key_path!["measure", "camera"],
+                    format!("no camera `{}` in {}", m.camera, scene_path.display()),
+                ))
+            }
+            Some(c) if !matches!(c.projection, Projection::Orthographic { .. }) => {
+                return Err(err(
+                    &key_path!["measure", "camera"],
+                    "the measuring camera must be orthographic".into(),
+                ))
+            }
+            _ => {}
+        }
+        for (k, v) in [("width", m.width), ("height", m.height)] {
+            if !(1..=16384).contains(&v) {
+                return Err(err(&key_path!["measure", k], format!("must be in 1..=16384, got {v}")));
+            }
+        }
+        if !matches!(scene.lights.get(m.light), Some(Light::Disk(_))) {
+            return Err(err(
+                &key_path!["measure", "light"],
+                format!("light {} is not a disk light of the scene", m.light),
+            ));
+        }
+        if m.plane >= scene.planes.len() {
+            return Err(err(
+                &key_path!["measure", "plane"],
+                format!("the scene has {} planes", scene.planes.len()),
+            ));
+        }
+        let a = &f.sweep;
+        for (key, empty) in [
+            ("schemes", a.schemes.is_empty()),
+            ("patterns", a.patterns.is_empty()),
+            ("samples", a.samples.is_empty()),
+            ("light_radii", a.light_radii.is_empty()),
+            ("seeds", a.seeds.is_empty()),
+        ] {
+            if empty {
+                return Err(err(&key_path!["sweep", key], "must list at least one value".into()));
+            }
+        }
+        for (i, &n) in a.samples.iter().enumerate() {
+            if !(1..=MAX_SAMPLES).contains(&n) {
+                return Err(err(
+                    &key_path!["sweep", "samples", i],
+                    format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}"),
+                ));
+            }
+        }
+        for (i, &r) in a.light_radii.iter().enumerate() {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(err(
+                    &key_path!["sweep", "light_radii", i],
+                    format!("light radius must be positive, got {r}"),
+                ));
+            }
+        }
+        let check_dupes = |key: &str, names: Vec<String>| -> Result<(), ConfigError> {
+            for (i, n) in names.iter().enumerate() {
+                if names[..i].contains(n) {
+                    return Err(err(&key_path!["sweep", key, i], format!("`{n}` is listed twice")));
+                }
+            }
+            Ok(())
+        };
+        check_dupes("schemes", a.schemes.iter().map(|s| s.to_string()).collect())?;
+        check_dupes("patterns", a.patterns.iter().map(|s| s.to_string()).collect())?;
+        check_dupes("samples", a.samples.iter().map(|s| s.to_string()).collect())?;
+        check_dupes("light_radii", a.light_radii.iter().map(|s| s.to_string()).collect())?;
+        check_dupes("seeds", a.seeds.iter().map(|s| s.to_string()).collect())?;
+        if !(1..=MAX_SAMPLES).contains(&f.ground_truth.samples) {
+            return Err(err(
+                &key_path!["ground_truth", "samples"],
+                format!("must be in 1..={MAX_SAMPLES}"),
+            ));
+        }
+        if let Some(fig) = &f.figures {
+            if !scene.cameras.contains_key(&fig.camera) {
+                return Err(err(
+                    &key_path!["figures", "camera"],
+                    format!("no camera `{}` in the scene", fig.camera),
+                ));
+            }
+            for (k, v) in [("width", fig.width), ("height", fig.height)] {
+                if !(1..=8192).contains(&v) {
+                    return Err(err(&key_path!["figures", k], format!("must be in 1..=8192, got {v}")));
+                }
+            }
+            for (k, v) in [
+                ("samples", fig.samples),
+                ("ground_truth_samples", fig.ground_truth_samples),
+            ] {
+                if !(1..=MAX_SAMPLES).contains(&v) {
+                    return Err(err(
+                        &key_path!["figures", k],
+                        format!("must be in 1..={MAX_SAMPLES}, got {v}"),
+                    ));
+                }
+            }
+        }
+        Ok(Spec {
+            name: f.name,
+            path: path.to_path_buf(),
+            scene_path,
+            scene_text,
+            scene,
+            backend: f.backend,
+            measure: f.measure,
+            axes: f.sweep,
+            ground_truth: f.ground_truth,
+            timing: f.timing,
+            figures: f.figures,
+        })
+    }
+
+    /// The scene with the swept light set to `radius` and `samples`.
+    pub fn scene_with(&self, radius: f64, samples: u32) -> Scene {
+        let mut scene = self.scene.clone();
+        if let Light::Disk(d) = &mut scene.lights[self.measure.light] {
+            d.radius = radius;
+            d.samples = samples;
+        }
+        scene
+    }
+}

@@ -1,0 +1,9 @@
+//! Measurements of a rendered visibility image. Each formula is documented once, here or in
+//! the submodule that computes it; the runner combines them into one record per run.
+
+pub mod error;
+pub mod profile;
+pub mod stats;
+
+pub use error::{ErrorMetrics, PenumbraMask};
+pub use profile::{RadialProfile, Receivers};

@@ -1,0 +1,65 @@
+//! Summary statistics over seeds: means with 95 % Student-t confidence intervals, medians.
+
+/// Two-sided 97.5 % quantiles of Student's t for 1..=30 degrees of freedom.
+const T975: [f64; 30] = [
+    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131, 2.120,
+    2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+];
+
+/// t quantile for a 95 % two-sided interval; the normal 1.96 beyond 30 degrees of freedom.
+pub fn t975(dof: usize) -> f64 {
+    match dof {
+        0 => f64::NAN,
+        d if d <= 30 => T975[d - 1],
+        _ => 1.96,
+    }
+}
+
+/// Mean and the half-width of its 95 % confidence interval, mean +- t s / sqrt(k); NaN values
+/// are skipped, and the half-width is NaN with fewer than two values.
+pub fn mean_ci(values: &[f64]) -> (f64, f64) {
+    let v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+    let k = v.len();
+    if k == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let mean = v.iter().sum::<f64>() / k as f64;
+    if k < 2 {
+        return (mean, f64::NAN);
+    }
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
+    (mean, t975(k - 1) * (var / k as f64).sqrt())
+}
+
+/// Median (mean of the middle two for an even count); NaN when empty.
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ci_of_known_sample() {
+        let (m, h) = mean_ci(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(m, 2.5);
+        // s = sqrt(5/3), t(3) = 3.182: h = 3.182 * sqrt(5/12).
+        assert!((h - 3.182 * (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!(mean_ci(&[1.0]).1.is_nan());
+        assert_eq!(mean_ci(&[f64::NAN, 2.0, 4.0]).0, 3.0);
+    }
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(&[]).is_nan());
+    }
+}

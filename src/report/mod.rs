@@ -1,0 +1,9 @@
+//! Outputs: CSV tables, plots, images and the markdown report, all written atomically.
+
+pub mod files;
+pub mod images;
+pub mod markdown;
+pub mod plots;
+pub mod summary;
+pub mod verdict;
+pub mod write;

@@ -1,0 +1,447 @@
+//! Writes a finished sweep: tables, plots, images, report and manifest, each file atomically,
+//! the manifest last.
+
+use super::files::{write_atomic, write_csv};
+use super::images::{diverging, grey, tonemap, write_exr, write_png, Rgb};
+use super::markdown::{report, verdict_radius};
+use super::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
+use super::summary::{self, Summary};
+use crate::experiment::run::{num, RUN_COLUMNS};
+use crate::experiment::runner::{figure_samples, Outcome};
+use crate::experiment::Spec;
+use crate::render::{AdapterInfo, Frame};
+use crate::sampling::{DiskScheme, Pattern};
+use std::path::Path;
+
+/// Everything a sweep produced, ready to write.
+pub struct Results<'a> {
+    /// The experiment.
+    pub spec: &'a Spec,
+    /// The sweep's outcome.
+    pub outcome: &'a Outcome,
+    /// Fig. 2-style pictures.
+    pub pictures: &'a [(String, Frame)],
+    /// The device.
+    pub adapter: &'a AdapterInfo,
+    /// Wall-clock seconds of the sweep.
+    pub seconds: f64,
+    /// Peak resident memory of the process, if known (bytes).
+    pub peak_rss: Option<u64>,
+}
+
+/// Writes every output under `out`.
+pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
+    let summaries = summary::summarise(r.outcome);
+    write_csv(
+        &out.join("runs.csv"),
+        &RUN_COLUMNS,
+        r.outcome.records.iter().map(|x| x.0.clone()),
+    )?;
+    let header = summary::header();
+    write_csv(
+        &out.join("summary.csv"),
+        &header.iter().map(String::as_str).collect::<Vec<_>>(),
+        summaries.iter().map(summary::row),
+    )?;
+    write_ground_truth(r, out)?;
+    write_plots(r, &summaries, &out.join("plots"))?;
+    write_images(r, &out.join("images"))?;
+    write_atomic(
+        &out.join("report.md"),
+        report(r.spec, r.outcome, &summaries, r.adapter, r.seconds).as_bytes(),
+    )?;
+    write_atomic(&out.join("manifest.toml"), manifest(r).as_bytes())
+}
+
+fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
+    let header = [
+        "light_radius",
+        "ground_truth_samples",
+        "exact_umbra_radius",
+        "exact_penumbra_radius",
+        "exact_extent_inner",
+        "exact_extent_outer",
+        "exact_width_10_90",
+        "gt_extent_inner",
+        "gt_extent_outer",
+        "gt_width_10_90",
+        "gt_max_abs_error",
+        "gt_rmse_penumbra",
+        "gt_bias_penumbra",
+        "penumbra_pixels",
+    ];
+    let rows = r.outcome.references.iter().map(|x| {
+        let (ru, rp) = x
+            .on_axis
+            .as_ref()
+            .map_or((f64::NAN, f64::NAN), |o| (o.umbra_radius(), o.penumbra_radius()));
+        let (ei, eo) = x.exact_profile.extent();
+        let (gi, go) = x.gt_profile.extent();
+        vec![
+            num(x.light_radius),
+            r.spec.ground_truth.samples.to_string(),
+            num(ru),
+            num(rp),
+            num(ei),
+            num(eo),
+            num(x.exact_profile.width_10_90()),
+            num(gi),
+            num(go),
+            num(x.gt_profile.width_10_90()),
+            num(x.gt_max_abs_all),
+            num(x.gt_vs_exact.rmse),
+            num(x.gt_vs_exact.bias),
+            x.mask.pixels.len().to_string(),
+        ]
+    });
+    write_csv(&out.join("ground_truth.csv"), &header, rows)
+}
+
+/// Series of one metric against a per-summary x, per scheme (per-pixel solid, shared dashed).
+fn series(
+    summaries: &[Summary],
+    radius: Option<f64>,
+    samples: Option<u32>,
+    x: impl Fn(&Summary) -> f64,
+    metric: &str,
+) -> Vec<(usize, Series)> {
+    let mut out = Vec::new();
+    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+        for pattern in Pattern::ALL {
+            let mut pts: Vec<(f64, f64, f64)> = summaries
+                .iter()
+                .filter(|s| s.run.scheme == *scheme && s.run.pattern == pattern)
+                .filter(|s| {
+                    radius.is_none_or(|r| s.run.light_radius == r) && samples.is_none_or(|n| s.run.samples == n)
+                })
+                .map(|s| (x(s), s.mean(metric), s.ci(metric)))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if !pts.is_empty() {
+                out.push((
+                    ci,
+                    Series {
+                        name: format!("{scheme} ({pattern})"),
+                        points: pts,
+                        dashed: pattern == Pattern::Shared,
+                    },
+                ));
+            }
+        }
+    }
+    out
+}
+
+fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result<()> {
+    let spec = r.spec;
+    let radius = verdict_radius(spec);
+    let n = figure_samples(spec);
+    let samples = |s: &Summary| s.run.samples as f64;
+    let (lo, hi) = (
+        *spec.axes.samples.iter().min().unwrap_or(&1) as f64,
+        *spec.axes.samples.iter().max().unwrap_or(&1) as f64,
+    );
+    let reference = r.outcome.references.iter().find(|x| x.light_radius == radius);
+    let exact_lines = |which: &str| -> Vec<RefLine> {
+        reference
+            .map(|x| {
+                let (a, b) = x.exact_profile.extent();
+                let y = if which == "extent" {
+                    b - a
+                } else {
+                    x.exact_profile.width_10_90()
+                };
+                vec![RefLine {
+                    name: format!("exact ({which})"),
+                    points: vec![(lo, y * 1e3), (hi, y * 1e3)],
+                }]
+            })
+            .unwrap_or_default()
+    };
+    let to_mm = |mut s: Vec<(usize, Series)>| {
+        for (_, x) in &mut s {
+            for p in &mut x.points {
+                p.1 *= 1e3;
+                p.2 *= 1e3;
+            }
+        }
+        s
+    };
+    let title = |what: &str| format!("{what}, light radius {radius} m");
+    line_plot(
+        &dir.join("width_vs_samples.png"),
+        &Axes::new(
+            &title("Visible penumbra extent"),
+            "shadow rays per pixel",
+            "extent width (mm)",
+            true,
+            false,
+        ),
+        &to_mm(series(summaries, Some(radius), None, samples, "extent_width")),
+        &exact_lines("extent"),
+    )?;
+    line_plot(
+        &dir.join("width_10_90_vs_samples.png"),
+        &Axes::new(
+            &title("10-90 % width of the mean radial profile"),
+            "shadow rays per pixel",
+            "10-90 % width (mm)",
+            true,
+            false,
+        ),
+        &to_mm(series(summaries, Some(radius), None, samples, "width_10_90")),
+        &exact_lines("10-90"),
+    )?;
+    line_plot(
+        &dir.join("rmse_vs_samples.png"),
+        &Axes {
+            legend: plotters::chart::SeriesLabelPosition::LowerLeft,
+            ..Axes::new(
+                &title("RMSE vs ground truth over the penumbra"),
+                "shadow rays per pixel",
+                "RMSE",
+                true,
+                true,
+            )
+        },
+        &series(summaries, Some(radius), None, samples, "rmse"),
+        &[],
+    )?;
+    line_plot(
+        &dir.join("rmse_vs_time.png"),
+        &Axes {
+            legend: plotters::chart::SeriesLabelPosition::LowerLeft,
+            ..Axes::new(
+                &title("What accuracy costs: RMSE vs frame time"),
+                "median frame time (ms)",
+                "RMSE",
+                true,
+                true,
+            )
+        },
+        &series(summaries, Some(radius), None, |s| s.mean("frame_ms"), "rmse"),
+        &[],
+    )?;
+    let radii_mm = |s: &Summary| s.run.light_radius * 1e3;
+    let mut exact_vs_radius: Vec<(f64, f64)> = r
+        .outcome
+        .references
+        .iter()
+        .map(|x| {
+            (x.light_radius * 1e3, {
+                let (a, b) = x.exact_profile.extent();
+                (b - a) * 1e3
+            })
+        })
+        .collect();
+    exact_vs_radius.sort_by(|a, b| a.0.total_cmp(&b.0));
+    line_plot(
+        &dir.join("width_vs_radius.png"),
+        &Axes::new(
+            &format!("Visible penumbra extent at {n} rays"),
+            "light radius (mm)",
+            "extent width (mm)",
+            false,
+            false,
+        ),
+        &to_mm(series(summaries, None, Some(n), radii_mm, "extent_width")),
+        &[RefLine {
+            name: "exact".into(),
+            points: exact_vs_radius,
+        }],
+    )?;
+    if let Some((ri, reference)) = r
+        .outcome
+        .references
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.light_radius == radius)
+    {
+        let mut profiles = Vec::new();
+        for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+            for pattern in Pattern::ALL {
+                if let Some(p) = r.outcome.profiles.get(&(*scheme, pattern, ri)) {
+                    let points = p
+                        .radius
+                        .iter()
+                        .zip(&p.mean)
+                        .map(|(x, y)| (x * 1e3, *y, f64::NAN))
+                        .collect();
+                    profiles.push((
+                        ci,
+                        Series {
+                            name: format!("{scheme} ({pattern})"),
+                            points,
+                            dashed: pattern == Pattern::Shared,
+                        },
+                    ));
+                }
+            }
+        }
+        let e = &reference.exact_profile;
+        let exact = RefLine {
+            name: "exact".into(),
+            points: e
+                .radius
+                .iter()
+                .zip(&e.mean)
+                .map(|(x, y)| (x * 1e3, *y))
+                .filter(|p| p.1.is_finite())
+                .collect(),
+        };
+        line_plot(
+            &dir.join("profiles.png"),
+            &Axes {
+                x_range: reference.on_axis.as_ref().map(|o| {
+                    let (ru, rp) = (o.umbra_radius().max(0.0) * 1e3, o.penumbra_radius() * 1e3);
+                    (ru - 0.4 * (rp - ru), rp + 0.4 * (rp - ru))
+                }),
+                legend: plotters::chart::SeriesLabelPosition::LowerRight,
+                ..Axes::new(
+                    &format!("Radial profile at {n} rays (mean over seeds), light radius {radius} m"),
+                    "distance from shadow centre (mm)",
+                    "visibility",
+                    false,
+                    false,
+                )
+            },
+            &profiles,
+            &[exact],
+        )?;
+    }
+    Ok(())
+}
+
+fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
+    let spec = r.spec;
+    let radius = verdict_radius(spec);
+    let n = figure_samples(spec);
+    let (w, h) = (spec.measure.width, spec.measure.height);
+    if let Some((ri, reference)) = r
+        .outcome
+        .references
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.light_radius == radius)
+    {
+        let gt = &reference.ground_truth;
+        write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
+        write_exr(&dir.join("exact.exr"), &reference.exact, w, h)?;
+        let mut tiles: Vec<(String, Rgb)> = Vec::new();
+        let mut errors: Vec<(String, Rgb)> = Vec::new();
+        for (scheme, pattern) in [
+            (DiskScheme::Uniform, Pattern::PerPixel),
+            (DiskScheme::Paper, Pattern::PerPixel),
+            (DiskScheme::Paper, Pattern::Shared),
+            (DiskScheme::Sobol, Pattern::PerPixel),
+        ] {
+            if let Some(img) = r.outcome.keep.get(&(scheme, pattern, ri)) {
+                write_exr(&dir.join(format!("{scheme}_{pattern}_{n}.exr")), img, w, h)?;
+                tiles.push((format!("{scheme} ({pattern}), {n} rays"), grey(img, w, h)));
+                errors.push((
+                    format!("{scheme} ({pattern}) - ground truth"),
+                    diverging(img, gt, 0.5, w, h),
+                ));
+            }
+        }
+        tiles.push((
+            format!("ground truth, {} rays", spec.ground_truth.samples),
+            grey(gt, w, h),
+        ));
+        tiles.push(("exact".into(), grey(&reference.exact, w, h)));
+        errors.push((
+            "ground truth - exact (x100)".into(),
+            diverging(gt, &reference.exact, 0.005, w, h),
+        ));
+        let columns = tiles.len().max(errors.len());
+        let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
+        image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
+    }
+    if !r.pictures.is_empty() {
+        let tiles: Vec<(String, Rgb)> = r
+            .pictures
+            .iter()
+            .map(|(l, f)| (l.clone(), tonemap(&f.radiance, f.width, f.height)))
+            .collect();
+        let refs: Vec<(String, &Rgb)> = tiles.iter().map(|(l, i)| (l.clone(), i)).collect();
+        image_grid(&dir.join("fig2_picture.png"), &refs, 2)?;
+        for (i, (_, f)) in r.pictures.iter().enumerate() {
+            write_png(
+                &dir.join(format!("picture_{i}.png")),
+                &tonemap(&f.radiance, f.width, f.height),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+fn git_commit() -> String {
+    let run = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match run(&["rev-parse", "HEAD"]) {
+        Some(c) => {
+            let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+            if dirty {
+                format!("{c}-dirty")
+            } else {
+                c
+            }
+        }
+        None => "unknown".into(),
+    }
+}
+
+fn manifest(r: &Results) -> String {
+    let s = r.spec;
+    let a = r.adapter;
+    let hash = |t: &str| format!("{:016x}", crate::experiment::run::fnv1a(t.as_bytes()));
+    let experiment_text = std::fs::read_to_string(&s.path).unwrap_or_default();
+    let q = |t: &str| format!("{t:?}");
+    let list = |v: Vec<String>| format!("[{}]", v.join(", "));
+    let mut m = String::from("# Provenance of the results in this folder.\n");
+    m += &format!("git_commit = {}\n", q(&git_commit()));
+    m += &format!(
+        "experiment = {}\nexperiment_fnv1a = {}\n",
+        q(&s.path.display().to_string()),
+        q(&hash(&experiment_text))
+    );
+    m += &format!(
+        "scene = {}\nscene_fnv1a = {}\n",
+        q(&s.scene_path.display().to_string()),
+        q(&hash(&s.scene_text))
+    );
+    m += &format!(
+        "runs = {}\nfailed_runs = {}\nresumed_groups = {}\nsweep_seconds = {:.1}\n",
+        r.outcome.records.len(),
+        r.outcome.failures,
+        r.outcome.resumed,
+        r.seconds
+    );
+    if let Some(rss) = r.peak_rss {
+        m += &format!("peak_rss_bytes = {rss}\n");
+    }
+    m += &format!(
+        "seeds = {}\n",
+        list(s.axes.seeds.iter().map(|x| x.to_string()).collect())
+    );
+    m += &format!(
+        "ground_truth_samples = {}\nground_truth_seed = {}\n",
+        s.ground_truth.samples,
+        crate::experiment::reference::GROUND_TRUTH_SEED
+    );
+    m += &format!(
+        "[adapter]\nbackend = {}\nname = {}\ndriver = {}\napi = {}\n",
+        q(&a.backend),
+        q(&a.name),
+        q(&a.driver),
+        q(&a.api)
+    );
+    m += &format!("[plan]\nfirst_run = {}\n", q(r.outcome.plan.to_string().trim()));
+    m
+}
