@@ -114,9 +114,29 @@ impl Source {
     pub fn parse<T: DeserializeOwned>(&self) -> Result<T, ConfigError> {
         toml::from_str(&self.text).map_err(|e| {
             let span = e.span();
-            let key = span.as_ref().map(|s| self.key_at(s)).unwrap_or_default();
+            let mut key = span.as_ref().map(|s| self.key_at(s)).unwrap_or_default();
+            if key.is_empty() {
+                key = span.as_ref().map(|s| self.key_on_line(s.start)).unwrap_or_default();
+            }
             self.error_at_span(span, key, e.message().trim().to_string())
         })
+    }
+
+    /// The bare key that starts the line holding `offset` (for syntax errors, where no
+    /// document tree exists to walk).
+    fn key_on_line(&self, offset: usize) -> String {
+        let start = self.text[..offset.min(self.text.len())]
+            .rfind('\n')
+            .map_or(0, |i| i + 1);
+        let line = self.text[start..].lines().next().unwrap_or("");
+        match line.split_once('=') {
+            Some((k, _))
+                if !k.trim().is_empty() && k.trim().chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) =>
+            {
+                k.trim().to_string()
+            }
+            _ => String::new(),
+        }
     }
 
     /// An error about the value at `path` (or, if absent, its nearest present parent).

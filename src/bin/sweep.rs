@@ -3,7 +3,7 @@
 use anyhow::Context;
 use clap::Parser;
 use penumbra::experiment::{pictures::render_pictures, run_sweep, spec::BackendChoice, Spec};
-use penumbra::render::{cpu::CpuBackend, gpu::GpuBackend, Backend};
+use penumbra::render::open_backend;
 use penumbra::report::markdown::verdict_radius;
 use penumbra::report::write::{write_all, Results};
 use std::path::PathBuf;
@@ -26,20 +26,6 @@ struct Args {
     /// Override the experiment's backend: auto, gpu or cpu.
     #[arg(long)]
     backend: Option<String>,
-}
-
-fn open_backend(choice: BackendChoice) -> anyhow::Result<Box<dyn Backend>> {
-    match choice {
-        BackendChoice::Cpu => Ok(Box::new(CpuBackend::default())),
-        BackendChoice::Gpu => Ok(Box::new(GpuBackend::new()?)),
-        BackendChoice::Auto => match GpuBackend::new() {
-            Ok(g) => Ok(Box::new(g)),
-            Err(e) => {
-                eprintln!("warning: {e:#}\nwarning: falling back to the f64 CPU backend (slow; results record it)");
-                Ok(Box::new(CpuBackend::default()))
-            }
-        },
-    }
 }
 
 fn peak_rss() -> Option<u64> {

@@ -50,9 +50,10 @@ impl Reference {
             height: m.height,
         };
         let key = format!(
-            "{};r={radius:e};{}",
+            "{};r={radius:e};{};build={:016x}",
             super::run::context_key(spec),
-            backend.adapter().name
+            backend.adapter().name,
+            build_id()
         );
         let file = cache.join(format!("ground-truth-{:016x}.bin", super::run::fnv1a(key.as_bytes())));
         let (ground_truth, hit) = match load_cached(&file, view) {
@@ -136,6 +137,17 @@ pub fn exact_image(scene: &Scene, view: View, light: usize, plane: usize, receiv
 }
 
 const MAGIC: &[u8; 8] = b"PNBRGT01";
+
+/// A hash of the running executable: any change to the renderer's code invalidates cached
+/// ground truths, whichever file it is in.
+fn build_id() -> u64 {
+    static ID: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *ID.get_or_init(|| {
+        std::env::current_exe()
+            .and_then(std::fs::read)
+            .map_or(0, |bytes| super::run::fnv1a(&bytes))
+    })
+}
 
 /// Cached (visibility of the measured light, object ids) of a ground-truth render.
 fn load_cached(path: &Path, view: View) -> Option<(Vec<f32>, Vec<u32>)> {

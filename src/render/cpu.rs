@@ -1,12 +1,12 @@
 //! The f64 CPU backend: the fallback when no GPU adapter exists and the cross-check of the GPU
 //! in tests. Same plan, same sample streams, double precision, rayon over rows.
 
-use super::shading::{occluded, shade_light};
+use super::shading::{shade_light, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::geometry::{plane_t, reproject_plane, reproject_sphere, sphere_roots};
 use crate::render::plan::{RenderPlan, MAX_LIGHTS};
 use crate::sampling::{shared_points, Pattern, Stream};
-use crate::scene::{Light, Scene};
+use crate::scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::FRAC_1_PI;
@@ -99,8 +99,13 @@ impl Backend for CpuBackend {
                     hit[x as usize] = id;
                     let mut irradiance = 0.0;
                     for (li, light) in scene.lights.iter().enumerate() {
-                        let stream = Stream::new(sampling.seed, li as u32, Some(pixel));
-                        let s = shade_light(scene, p, n, light, sampling.scheme, stream, shared[li].as_deref());
+                        let targets = match &shared[li] {
+                            Some(points) => Targets::Shared(points),
+                            None => {
+                                Targets::PerPixel(sampling.scheme, Stream::new(sampling.seed, li as u32, Some(pixel)))
+                            }
+                        };
+                        let s = shade_light(scene, p, n, id, light, targets);
                         vis[li * w + x as usize] = s.visibility as f32;
                         irradiance += s.irradiance;
                         rays[li] += s.rays;
@@ -155,18 +160,4 @@ impl Backend for CpuBackend {
             clock: Clock::WallClock,
         })
     }
-}
-
-/// Whether the segment from a surface point towards `target` is blocked (used by tests).
-pub fn segment_blocked(scene: &Scene, from: DVec3, normal: DVec3, target: DVec3) -> bool {
-    let o = crate::geometry::offset_origin(from, normal);
-    occluded(scene, o, target - o)
-}
-
-/// Lights of the scene that are disks, with their indices.
-pub fn disk_lights(scene: &Scene) -> impl Iterator<Item = (usize, &crate::scene::DiskLight)> {
-    scene.lights.iter().enumerate().filter_map(|(i, l)| match l {
-        Light::Disk(d) => Some((i, d)),
-        Light::Point { .. } => None,
-    })
 }

@@ -143,3 +143,20 @@ pub trait Backend {
         repeats: u32,
     ) -> anyhow::Result<Timing>;
 }
+
+/// Opens the backend an experiment asks for; `Auto` falls back to the CPU with a warning that
+/// names what to install.
+pub fn open_backend(choice: crate::experiment::spec::BackendChoice) -> anyhow::Result<Box<dyn Backend>> {
+    use crate::experiment::spec::BackendChoice;
+    match choice {
+        BackendChoice::Cpu => Ok(Box::new(cpu::CpuBackend::default())),
+        BackendChoice::Gpu => Ok(Box::new(gpu::GpuBackend::new()?)),
+        BackendChoice::Auto => match gpu::GpuBackend::new() {
+            Ok(g) => Ok(Box::new(g)),
+            Err(e) => {
+                eprintln!("warning: {e:#}\nwarning: falling back to the f64 CPU backend (slow; results record it)");
+                Ok(Box::new(cpu::CpuBackend::default()))
+            }
+        },
+    }
+}

@@ -1,7 +1,7 @@
 //! Per-receiver shadow-ray logic of the CPU backend, in f64. `shaders/render.wgsl` follows it
 //! line for line in f32; change both together.
 
-use crate::geometry::{offset_origin, plane_t, sphere_roots};
+use crate::geometry::{plane_t, sphere_roots};
 use crate::sampling::{DiskScheme, Stream};
 use crate::scene::{DiskLight, Light, Scene};
 use glam::{DVec2, DVec3};
@@ -17,16 +17,24 @@ pub struct LightSample {
     pub rays: u64,
 }
 
-/// Any-hit test of the segment origin -> origin + d (exclusive of both ends) against the scene.
-pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3) -> bool {
+/// Any-hit test of the segment origin -> origin + d (exclusive of both ends) against the scene,
+/// skipping object `skip`: the receiver itself. Spheres and planes are convex, so a ray leaving
+/// one towards its outside cannot meet it again; skipping it removes self-intersection exactly,
+/// with no origin offset to shift the receiver (an offset along the normal moves the shadow edge
+/// and biases visibility in proportion to offset / penumbra width).
+pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, skip: u32) -> bool {
     let len = d.length();
     let dir = d / len;
     let inside = |t: f64| t > 0.0 && t < len;
-    scene
-        .spheres
-        .iter()
-        .any(|s| sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1)))
-        || scene.planes.iter().any(|p| plane_t(origin, dir, p).is_some_and(inside))
+    let sphere_hit = scene.spheres.iter().enumerate().any(|(i, s)| {
+        i as u32 != skip && sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1))
+    });
+    sphere_hit
+        || scene
+            .planes
+            .iter()
+            .enumerate()
+            .any(|(i, p)| scene.plane_id(i) != skip && plane_t(origin, dir, p).is_some_and(inside))
 }
 
 /// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:
@@ -36,18 +44,16 @@ pub fn disk_unreachable(p: DVec3, n: DVec3, l: &DiskLight) -> bool {
     l.normal.dot(p - l.center) <= 0.0 || n.dot(l.center - p) + l.radius * tilt <= 0.0
 }
 
-/// Shadow rays from receiver (p, n) to `light`. `shared` holds the precomputed unit-disk points
-/// when every pixel uses the same set; otherwise `scheme` draws from `stream`.
-pub fn shade_light(
-    scene: &Scene,
-    p: DVec3,
-    n: DVec3,
-    light: &Light,
-    scheme: DiskScheme,
-    stream: Stream,
-    shared: Option<&[DVec2]>,
-) -> LightSample {
-    let origin = offset_origin(p, n);
+/// Where a receiver's shadow rays land on the unit disk.
+pub enum Targets<'a> {
+    /// Drawn by `scheme` from this receiver's own stream.
+    PerPixel(DiskScheme, Stream),
+    /// The precomputed set every receiver shares.
+    Shared(&'a [DVec2]),
+}
+
+/// Shadow rays from receiver (p, n) on object `id` to `light`.
+pub fn shade_light(scene: &Scene, p: DVec3, n: DVec3, id: u32, light: &Light, targets: Targets) -> LightSample {
     match light {
         Light::Point { position, power } => {
             let d = *position - p;
@@ -58,7 +64,7 @@ pub fn shade_light(
                     rays: 0,
                 };
             }
-            let visible = !occluded(scene, origin, *position - origin);
+            let visible = !occluded(scene, p, *position - p, id);
             let irradiance = if visible {
                 power / (4.0 * PI) * n.dot(d.normalize()) / d.length_squared()
             } else {
@@ -81,9 +87,9 @@ pub fn shade_light(
             let (u, v) = l.basis();
             let (mut visible, mut rays, mut sum) = (0u32, 0u64, 0.0);
             for k in 0..l.samples {
-                let s = match shared {
-                    Some(points) => points[k as usize],
-                    None => scheme.point(l.samples, k, stream),
+                let s = match targets {
+                    Targets::Shared(points) => points[k as usize],
+                    Targets::PerPixel(scheme, stream) => scheme.point(l.samples, k, stream),
                 };
                 let q = l.center + l.radius * (s.x * u + s.y * v);
                 let d = q - p;
@@ -91,7 +97,7 @@ pub fn shade_light(
                     continue;
                 }
                 rays += 1;
-                if !occluded(scene, origin, q - origin) {
+                if !occluded(scene, p, d, id) {
                     visible += 1;
                     let d2 = d.length_squared();
                     sum += n.dot(d) * -l.normal.dot(d) / (d2 * d2);

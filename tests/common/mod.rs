@@ -26,3 +26,47 @@ pub fn gpu() -> Option<std::sync::MutexGuard<'static, GpuBackend>> {
 pub fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
 }
+
+/// A tiny experiment over the sphere scene, written into `dir` with the scene beside it;
+/// `edit` may change the experiment text first. Returns the experiment path.
+pub fn tiny_experiment(dir: &std::path::Path, edit: impl Fn(String) -> String) -> PathBuf {
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::copy(repo("experiments/scenes/sphere.toml"), dir.join("scenes/sphere.toml")).unwrap();
+    let text = r#"name = "tiny"
+scene = "scenes/sphere.toml"
+
+[measure]
+camera = "measure"
+width = 24
+height = 24
+
+[sweep]
+schemes = ["uniform", "paper"]
+patterns = ["per-pixel", "shared"]
+samples = [4, 16]
+light_radii = [0.02]
+seeds = [1, 2]
+
+[ground_truth]
+samples = 256
+
+[timing]
+warmup = 0
+repeats = 0
+"#;
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, edit(text.to_string())).unwrap();
+    path
+}
+
+/// Runs the `sweep` binary; returns (exit code, stderr).
+pub fn sweep(args: &[&std::ffi::OsStr]) -> (i32, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}

@@ -82,16 +82,56 @@ const _: () = assert!(std::mem::size_of::<GpuPlane>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 80);
 const _: () = assert!(std::mem::size_of::<PassInfo>() == 16);
 
-fn local(p: DVec3, origin: DVec3) -> [f32; 3] {
-    (p - origin).as_vec3().to_array()
+/// The frame of GPU coordinates: world = origin + scale * local. `scale` is a power of two, so
+/// dividing by it is exact.
+struct Local {
+    origin: DVec3,
+    scale: f64,
+}
+
+impl Local {
+    /// Re-bases on the camera's look-at point and rescales to the scene's extent, so that f32
+    /// keeps its relative precision wherever the scene is placed and whatever its size, and the
+    /// self-intersection offsets (tuned for unit-sized scenes) stay proportionate.
+    fn new(scene: &Scene, view: View) -> Local {
+        let origin = view.camera.look_at;
+        let mut extent = (view.camera.position - origin).length();
+        for s in &scene.spheres {
+            extent = extent.max((s.center - origin).length() + s.radius);
+        }
+        for l in &scene.lights {
+            extent = extent.max(match l {
+                Light::Point { position, .. } => (*position - origin).length(),
+                Light::Disk(d) => (d.center - origin).length() + d.radius,
+            });
+        }
+        let scale = if extent > 0.0 && extent.is_finite() {
+            2f64.powi(extent.log2().round() as i32)
+        } else {
+            1.0
+        };
+        Local { origin, scale }
+    }
+
+    fn point(&self, p: DVec3) -> [f32; 3] {
+        ((p - self.origin) / self.scale).as_vec3().to_array()
+    }
+
+    fn length(&self, x: f64) -> f32 {
+        (x / self.scale) as f32
+    }
+
+    /// Power rescaled so that irradiance, Phi / d^2, comes out in world units.
+    fn power(&self, x: f64) -> f32 {
+        (x / (self.scale * self.scale)) as f32
+    }
 }
 
 fn dir(p: DVec3) -> [f32; 3] {
     p.as_vec3().to_array()
 }
 
-/// Everything uploaded for one frame, in coordinates relative to `origin` (the camera's look-at
-/// point, chosen in f64), so f32 keeps its precision wherever the scene is placed.
+/// Everything uploaded for one frame, in the local frame of [`Local`].
 pub struct Packed {
     pub params: Params,
     pub spheres: Vec<GpuSphere>,
@@ -102,8 +142,14 @@ pub struct Packed {
 
 /// Packs a scene, view and sampling choice into GPU structs.
 pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
-    let origin = view.camera.look_at;
+    let local = Local::new(scene, view);
     let (frame, (hx, hy), ortho) = view.camera.gpu_terms(view.width, view.height);
+    // Perspective half extents are tangents (unitless); orthographic ones are lengths.
+    let (hx, hy) = if ortho {
+        (hx / local.scale, hy / local.scale)
+    } else {
+        (hx, hy)
+    };
     let params = Params {
         width: view.width,
         height: view.height,
@@ -113,7 +159,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
         scheme: sampling.scheme.gpu_id(),
         shared_pattern: (sampling.pattern == Pattern::Shared) as u32,
         seed: sampling.seed,
-        cam_origin: local(view.camera.position, origin),
+        cam_origin: local.point(view.camera.position),
         ortho: ortho as u32,
         cam_right: dir(frame.right),
         half_x: hx as f32,
@@ -126,8 +172,8 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
         .spheres
         .iter()
         .map(|s| GpuSphere {
-            center: local(s.center, origin),
-            radius: s.radius as f32,
+            center: local.point(s.center),
+            radius: local.length(s.radius),
             albedo: s.albedo as f32,
             _pad: [0.0; 3],
         })
@@ -137,7 +183,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
         .iter()
         .map(|p| GpuPlane {
             // The point of the plane nearest the new origin: small coordinates, same plane.
-            point: dir(-p.normal * (origin - p.point).dot(p.normal)),
+            point: local.point(local.origin - p.normal * (local.origin - p.point).dot(p.normal)),
             albedo: p.albedo as f32,
             normal: dir(p.normal),
             _pad: 0.0,
@@ -149,10 +195,10 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
         let offset = shared.len() as u32;
         lights.push(match l {
             Light::Point { position, power } => GpuLight {
-                center: local(*position, origin),
+                center: local.point(*position),
                 radius: 0.0,
                 normal: [0.0; 3],
-                power: *power as f32,
+                power: local.power(*power),
                 u: [0.0; 3],
                 kind: 0,
                 v: [0.0; 3],
@@ -170,10 +216,10 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
                     );
                 }
                 GpuLight {
-                    center: local(d.center, origin),
-                    radius: d.radius as f32,
+                    center: local.point(d.center),
+                    radius: local.length(d.radius),
                     normal: dir(d.normal),
-                    power: d.power as f32,
+                    power: local.power(d.power),
                     u: dir(u),
                     kind: 1,
                     v: dir(v),

@@ -57,13 +57,15 @@ struct FrameResources {
 }
 
 impl GpuBackend {
-    /// Opens the first adapter wgpu finds (high-performance preferred, software allowed).
+    /// Opens the first adapter wgpu finds (high-performance preferred, software allowed;
+    /// `WGPU_BACKEND` narrows the graphics APIs tried).
     pub fn new() -> anyhow::Result<GpuBackend> {
         pollster::block_on(Self::open())
     }
 
     async fn open() -> anyhow::Result<GpuBackend> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+        // WGPU_BACKEND (e.g. `vulkan`, `gl`) restricts the APIs tried.
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env());
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,

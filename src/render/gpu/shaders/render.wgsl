@@ -88,18 +88,20 @@ fn plane_t(origin: vec3<f32>, dir: vec3<f32>, pl: Plane) -> f32 {
     return dot(pl.point - origin, pl.normal) / denom;
 }
 
-fn occluded(origin: vec3<f32>, d: vec3<f32>) -> bool {
+// Any-hit along origin -> origin + d, skipping object `skip` (the convex receiver itself:
+// see shading::occluded for why no origin offset is used for spheres and planes).
+fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32) -> bool {
     let len = length(d);
     let dir = d / len;
     for (var i = 0u; i < params.sphere_count; i++) {
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
-        if (r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
+        if (i != skip && r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
             return true;
         }
     }
     for (var i = 0u; i < params.plane_count; i++) {
         let t = plane_t(origin, dir, planes[i]);
-        if (t > 0.0 && t < len) {
+        if (params.sphere_count + i != skip && t > 0.0 && t < len) {
             return true;
         }
     }
@@ -188,7 +190,6 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     let light = lights[li];
     let p = hit.position;
     let n = hit.normal;
-    let origin = offset_origin(p, n);
     var vis = 0.0;
     var irradiance = 0.0;
     var rays = 0u;
@@ -196,7 +197,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
         let d = light.center - p;
         if (dot(n, d) > 0.0) {
             rays = 1u;
-            if (!occluded(origin, light.center - origin)) {
+            if (!occluded(p, d, hit.object)) {
                 vis = 1.0;
                 irradiance = light.power / (4.0 * PI) * dot(n, normalize(d)) / dot(d, d);
             }
@@ -221,7 +222,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                     continue;
                 }
                 rays += 1u;
-                if (!occluded(origin, q - origin)) {
+                if (!occluded(p, d, hit.object)) {
                     visible += 1u;
                     let d2 = dot(d, d);
                     sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);

@@ -1,0 +1,130 @@
+//! Bad input: a clear error naming file, line and key, a non-zero exit, and earlier results
+//! left exactly as they were.
+
+mod common;
+
+use std::ffi::OsStr;
+use std::path::Path;
+
+/// Runs the sweep on an edited tiny experiment over a results folder holding earlier results,
+/// and returns stderr after checking the exit code and that nothing was touched.
+fn rejects(edit: impl Fn(String) -> String) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), edit);
+    let out = dir.path().join("results");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("runs.csv"), "earlier results\n").unwrap();
+    let (code, stderr) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+    assert_ne!(code, 0, "accepted bad input; stderr:\n{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("runs.csv")).unwrap(),
+        "earlier results\n"
+    );
+    let entries: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(entries.len(), 1, "the failed run wrote {entries:?}");
+    stderr
+}
+
+fn assert_located(stderr: &str, file: &str, line: usize, key: &str) {
+    let want = format!("{file}:{line}:");
+    assert!(stderr.contains(&want), "expected `{want}` in:\n{stderr}");
+    assert!(stderr.contains(key), "expected key `{key}` in:\n{stderr}");
+}
+
+#[test]
+fn malformed_toml() {
+    let e = rejects(|t| t.replace("width = 24", "width = = 24"));
+    assert_located(&e, "tiny.toml", 6, "key `width`");
+}
+
+#[test]
+fn unknown_key() {
+    let e = rejects(|t| t.replace("seeds = [1, 2]", "seeds = [1, 2]\nseed_count = 3"));
+    assert_located(&e, "tiny.toml", 15, "seed_count");
+}
+
+#[test]
+fn negative_light_radius() {
+    let e = rejects(|t| t.replace("light_radii = [0.02]", "light_radii = [0.02, -0.01]"));
+    assert_located(&e, "tiny.toml", 13, "sweep.light_radii[1]");
+    assert!(e.contains("positive"), "{e}");
+}
+
+#[test]
+fn zero_samples() {
+    let e = rejects(|t| t.replace("samples = [4, 16]", "samples = [0, 16]"));
+    assert_located(&e, "tiny.toml", 12, "sweep.samples[0]");
+}
+
+#[test]
+fn unknown_scheme() {
+    let e = rejects(|t| t.replace(r#"["uniform", "paper"]"#, r#"["uniform", "halton"]"#));
+    assert_located(&e, "tiny.toml", 10, "sweep.schemes");
+    assert!(e.contains("halton") && e.contains("paper-literal"), "{e}");
+}
+
+#[test]
+fn bad_scene_value_is_located_in_the_scene_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t);
+    let scene = dir.path().join("scenes/sphere.toml");
+    let text = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("radius = 0.25", "radius = 0.0");
+    std::fs::write(&scene, text).unwrap();
+    let (code, e) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), dir.path().join("r").as_os_str()]);
+    assert_ne!(code, 0);
+    assert!(e.contains("sphere.toml:") && e.contains("spheres[0].radius"), "{e}");
+    assert!(!Path::new(&dir.path().join("r/runs.csv")).exists());
+}
+
+#[test]
+fn missing_experiment_file() {
+    let (code, e) = common::sweep(&[OsStr::new("/nonexistent/exp.toml")]);
+    assert_ne!(code, 0);
+    assert!(e.contains("/nonexistent/exp.toml") && e.contains("cannot read"), "{e}");
+}
+
+/// No GPU adapter: `--backend gpu` fails naming what to install; `auto` warns and falls back to
+/// the CPU backend, whose name then stands in the results.
+#[test]
+fn no_gpu_adapter() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t);
+    let run = |backend: &str, out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+            .args([
+                exp.as_os_str(),
+                OsStr::new("--backend"),
+                OsStr::new(backend),
+                OsStr::new("--out"),
+                dir.path().join(out).as_os_str(),
+            ])
+            .env("WGPU_BACKEND", "vulkan")
+            .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+            .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+            .output()
+            .unwrap()
+    };
+    let gpu = run("gpu", "g");
+    let err = String::from_utf8_lossy(&gpu.stderr);
+    assert!(
+        !gpu.status.success() && err.contains("no GPU adapter") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+    assert!(!dir.path().join("g/runs.csv").exists());
+    let auto = run("auto", "a");
+    let err = String::from_utf8_lossy(&auto.stderr);
+    assert!(
+        auto.status.success() && err.contains("falling back to the f64 CPU backend"),
+        "{err}"
+    );
+    let runs = std::fs::read_to_string(dir.path().join("a/runs.csv")).unwrap();
+    assert!(
+        runs.lines().skip(1).all(|l| l.contains(",cpu,penumbra f64 reference,")),
+        "{runs}"
+    );
+}

@@ -1,0 +1,147 @@
+//! "Simulate only what the scene calls for": the plan is derived from the scene, and the rays
+//! a frame actually traces are counted and compared with an independent count.
+
+mod common;
+
+use glam::DVec3;
+use penumbra::render::cpu::CpuBackend;
+use penumbra::render::plan::Pass;
+use penumbra::render::{Backend, RenderPlan, Sampling, View};
+use penumbra::sampling::{DiskScheme, Pattern};
+use penumbra::scene::camera::{Camera, Projection};
+use penumbra::scene::{DiskLight, Light, Plane, Scene, Sphere};
+
+/// A ground plane seen in perspective up to the horizon, a point light and a disk light above
+/// it, and a disk light below it facing up (every receiver is behind that one).
+fn scene() -> (Scene, Camera) {
+    let camera = Camera {
+        position: DVec3::new(0.0, -4.0, 1.0),
+        look_at: DVec3::new(0.0, 0.0, 0.6),
+        up: DVec3::Z,
+        projection: Projection::Perspective { fov_y_deg: 50.0 },
+    };
+    let scene = Scene {
+        cameras: Default::default(),
+        spheres: vec![],
+        planes: vec![Plane {
+            point: DVec3::ZERO,
+            normal: DVec3::Z,
+            albedo: 0.5,
+        }],
+        lights: vec![
+            Light::Point {
+                position: DVec3::new(0.0, 0.0, 3.0),
+                power: 10.0,
+            },
+            Light::Disk(DiskLight {
+                center: DVec3::new(1.0, 0.0, 2.0),
+                normal: DVec3::NEG_Z,
+                radius: 0.3,
+                power: 10.0,
+                samples: 8,
+            }),
+            Light::Disk(DiskLight {
+                center: DVec3::new(0.0, 0.0, -1.0),
+                normal: DVec3::Z,
+                radius: 0.3,
+                power: 10.0,
+                samples: 32,
+            }),
+        ],
+    };
+    (scene, camera)
+}
+
+#[test]
+fn plan_follows_the_scene() {
+    let (mut s, cam) = scene();
+    let view = View {
+        camera: &cam,
+        width: 40,
+        height: 30,
+    };
+    let plan = RenderPlan::new(&s, view).unwrap();
+    assert_eq!(plan.passes.len(), 4);
+    assert_eq!(
+        plan.passes[0],
+        Pass::Primary {
+            rays: 1200,
+            shapes: vec!["plane"]
+        }
+    );
+    assert!(matches!(
+        plan.passes[1],
+        Pass::Shadow {
+            kind: "point",
+            rays_per_receiver: 1,
+            ..
+        }
+    ));
+    assert!(matches!(
+        plan.passes[2],
+        Pass::Shadow {
+            kind: "disk",
+            rays_per_receiver: 8,
+            max_rays: 9600,
+            ..
+        }
+    ));
+    assert_eq!(plan.max_rays(), 1200 * (1 + 1 + 8 + 32));
+    s.lights.clear();
+    s.spheres.push(Sphere {
+        center: DVec3::Z,
+        radius: 0.5,
+        albedo: 0.5,
+    });
+    let plan = RenderPlan::new(&s, view).unwrap();
+    assert_eq!(
+        plan.passes,
+        vec![Pass::Primary {
+            rays: 1200,
+            shapes: vec!["sphere", "plane"]
+        }]
+    );
+}
+
+/// Receivers (pixels whose ray goes down to the plane) each trace 1 ray to the point light and
+/// 8 to the disk above; none to the light below the plane. Counted independently from the
+/// camera's rays.
+#[test]
+fn traced_rays_match_an_independent_count() {
+    let (s, cam) = scene();
+    let view = View {
+        camera: &cam,
+        width: 40,
+        height: 30,
+    };
+    let receivers = (0..30)
+        .flat_map(|y| (0..40).map(move |x| (x, y)))
+        .filter(|&(x, y)| cam.ray(x, y, 40, 30).direction.z < 0.0)
+        .count() as u64;
+    assert!(
+        receivers > 100 && receivers < 1200,
+        "the view must show sky and ground: {receivers}"
+    );
+    let sampling = Sampling {
+        scheme: DiskScheme::Uniform,
+        pattern: Pattern::PerPixel,
+        seed: 3,
+    };
+    let check = |name: &str, b: &mut dyn Backend| {
+        let f = b.render(&s, view, sampling).unwrap();
+        assert_eq!(f.rays.primary, 1200, "{name}");
+        assert_eq!(f.rays.shadow[0], receivers, "{name}: point light");
+        assert_eq!(f.rays.shadow[1], 8 * receivers, "{name}: disk light above");
+        assert_eq!(f.rays.shadow[2], 0, "{name}: disk light below the receivers");
+        let below: Vec<f32> = f.visibility[2].iter().copied().filter(|v| *v >= 0.0).collect();
+        assert_eq!(below.len() as u64, receivers);
+        assert!(
+            below.iter().all(|v| *v == 0.0),
+            "{name}: a light facing away is invisible"
+        );
+    };
+    check("cpu", &mut CpuBackend::default());
+    if let Some(mut g) = common::gpu() {
+        check("gpu", &mut *g);
+    }
+}
