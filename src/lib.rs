@@ -14,9 +14,11 @@
 //! assert!(pts[1..].iter().all(|p| p.length() >= 0.3 - 1e-12 && p.length() <= 1.0));
 //! ```
 
+pub mod accel;
 pub mod config;
 pub mod experiment;
 pub mod geometry;
+pub mod mesh;
 pub mod metrics;
 pub mod reference;
 pub mod render;

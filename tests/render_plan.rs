@@ -20,15 +20,14 @@ fn scene() -> (Scene, Camera) {
         up: DVec3::Z,
         projection: Projection::Perspective { fov_y_deg: 50.0 },
     };
-    let scene = Scene {
-        cameras: Default::default(),
-        spheres: vec![],
-        planes: vec![Plane {
+    let scene = Scene::analytic(
+        vec![],
+        vec![Plane {
             point: DVec3::ZERO,
             normal: DVec3::Z,
             albedo: 0.5,
         }],
-        lights: vec![
+        vec![
             Light::Point {
                 position: DVec3::new(0.0, 0.0, 3.0),
                 power: 10.0,
@@ -48,7 +47,7 @@ fn scene() -> (Scene, Camera) {
                 samples: 32,
             }),
         ],
-    };
+    );
     (scene, camera)
 }
 

@@ -22,7 +22,8 @@ pub fn render_pictures(
         (DiskScheme::Paper, Pattern::PerPixel, f.samples),
         (DiskScheme::Jittered, Pattern::PerPixel, f.ground_truth_samples),
     ] {
-        let scene = spec.scene_with(light_radius, n);
+        let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
+        let scene = spec.scene_with(lights, light_radius, n);
         let view = View {
             camera: &scene.cameras[&f.camera],
             width: f.width,

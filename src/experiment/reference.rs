@@ -4,7 +4,7 @@
 use super::spec::Spec;
 use crate::metrics::{ErrorMetrics, PenumbraMask, RadialProfile, Receivers};
 use crate::reference::{visible_fraction, OnAxis};
-use crate::render::{Backend, Sampling, View};
+use crate::render::{Backend, Sampling, View, NO_RECEIVER};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::{Light, Scene};
 use anyhow::Context;
@@ -14,34 +14,60 @@ use std::path::Path;
 /// Seed of the ground-truth render (independent of the sweep's seeds).
 pub const GROUND_TRUTH_SEED: u32 = 0x6a09_e667;
 
-/// Everything the runs of one light radius are judged against.
+/// Everything the runs of one (lights on, light radius) pair are judged against.
 pub struct Reference {
+    /// Lights on.
+    pub lights: u32,
     /// Light radius (m).
     pub light_radius: f64,
-    /// Ground-truth visibility of the measured light (jittered, thousands of rays per pixel).
+    /// Ground-truth shadow image: per pixel, the mean visibility of the lights in use
+    /// (jittered, thousands of rays per pixel per light).
     pub ground_truth: Vec<f32>,
-    /// Exact visibility of receiver pixels ([`crate::render::NO_RECEIVER`] elsewhere).
-    pub exact: Vec<f32>,
-    /// Receiver pixels and their radii.
+    /// Exact shadow image of receiver-plane pixels ([`NO_RECEIVER`] elsewhere), when the scene
+    /// has an exact answer: disk lights and analytic shapes only.
+    pub exact: Option<Vec<f32>>,
+    /// Receiver-plane pixels and their radii from the shadow's centre.
     pub receivers: Receivers,
-    /// Penumbra pixels of the ground truth.
+    /// Penumbra pixels of the ground truth (any surface).
     pub mask: PenumbraMask,
-    /// Closed-form radii, when the scene is on-axis.
+    /// Closed-form radii, when one light is on and the scene is on-axis.
     pub on_axis: Option<OnAxis>,
-    /// Radial profile of the exact image.
-    pub exact_profile: RadialProfile,
-    /// Ground truth against exact over all receiver pixels (max_abs) and the penumbra (rmse, bias).
-    pub gt_vs_exact: ErrorMetrics,
+    /// Radial profile of the exact image (on-axis scenes).
+    pub exact_profile: Option<RadialProfile>,
+    /// Ground truth against exact over the penumbra.
+    pub gt_vs_exact: Option<ErrorMetrics>,
     /// Largest |ground truth - exact| over every receiver pixel.
-    pub gt_max_abs_all: f64,
-    /// Radial profile of the ground truth.
-    pub gt_profile: RadialProfile,
+    pub gt_max_abs_all: Option<f64>,
+    /// Radial profile of the ground truth (on-axis scenes).
+    pub gt_profile: Option<RadialProfile>,
+}
+
+/// The shadow image of a frame: per pixel, the mean visibility over its lights; pixels with no
+/// receiver stay [`NO_RECEIVER`].
+pub fn shadow_image(visibility: &[Vec<f32>]) -> Vec<f32> {
+    let n = visibility.len() as f32;
+    (0..visibility[0].len())
+        .map(|i| {
+            let v0 = visibility[0][i];
+            if v0 == NO_RECEIVER {
+                NO_RECEIVER
+            } else {
+                visibility.iter().map(|v| v[i]).sum::<f32>() / n
+            }
+        })
+        .collect()
 }
 
 impl Reference {
-    /// Renders (or loads from `cache`) the ground truth for `radius` and computes the exact image.
-    pub fn build(spec: &Spec, backend: &mut dyn Backend, radius: f64, cache: &Path) -> anyhow::Result<Reference> {
-        let scene = spec.scene_with(radius, spec.ground_truth.samples);
+    /// Renders (or loads from `cache`) the ground truth and computes the exact image if any.
+    pub fn build(
+        spec: &Spec,
+        backend: &mut dyn Backend,
+        lights: u32,
+        radius: f64,
+        cache: &Path,
+    ) -> anyhow::Result<Reference> {
+        let scene = spec.scene_with(lights, radius, spec.ground_truth.samples);
         let m = &spec.measure;
         let camera = &scene.cameras[&m.camera];
         let view = View {
@@ -50,7 +76,7 @@ impl Reference {
             height: m.height,
         };
         let key = format!(
-            "{};r={radius:e};{};build={:016x}",
+            "{};lights={lights};r={radius:e};{};build={:016x}",
             super::run::context_key(spec),
             backend.adapter().name,
             build_id()
@@ -64,35 +90,41 @@ impl Reference {
                     pattern: Pattern::PerPixel,
                     seed: GROUND_TRUTH_SEED,
                 };
-                let mut f = backend
+                let f = backend
                     .render(&scene, view, sampling)
                     .context("rendering the ground truth")?;
-                let rendered = (f.visibility.swap_remove(m.light), f.hit);
+                let rendered = (shadow_image(&f.visibility), f.hit);
                 save_cached(&file, &rendered)?;
                 rendered
             }
         };
-        let on_axis = OnAxis::detect(&scene, m.light, m.plane);
+        let on_axis = if lights == 1 {
+            OnAxis::detect(&scene, 0, m.plane)
+        } else {
+            None
+        };
         let centre = on_axis.as_ref().map_or(camera.look_at, |o| o.foot);
         let bin = match camera.projection {
             crate::scene::camera::Projection::Orthographic { width } => width / m.width as f64,
-            crate::scene::camera::Projection::Perspective { .. } => {
-                unreachable!("validated orthographic")
-            }
+            crate::scene::camera::Projection::Perspective { .. } => unreachable!("validated orthographic"),
         };
         let receivers = Receivers::new(&scene, view, m.plane, &hit, centre, bin);
-        let exact = exact_image(&scene, view, m.light, m.plane, &receivers);
+        let exact = has_exact_answer(&scene).then(|| exact_image(&scene, view, m.plane, &receivers));
         let mask = PenumbraMask::from_reference(&ground_truth);
-        let gt_vs_exact = ErrorMetrics::measure(&ground_truth, &exact, &mask);
-        let gt_max_abs_all = receivers
-            .pixels
-            .iter()
-            .map(|&(i, _)| (ground_truth[i] - exact[i]).abs() as f64)
-            .fold(0.0, f64::max);
+        let gt_vs_exact = exact.as_ref().map(|e| ErrorMetrics::measure(&ground_truth, e, &mask));
+        let gt_max_abs_all = exact.as_ref().map(|e| {
+            receivers
+                .pixels
+                .iter()
+                .map(|&(i, _)| (ground_truth[i] - e[i]).abs() as f64)
+                .fold(0.0, f64::max)
+        });
+        let profile = |image: &[f32]| on_axis.is_some().then(|| RadialProfile::new(&receivers, image));
         Ok(Reference {
+            lights,
             light_radius: radius,
-            exact_profile: RadialProfile::new(&receivers, &exact),
-            gt_profile: RadialProfile::new(&receivers, &ground_truth),
+            exact_profile: exact.as_deref().and_then(profile),
+            gt_profile: profile(&ground_truth),
             ground_truth,
             exact,
             receivers,
@@ -104,11 +136,14 @@ impl Reference {
     }
 }
 
-/// Exact visibility of `light` at every receiver pixel (rayon; the penumbra dominates the cost).
-pub fn exact_image(scene: &Scene, view: View, light: usize, plane: usize, receivers: &Receivers) -> Vec<f32> {
-    let Light::Disk(l) = &scene.lights[light] else {
-        panic!("validated disk light")
-    };
+/// The exact reference covers disk lights and analytic shapes (no meshes, no point lights).
+pub fn has_exact_answer(scene: &Scene) -> bool {
+    scene.bvh.is_none() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
+}
+
+/// Exact shadow image (mean over the scene's disk lights) at every receiver pixel (rayon; the
+/// penumbra dominates the cost).
+pub fn exact_image(scene: &Scene, view: View, plane: usize, receivers: &Receivers) -> Vec<f32> {
     let pl = &scene.planes[plane];
     let points: Vec<(usize, glam::DVec3)> = receivers
         .pixels
@@ -120,16 +155,22 @@ pub fn exact_image(scene: &Scene, view: View, light: usize, plane: usize, receiv
             (i, crate::geometry::reproject_plane(ray.origin + ray.direction * t, pl))
         })
         .collect();
+    let disks: Vec<_> = scene
+        .lights
+        .iter()
+        .filter_map(|l| if let Light::Disk(d) = l { Some(d) } else { None })
+        .collect();
     let values: Vec<(usize, f32)> = points
         .par_iter()
         .map(|&(i, p)| {
-            (
-                i,
-                visible_fraction(p, pl.normal, l, &scene.spheres, &scene.planes) as f32,
-            )
+            let v: f64 = disks
+                .iter()
+                .map(|l| visible_fraction(p, pl.normal, l, &scene.spheres, &scene.planes))
+                .sum();
+            (i, (v / disks.len() as f64) as f32)
         })
         .collect();
-    let mut image = vec![crate::render::NO_RECEIVER; view.pixels()];
+    let mut image = vec![NO_RECEIVER; view.pixels()];
     for (i, v) in values {
         image[i] = v;
     }

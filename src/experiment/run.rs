@@ -15,6 +15,8 @@ pub struct Run {
     pub samples: u32,
     /// Light radius, metres.
     pub light_radius: f64,
+    /// Lights on (the scene's first k).
+    pub lights: u32,
     /// Seed.
     pub seed: u32,
 }
@@ -33,12 +35,16 @@ impl Group {
     }
 }
 
-/// The sweep in canonical order: light radius, then scheme, pattern, samples; seeds innermost,
-/// grouped. The order fixes the row order of runs.csv whatever order work was done in.
+/// The sweep in canonical order: lights on, light radius, then scheme, pattern, samples; seeds
+/// innermost, grouped. The order fixes the row order of runs.csv whatever order work was done in.
 pub fn expand(spec: &Spec) -> Vec<Group> {
     let a = &spec.axes;
     let mut groups = Vec::new();
-    for &light_radius in &a.light_radii {
+    for (&lights, &light_radius) in a
+        .light_counts
+        .iter()
+        .flat_map(|l| a.light_radii.iter().map(move |r| (l, r)))
+    {
         for &scheme in &a.schemes {
             for &pattern in &a.patterns {
                 for &samples in &a.samples {
@@ -50,6 +56,7 @@ pub fn expand(spec: &Spec) -> Vec<Group> {
                             pattern,
                             samples,
                             light_radius,
+                            lights,
                             seed,
                         })
                         .collect();
@@ -71,11 +78,10 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
 /// Everything besides the run's own axes that determines its result.
 pub fn context_key(spec: &Spec) -> String {
     format!(
-        "scene={:016x};measure={:?};gt={};light={};plane={}",
+        "scene={:016x};measure={:?};gt={};plane={}",
         fnv1a(spec.scene_text.as_bytes()),
         (&spec.measure.camera, spec.measure.width, spec.measure.height),
         spec.ground_truth.samples,
-        spec.measure.light,
         spec.measure.plane
     )
 }
@@ -85,8 +91,8 @@ impl Run {
     /// keying resumed work: a changed scene or view gives new keys.
     pub fn key(&self, context: &str) -> String {
         let text = format!(
-            "{context};{};{};{};{:e};{}",
-            self.scheme, self.pattern, self.samples, self.light_radius, self.seed
+            "{context};{};{};{};{:e};{};{}",
+            self.scheme, self.pattern, self.samples, self.light_radius, self.lights, self.seed
         );
         format!("{:016x}", fnv1a(text.as_bytes()))
     }
@@ -102,13 +108,14 @@ pub fn num(x: f64) -> String {
 }
 
 /// Columns of runs.csv, in order. Each is defined in `metrics` or README.md.
-pub const RUN_COLUMNS: [&str; 33] = [
+pub const RUN_COLUMNS: [&str; 41] = [
     "run_key",
     "status",
     "scheme",
     "pattern",
     "samples",
     "light_radius",
+    "lights",
     "seed",
     "width",
     "height",
@@ -126,17 +133,29 @@ pub const RUN_COLUMNS: [&str; 33] = [
     "relmse",
     "bias",
     "rmse_exact",
+    "penumbra_area_ratio",
+    "penumbra_lost_share",
     "primary_rays",
     "shadow_rays",
     "frame_ms",
     "rays_per_s",
+    "primary_rays_per_s",
+    "shadow_rays_per_s",
     "clock",
+    "bvh_preset",
+    "bvh_build_ms",
+    "gpu_bytes_per_triangle",
     "backend",
     "adapter",
     "driver",
     "api",
     "error",
 ];
+
+/// Columns naming the run (before the metrics).
+pub const IDENTITY_COLUMNS: usize = 10;
+/// Columns naming the device (after the metrics).
+pub const ADAPTER_COLUMNS: usize = 5;
 
 /// One row of runs.csv, as strings in [`RUN_COLUMNS`] order (kept as text so a resumed sweep
 /// reproduces earlier rows byte for byte).

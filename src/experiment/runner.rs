@@ -2,11 +2,11 @@
 //! it, and stream the records to a journal so an interrupted sweep resumes where it stopped.
 
 use super::journal::Journal;
-use super::reference::Reference;
-use super::run::{context_key, expand, num, Group, Record, Run};
+use super::reference::{shadow_image, Reference};
+use super::run::{context_key, expand, num, Group, Record, Run, ADAPTER_COLUMNS, IDENTITY_COLUMNS};
 use super::spec::Spec;
 use crate::metrics::{stats, ErrorMetrics, RadialProfile};
-use crate::render::{Backend, Frame, RenderPlan, Sampling, View};
+use crate::render::{Backend, RenderPlan, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
 use anyhow::Context;
 use std::collections::BTreeMap;
@@ -84,7 +84,8 @@ pub fn run_sweep(
         profiles: BTreeMap::new(),
         keep: BTreeMap::new(),
         plan: {
-            let s = spec.scene_with(spec.axes.light_radii[0], spec.axes.samples[0]);
+            let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
+            let s = spec.scene_with(lights, spec.axes.light_radii[0], figure_samples(spec));
             RenderPlan::new(
                 &s,
                 View {
@@ -97,10 +98,18 @@ pub fn run_sweep(
         failures: 0,
         resumed: 0,
     };
-    for (ri, &radius) in spec.axes.light_radii.iter().enumerate() {
-        bar.set_message(format!("reference for light radius {radius} m"));
-        let reference = Reference::build(spec, backend, radius, cache)?;
-        for group in groups.iter().filter(|g| g.head().light_radius == radius) {
+    let pairs = spec
+        .axes
+        .light_counts
+        .iter()
+        .flat_map(|&l| spec.axes.light_radii.iter().map(move |&r| (l, r)));
+    for (ri, (lights, radius)) in pairs.enumerate() {
+        bar.set_message(format!("reference for {lights} light(s) of radius {radius} m"));
+        let reference = Reference::build(spec, backend, lights, radius, cache)?;
+        for group in groups
+            .iter()
+            .filter(|g| g.head().light_radius == radius && g.head().lights == lights)
+        {
             let head = *group.head();
             let gkey = head.key(&context);
             let needed_for_figures = head.samples == fig_n;
@@ -139,6 +148,9 @@ fn keep_for_figures(out: &mut Outcome, reference: &Reference, head: Run, ri: usi
     let Some(first) = images.first() else { return };
     let key = (head.scheme, head.pattern, ri);
     out.keep.insert(key, first.clone());
+    if reference.on_axis.is_none() {
+        return;
+    }
     let mut avg = RadialProfile::new(&reference.receivers, first);
     let profiles: Vec<_> = images
         .iter()
@@ -207,8 +219,8 @@ fn group_stats(group: &Group, reference: &Reference, images: &[Vec<f32>], contex
     }
 }
 
-/// Columns of a record between the run's identity (9) and the adapter's (5).
-const METRIC_COLUMNS: usize = super::run::RUN_COLUMNS.len() - 14;
+/// Columns of a record between the run's identity and the adapter's.
+const METRIC_COLUMNS: usize = super::run::RUN_COLUMNS.len() - IDENTITY_COLUMNS - ADAPTER_COLUMNS;
 
 fn assemble(
     spec: &Spec,
@@ -228,6 +240,7 @@ fn assemble(
         run.pattern.to_string(),
         run.samples.to_string(),
         num(run.light_radius),
+        run.lights.to_string(),
         run.seed.to_string(),
         spec.measure.width.to_string(),
         spec.measure.height.to_string(),
@@ -261,7 +274,7 @@ fn measure_run(
     run: &Run,
     reference: &Reference,
 ) -> anyhow::Result<(Record, Vec<f32>)> {
-    let scene = spec.scene_with(run.light_radius, run.samples);
+    let scene = spec.scene_with(run.lights, run.light_radius, run.samples);
     let m = &spec.measure;
     let view = View {
         camera: &scene.cameras[&m.camera],
@@ -273,64 +286,112 @@ fn measure_run(
         pattern: run.pattern,
         seed: run.seed,
     };
-    let Frame {
-        mut visibility, rays, ..
-    } = backend.render(&scene, view, sampling).context("render")?;
-    let image = visibility.swap_remove(m.light);
+    let frame = backend.render(&scene, view, sampling).context("render")?;
+    let image = shadow_image(&frame.visibility);
+    let rays = frame.rays;
     let t = &spec.timing;
-    let (seconds, clock) = if t.repeats > 0 {
+    let (seconds, primary_seconds, clock) = if t.repeats > 0 {
         let timing = backend
             .time(&scene, view, sampling, t.warmup, t.repeats)
             .context("timing")?;
-        (stats::median(&timing.seconds), timing.clock.name().to_string())
+        (
+            stats::median(&timing.seconds),
+            stats::median(&timing.primary_seconds),
+            timing.clock.name().to_string(),
+        )
     } else {
-        (f64::NAN, String::new())
+        (f64::NAN, f64::NAN, String::new())
     };
-    let profile = RadialProfile::new(&reference.receivers, &image);
-    let (inner, outer) = profile.extent();
-    let (ex_in, ex_out) = reference.exact_profile.extent();
-    let (bias, abs_bias) = profile_bias(&profile, reference);
+    let radial = radial_metrics(&image, reference);
     let vs_gt = ErrorMetrics::measure(&image, &reference.ground_truth, &reference.mask);
-    let vs_exact = ErrorMetrics::measure(&image, &reference.exact, &reference.mask);
-    let (ru, rp) = reference
-        .on_axis
+    let rmse_exact = reference
+        .exact
         .as_ref()
-        .map_or((f64::NAN, f64::NAN), |o| (o.umbra_radius(), o.penumbra_radius()));
+        .map_or(f64::NAN, |e| ErrorMetrics::measure(&image, e, &reference.mask).rmse);
+    let (area_ratio, lost) = penumbra_coverage(&image, reference);
     let total_rays = rays.primary + rays.shadow_total();
-    let metrics = vec![
-        num(ru),
-        num(rp),
-        num(ex_out - ex_in),
-        num(reference.exact_profile.width_10_90()),
-        num(inner),
-        num(outer),
-        num(outer - inner),
-        num(profile.width_10_90()),
-        num(bias),
-        num(abs_bias),
+    let (preset, build_ms, bytes) = match &scene.bvh {
+        Some(b) => (
+            b.preset.name().to_string(),
+            num(b.total_time.as_secs_f64() * 1e3),
+            num((b.node_count() * 32 + b.tree.primitive_indices.len() * 48) as f64 / b.world.len() as f64),
+        ),
+        None => Default::default(),
+    };
+    let mut metrics = radial;
+    metrics.extend([
         num(vs_gt.rmse),
         num(vs_gt.relmse),
         num(vs_gt.bias),
-        num(vs_exact.rmse),
+        num(rmse_exact),
+        num(area_ratio),
+        num(lost),
         rays.primary.to_string(),
         rays.shadow_total().to_string(),
         num(seconds * 1e3),
         num(total_rays as f64 / seconds),
+        num(rays.primary as f64 / primary_seconds),
+        num(rays.shadow_total() as f64 / (seconds - primary_seconds)),
         clock,
-    ];
+        preset,
+        build_ms,
+        bytes,
+    ]);
     Ok((
         assemble(spec, backend, run, &context_key(spec), "ok", &metrics, ""),
         image,
     ))
 }
 
+/// The on-axis columns (closed-form radii, exact and measured extents and 10-90 widths, profile
+/// bias), blank when the scene has no rotationally symmetric exact shadow.
+fn radial_metrics(image: &[f32], reference: &Reference) -> Vec<String> {
+    let (Some(o), Some(exact)) = (&reference.on_axis, &reference.exact_profile) else {
+        return vec![String::new(); 10];
+    };
+    let profile = RadialProfile::new(&reference.receivers, image);
+    let (inner, outer) = profile.extent();
+    let (ex_in, ex_out) = exact.extent();
+    let (bias, abs_bias) = profile_bias(&profile, exact);
+    [
+        o.umbra_radius(),
+        o.penumbra_radius(),
+        ex_out - ex_in,
+        exact.width_10_90(),
+        inner,
+        outer,
+        outer - inner,
+        profile.width_10_90(),
+        bias,
+        abs_bias,
+    ]
+    .map(num)
+    .to_vec()
+}
+
+/// Penumbra for any scene, against the ground truth's penumbra mask P (eps < V_gt < 1 - eps):
+/// the image's penumbra area (pixels with eps < V < 1 - eps) relative to |P|, and the share of P
+/// that the image shows as fully lit or fully dark (penumbra the image loses).
+pub fn penumbra_coverage(image: &[f32], reference: &Reference) -> (f64, f64) {
+    let eps = crate::metrics::error::EPS as f32;
+    let n = reference.mask.pixels.len() as f64;
+    let area = image.iter().filter(|v| **v > eps && **v < 1.0 - eps).count() as f64;
+    let lost = reference
+        .mask
+        .pixels
+        .iter()
+        .filter(|&&i| image[i] <= eps || image[i] >= 1.0 - eps)
+        .count() as f64;
+    (area / n, lost / n)
+}
+
 /// Signed and absolute mean of (profile - exact profile) over bins inside the exact penumbra
 /// (between the exact image's inner and outer extent).
-pub fn profile_bias(profile: &RadialProfile, reference: &Reference) -> (f64, f64) {
-    let (lo, hi) = reference.exact_profile.extent();
+pub fn profile_bias(profile: &RadialProfile, exact: &RadialProfile) -> (f64, f64) {
+    let (lo, hi) = exact.extent();
     let diffs: Vec<f64> = (0..profile.radius.len())
         .filter(|&b| profile.radius[b] >= lo && profile.radius[b] <= hi)
-        .map(|b| profile.mean[b] - reference.exact_profile.mean[b])
+        .map(|b| profile.mean[b] - exact.mean[b])
         .filter(|d| !d.is_nan())
         .collect();
     if diffs.is_empty() {

@@ -50,10 +50,7 @@ pub struct Measure {
     pub width: u32,
     /// Image height, pixels.
     pub height: u32,
-    /// Index of the disk light whose radius and shadow-ray count are swept.
-    #[serde(default)]
-    pub light: usize,
-    /// Index of the receiver plane.
+    /// Index of the receiver plane (radial profiles and exact references are taken on it).
     #[serde(default)]
     pub plane: usize,
 }
@@ -72,6 +69,10 @@ pub struct Axes {
     pub light_radii: Vec<f64>,
     /// Seeds.
     pub seeds: Vec<u32>,
+    /// How many of the scene's lights are on (the first k); every light in use gets the swept
+    /// radius and shadow-ray count. Default: all of them.
+    #[serde(default)]
+    pub light_counts: Vec<u32>,
 }
 
 /// The high-sample reference image.
@@ -189,11 +190,23 @@ impl Spec {
                 return Err(err(&key_path!["measure", k], format!("must be in 1..=16384, got {v}")));
             }
         }
-        if !matches!(scene.lights.get(m.light), Some(Light::Disk(_))) {
+        let mut axes = f.sweep;
+        if axes.light_counts.is_empty() {
+            axes.light_counts = vec![scene.lights.len() as u32];
+        }
+        if !scene.lights.iter().any(|l| matches!(l, Light::Disk(_))) {
             return Err(err(
-                &key_path!["measure", "light"],
-                format!("light {} is not a disk light of the scene", m.light),
+                &key_path!["scene"],
+                format!("{} has no disk light to sweep", scene_path.display()),
             ));
+        }
+        for (i, &k) in axes.light_counts.iter().enumerate() {
+            if k == 0 || k as usize > scene.lights.len() {
+                return Err(err(
+                    &key_path!["sweep", "light_counts", i],
+                    format!("must be in 1..={}, the scene's lights", scene.lights.len()),
+                ));
+            }
         }
         if m.plane >= scene.planes.len() {
             return Err(err(
@@ -201,7 +214,7 @@ impl Spec {
                 format!("the scene has {} planes", scene.planes.len()),
             ));
         }
-        let a = &f.sweep;
+        let a = &axes;
         for (key, empty) in [
             ("schemes", a.schemes.is_empty()),
             ("patterns", a.patterns.is_empty()),
@@ -242,6 +255,7 @@ impl Spec {
         check_dupes("samples", a.samples.iter().map(|s| s.to_string()).collect())?;
         check_dupes("light_radii", a.light_radii.iter().map(|s| s.to_string()).collect())?;
         check_dupes("seeds", a.seeds.iter().map(|s| s.to_string()).collect())?;
+        check_dupes("light_counts", a.light_counts.iter().map(|s| s.to_string()).collect())?;
         if !(1..=MAX_SAMPLES).contains(&f.ground_truth.samples) {
             return Err(err(
                 &key_path!["ground_truth", "samples"],
@@ -280,19 +294,23 @@ impl Spec {
             scene,
             backend: f.backend,
             measure: f.measure,
-            axes: f.sweep,
+            axes,
             ground_truth: f.ground_truth,
             timing: f.timing,
             figures: f.figures,
         })
     }
 
-    /// The scene with the swept light set to `radius` and `samples`.
-    pub fn scene_with(&self, radius: f64, samples: u32) -> Scene {
+    /// The scene with its first `lights` lights on, every disk light among them set to `radius`
+    /// and `samples`.
+    pub fn scene_with(&self, lights: u32, radius: f64, samples: u32) -> Scene {
         let mut scene = self.scene.clone();
-        if let Light::Disk(d) = &mut scene.lights[self.measure.light] {
-            d.radius = radius;
-            d.samples = samples;
+        scene.lights.truncate(lights as usize);
+        for l in &mut scene.lights {
+            if let Light::Disk(d) = l {
+                d.radius = radius;
+                d.samples = samples;
+            }
         }
         scene
     }

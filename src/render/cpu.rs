@@ -1,7 +1,7 @@
 //! The f64 CPU backend: the fallback when no GPU adapter exists and the cross-check of the GPU
 //! in tests. Same plan, same sample streams, double precision, rayon over rows.
 
-use super::shading::{shade_light, Targets};
+use super::shading::{shade_light, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::geometry::{plane_t, reproject_plane, reproject_sphere, sphere_roots};
 use crate::render::plan::{RenderPlan, MAX_LIGHTS};
@@ -30,39 +30,61 @@ impl Default for CpuBackend {
     }
 }
 
-/// The closest surface a ray meets: point (re-projected onto the surface), normal facing the
-/// ray, albedo and object id.
-pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(DVec3, DVec3, f64, u32)> {
-    let mut best: Option<(f64, u32)> = None;
-    let mut consider = |t: f64, id: u32| {
-        if t > 0.0 && best.is_none_or(|(bt, _)| t < bt) {
-            best = Some((t, id));
+/// The closest surface a ray meets, as a receiver of shadow rays: point re-projected onto
+/// analytic surfaces, geometric normal facing the ray.
+pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver> {
+    let mut best: Option<(f64, u32, u32)> = None;
+    let consider = |best: &mut Option<(f64, u32, u32)>, t: f64, id: u32, tri: u32| {
+        if t > 0.0 && best.is_none_or(|(bt, _, _)| t < bt) {
+            *best = Some((t, id, tri));
         }
     };
     for (i, s) in scene.spheres.iter().enumerate() {
         if let Some((t0, t1)) = sphere_roots(origin, dir, s) {
-            consider(if t0 > 0.0 { t0 } else { t1 }, i as u32);
+            consider(&mut best, if t0 > 0.0 { t0 } else { t1 }, i as u32, NO_HIT);
         }
     }
     for (i, p) in scene.planes.iter().enumerate() {
         if let Some(t) = plane_t(origin, dir, p) {
-            consider(t, scene.plane_id(i));
+            consider(&mut best, t, scene.plane_id(i), NO_HIT);
         }
     }
-    let (t, id) = best?;
+    if let Some(bvh) = &scene.bvh {
+        let tmax = best.map_or(f64::INFINITY, |b| b.0);
+        if let Some(h) = bvh.closest(origin, dir, tmax, NO_HIT) {
+            consider(
+                &mut best,
+                h.t,
+                scene.mesh_id(bvh.mesh_of[h.triangle as usize] as usize),
+                h.triangle,
+            );
+        }
+    }
+    let (t, object, triangle) = best?;
     let raw = origin + dir * t;
-    let (p, n, albedo) = match scene.spheres.get(id as usize) {
-        Some(s) => {
-            let p = reproject_sphere(raw, s);
-            (p, (p - s.center) / s.radius, s.albedo)
-        }
-        None => {
-            let pl = &scene.planes[id as usize - scene.spheres.len()];
-            (reproject_plane(raw, pl), pl.normal, pl.albedo)
-        }
+    let (p, n, albedo) = if let Some(s) = scene.spheres.get(object as usize) {
+        let p = reproject_sphere(raw, s);
+        (p, (p - s.center) / s.radius, s.albedo)
+    } else if let Some(pl) = scene.planes.get(object as usize - scene.spheres.len()) {
+        (reproject_plane(raw, pl), pl.normal, pl.albedo)
+    } else {
+        let bvh = scene.bvh.as_ref().expect("a mesh hit has a BVH");
+        let tri = &bvh.world[triangle as usize];
+        let mesh = bvh.mesh_of[triangle as usize] as usize;
+        (
+            raw,
+            (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize(),
+            scene.meshes[mesh].albedo,
+        )
     };
     let n = if n.dot(dir) > 0.0 { -n } else { n };
-    Some((p, n, albedo, id))
+    Some(Receiver {
+        p,
+        n,
+        albedo,
+        object,
+        triangle,
+    })
 }
 
 impl Backend for CpuBackend {
@@ -92,11 +114,11 @@ impl Backend for CpuBackend {
                 let mut rays = [0u64; MAX_LIGHTS];
                 for x in 0..view.width {
                     let ray = view.camera.ray(x, y, view.width, view.height);
-                    let Some((p, n, albedo, id)) = closest_hit(scene, ray.origin, ray.direction) else {
+                    let Some(receiver) = closest_hit(scene, ray.origin, ray.direction) else {
                         continue;
                     };
                     let pixel = y * view.width + x;
-                    hit[x as usize] = id;
+                    hit[x as usize] = receiver.object;
                     let mut irradiance = 0.0;
                     for (li, light) in scene.lights.iter().enumerate() {
                         let targets = match &shared[li] {
@@ -105,12 +127,12 @@ impl Backend for CpuBackend {
                                 Targets::PerPixel(sampling.scheme, Stream::new(sampling.seed, li as u32, Some(pixel)))
                             }
                         };
-                        let s = shade_light(scene, p, n, id, light, targets);
+                        let s = shade_light(scene, &receiver, light, targets);
                         vis[li * w + x as usize] = s.visibility as f32;
                         irradiance += s.irradiance;
                         rays[li] += s.rays;
                     }
-                    radiance[x as usize] = (albedo * FRAC_1_PI * irradiance) as f32;
+                    radiance[x as usize] = (receiver.albedo * FRAC_1_PI * irradiance) as f32;
                 }
                 (radiance, vis, hit, rays)
             })
@@ -157,6 +179,7 @@ impl Backend for CpuBackend {
         }
         Ok(Timing {
             seconds,
+            primary_seconds: vec![],
             clock: Clock::WallClock,
         })
     }

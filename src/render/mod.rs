@@ -8,7 +8,7 @@
 pub mod cpu;
 pub mod gpu;
 pub mod plan;
-mod shading;
+pub mod shading;
 
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::{camera::Camera, Scene};
@@ -108,6 +108,8 @@ impl Clock {
 pub struct Timing {
     /// Seconds per frame, one per timed repeat.
     pub seconds: Vec<f64>,
+    /// Seconds of the primary (camera-ray) pass per frame, where the clock can split passes.
+    pub primary_seconds: Vec<f64>,
     /// Where the times came from.
     pub clock: Clock,
 }

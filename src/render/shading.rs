@@ -1,7 +1,7 @@
 //! Per-receiver shadow-ray logic of the CPU backend, in f64. `shaders/render.wgsl` follows it
 //! line for line in f32; change both together.
 
-use crate::geometry::{plane_t, sphere_roots};
+use crate::geometry::{offset_origin, plane_t, sphere_roots};
 use crate::sampling::{DiskScheme, Stream};
 use crate::scene::{DiskLight, Light, Scene};
 use glam::{DVec2, DVec3};
@@ -17,24 +17,56 @@ pub struct LightSample {
     pub rays: u64,
 }
 
+/// A surface point that receives shadow rays.
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver {
+    /// Position.
+    pub p: DVec3,
+    /// Unit geometric normal, on the side the camera sees.
+    pub n: DVec3,
+    /// Lambertian albedo.
+    pub albedo: f64,
+    /// Object id.
+    pub object: u32,
+    /// Triangle index for mesh receivers, else [`super::NO_HIT`].
+    pub triangle: u32,
+}
+
+impl Receiver {
+    /// Where its shadow rays start. Spheres and planes are convex: a ray leaving one towards its
+    /// outside cannot meet it again, so skipping the receiver's own object removes
+    /// self-intersection exactly and the ray starts on the surface (an offset along the normal
+    /// would move the shadow edge and bias visibility in proportion to offset / penumbra width).
+    /// A mesh is not convex: its own triangle is skipped and the origin is lifted by Waechter &
+    /// Binder's scale-relative offset so neighbouring triangles sharing an edge are not hit.
+    fn origin(&self) -> DVec3 {
+        if self.triangle == super::NO_HIT {
+            self.p
+        } else {
+            offset_origin(self.p, self.n)
+        }
+    }
+}
+
 /// Any-hit test of the segment origin -> origin + d (exclusive of both ends) against the scene,
-/// skipping object `skip`: the receiver itself. Spheres and planes are convex, so a ray leaving
-/// one towards its outside cannot meet it again; skipping it removes self-intersection exactly,
-/// with no origin offset to shift the receiver (an offset along the normal moves the shadow edge
-/// and biases visibility in proportion to offset / penumbra width).
-pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, skip: u32) -> bool {
+/// skipping the receiver's own sphere or plane (`object`) or triangle.
+pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, r: &Receiver) -> bool {
     let len = d.length();
     let dir = d / len;
     let inside = |t: f64| t > 0.0 && t < len;
     let sphere_hit = scene.spheres.iter().enumerate().any(|(i, s)| {
-        i as u32 != skip && sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1))
+        i as u32 != r.object && sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1))
     });
     sphere_hit
         || scene
             .planes
             .iter()
             .enumerate()
-            .any(|(i, p)| scene.plane_id(i) != skip && plane_t(origin, dir, p).is_some_and(inside))
+            .any(|(i, p)| scene.plane_id(i) != r.object && plane_t(origin, dir, p).is_some_and(inside))
+        || scene
+            .bvh
+            .as_ref()
+            .is_some_and(|b| b.any_hit(origin, dir, len, r.triangle))
 }
 
 /// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:
@@ -52,8 +84,9 @@ pub enum Targets<'a> {
     Shared(&'a [DVec2]),
 }
 
-/// Shadow rays from receiver (p, n) on object `id` to `light`.
-pub fn shade_light(scene: &Scene, p: DVec3, n: DVec3, id: u32, light: &Light, targets: Targets) -> LightSample {
+/// Shadow rays from a receiver to `light`.
+pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets) -> LightSample {
+    let (p, n, origin) = (r.p, r.n, r.origin());
     match light {
         Light::Point { position, power } => {
             let d = *position - p;
@@ -64,7 +97,7 @@ pub fn shade_light(scene: &Scene, p: DVec3, n: DVec3, id: u32, light: &Light, ta
                     rays: 0,
                 };
             }
-            let visible = !occluded(scene, p, *position - p, id);
+            let visible = !occluded(scene, origin, *position - origin, r);
             let irradiance = if visible {
                 power / (4.0 * PI) * n.dot(d.normalize()) / d.length_squared()
             } else {
@@ -97,7 +130,7 @@ pub fn shade_light(scene: &Scene, p: DVec3, n: DVec3, id: u32, light: &Light, ta
                     continue;
                 }
                 rays += 1;
-                if !occluded(scene, p, d, id) {
+                if !occluded(scene, origin, q - origin, r) {
                     visible += 1;
                     let d2 = d.length_squared();
                     sum += n.dot(d) * -l.normal.dot(d) / (d2 * d2);

@@ -8,7 +8,7 @@ use crate::metrics::stats::mean_ci;
 use crate::sampling::{DiskScheme, Pattern};
 
 /// Metrics aggregated as mean and CI half-width.
-pub const AGGREGATED: [&str; 10] = [
+pub const AGGREGATED: [&str; 14] = [
     "extent_width",
     "width_10_90",
     "profile_bias",
@@ -17,8 +17,12 @@ pub const AGGREGATED: [&str; 10] = [
     "relmse",
     "bias",
     "rmse_exact",
+    "penumbra_area_ratio",
+    "penumbra_lost_share",
     "frame_ms",
     "rays_per_s",
+    "primary_rays_per_s",
+    "shadow_rays_per_s",
 ];
 
 /// One configuration (all axes but the seed) summarised.
@@ -87,6 +91,7 @@ fn same_config(r: &Record, run: &Run) -> bool {
         && r.get("pattern") == run.pattern.name()
         && r.num("samples") == run.samples as f64
         && r.num("light_radius") == run.light_radius
+        && r.num("lights") == run.lights as f64
 }
 
 /// The summary of one configuration, if swept.
@@ -96,9 +101,15 @@ pub fn find(
     pattern: Pattern,
     samples: u32,
     radius: f64,
+    lights: u32,
 ) -> Option<&Summary> {
     summaries.iter().find(|s| {
-        s.run.scheme == scheme && s.run.pattern == pattern && s.run.samples == samples && s.run.light_radius == radius
+        let r = &s.run;
+        r.scheme == scheme
+            && r.pattern == pattern
+            && r.samples == samples
+            && r.light_radius == radius
+            && r.lights == lights
     })
 }
 
@@ -109,6 +120,7 @@ pub fn header() -> Vec<String> {
         "pattern",
         "samples",
         "light_radius",
+        "lights",
         "seeds",
         "exact_extent_width",
         "exact_width_10_90",
@@ -130,6 +142,7 @@ pub fn row(s: &Summary) -> Vec<String> {
         s.run.pattern.to_string(),
         s.run.samples.to_string(),
         num(s.run.light_radius),
+        s.run.lights.to_string(),
         s.seeds.to_string(),
         num(s.exact_extent_width),
         num(s.exact_width_10_90),

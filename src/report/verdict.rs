@@ -65,8 +65,8 @@ pub struct Verdict {
 impl Verdict {
     /// Builds the verdict for one pattern, if both schemes were swept there.
     pub fn new(summaries: &[Summary], samples: u32, light_radius: f64, pattern: Pattern) -> Option<Verdict> {
-        let p = find(summaries, DiskScheme::Paper, pattern, samples, light_radius)?;
-        let u = find(summaries, DiskScheme::Uniform, pattern, samples, light_radius)?;
+        let p = find(summaries, DiskScheme::Paper, pattern, samples, light_radius, 1)?;
+        let u = find(summaries, DiskScheme::Uniform, pattern, samples, light_radius, 1)?;
         let cmp = |m: &str| Compare {
             a: (p.mean(m), p.ci(m)),
             b: (u.mean(m), u.ci(m)),

@@ -2,7 +2,7 @@
 //! the manifest last.
 
 use super::files::{write_atomic, write_csv};
-use super::images::{diverging, grey, tonemap, write_exr, write_png, Rgb};
+use super::images::{diverging, grey, tonemap, write_exr, Rgb};
 use super::markdown::{report, verdict_radius};
 use super::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
 use super::summary::{self, Summary};
@@ -55,6 +55,7 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
 
 fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
     let header = [
+        "lights",
         "light_radius",
         "ground_truth_samples",
         "exact_umbra_radius",
@@ -70,51 +71,62 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
         "gt_bias_penumbra",
         "penumbra_pixels",
     ];
+    let nan2 = (f64::NAN, f64::NAN);
     let rows = r.outcome.references.iter().map(|x| {
         let (ru, rp) = x
             .on_axis
             .as_ref()
-            .map_or((f64::NAN, f64::NAN), |o| (o.umbra_radius(), o.penumbra_radius()));
-        let (ei, eo) = x.exact_profile.extent();
-        let (gi, go) = x.gt_profile.extent();
+            .map_or(nan2, |o| (o.umbra_radius(), o.penumbra_radius()));
+        let (ei, eo) = x.exact_profile.as_ref().map_or(nan2, |p| p.extent());
+        let (gi, go) = x.gt_profile.as_ref().map_or(nan2, |p| p.extent());
         vec![
+            x.lights.to_string(),
             num(x.light_radius),
             r.spec.ground_truth.samples.to_string(),
             num(ru),
             num(rp),
             num(ei),
             num(eo),
-            num(x.exact_profile.width_10_90()),
+            num(x.exact_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90())),
             num(gi),
             num(go),
-            num(x.gt_profile.width_10_90()),
-            num(x.gt_max_abs_all),
-            num(x.gt_vs_exact.rmse),
-            num(x.gt_vs_exact.bias),
+            num(x.gt_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90())),
+            num(x.gt_max_abs_all.unwrap_or(f64::NAN)),
+            num(x.gt_vs_exact.map_or(f64::NAN, |e| e.rmse)),
+            num(x.gt_vs_exact.map_or(f64::NAN, |e| e.bias)),
             x.mask.pixels.len().to_string(),
         ]
     });
     write_csv(&out.join("ground_truth.csv"), &header, rows)
 }
 
+/// Which summaries a plot shows.
+#[derive(Clone, Copy)]
+struct Filter {
+    radius: Option<f64>,
+    samples: Option<u32>,
+    lights: u32,
+}
+
 /// Series of one metric against a per-summary x, per scheme (per-pixel solid, shared dashed).
 fn series(
     summaries: &[Summary],
-    radius: Option<f64>,
-    samples: Option<u32>,
+    f: Filter,
     x: impl Fn(&Summary) -> f64,
     metric: &str,
+    scale: f64,
 ) -> Vec<(usize, Series)> {
     let mut out = Vec::new();
     for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
         for pattern in Pattern::ALL {
             let mut pts: Vec<(f64, f64, f64)> = summaries
                 .iter()
-                .filter(|s| s.run.scheme == *scheme && s.run.pattern == pattern)
+                .filter(|s| s.run.scheme == *scheme && s.run.pattern == pattern && s.run.lights == f.lights)
                 .filter(|s| {
-                    radius.is_none_or(|r| s.run.light_radius == r) && samples.is_none_or(|n| s.run.samples == n)
+                    f.radius.is_none_or(|r| s.run.light_radius == r) && f.samples.is_none_or(|n| s.run.samples == n)
                 })
-                .map(|s| (x(s), s.mean(metric), s.ci(metric)))
+                .map(|s| (x(s), s.mean(metric) * scale, s.ci(metric) * scale))
+                .filter(|p| p.1.is_finite())
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             if !pts.is_empty() {
@@ -134,68 +146,34 @@ fn series(
 
 fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result<()> {
     let spec = r.spec;
+    for &lights in &spec.axes.light_counts {
+        let suffix = if spec.axes.light_counts.len() > 1 {
+            format!("_{lights}lights")
+        } else {
+            String::new()
+        };
+        plots_for(r, summaries, dir, lights, &suffix)?;
+    }
+    Ok(())
+}
+
+fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix: &str) -> anyhow::Result<()> {
+    use plotters::chart::SeriesLabelPosition::{LowerLeft, LowerRight};
+    let spec = r.spec;
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
+    let at_radius = Filter {
+        radius: Some(radius),
+        samples: None,
+        lights,
+    };
     let samples = |s: &Summary| s.run.samples as f64;
-    let (lo, hi) = (
-        *spec.axes.samples.iter().min().unwrap_or(&1) as f64,
-        *spec.axes.samples.iter().max().unwrap_or(&1) as f64,
-    );
-    let reference = r.outcome.references.iter().find(|x| x.light_radius == radius);
-    let exact_lines = |which: &str| -> Vec<RefLine> {
-        reference
-            .map(|x| {
-                let (a, b) = x.exact_profile.extent();
-                let y = if which == "extent" {
-                    b - a
-                } else {
-                    x.exact_profile.width_10_90()
-                };
-                vec![RefLine {
-                    name: format!("exact ({which})"),
-                    points: vec![(lo, y * 1e3), (hi, y * 1e3)],
-                }]
-            })
-            .unwrap_or_default()
-    };
-    let to_mm = |mut s: Vec<(usize, Series)>| {
-        for (_, x) in &mut s {
-            for p in &mut x.points {
-                p.1 *= 1e3;
-                p.2 *= 1e3;
-            }
-        }
-        s
-    };
-    let title = |what: &str| format!("{what}, light radius {radius} m");
+    let file = |name: &str| dir.join(format!("{name}{suffix}.png"));
+    let title = |what: &str| format!("{what}, light radius {radius} m, {lights} light(s)");
     line_plot(
-        &dir.join("width_vs_samples.png"),
-        &Axes::new(
-            &title("Visible penumbra extent"),
-            "shadow rays per pixel",
-            "extent width (mm)",
-            true,
-            false,
-        ),
-        &to_mm(series(summaries, Some(radius), None, samples, "extent_width")),
-        &exact_lines("extent"),
-    )?;
-    line_plot(
-        &dir.join("width_10_90_vs_samples.png"),
-        &Axes::new(
-            &title("10-90 % width of the mean radial profile"),
-            "shadow rays per pixel",
-            "10-90 % width (mm)",
-            true,
-            false,
-        ),
-        &to_mm(series(summaries, Some(radius), None, samples, "width_10_90")),
-        &exact_lines("10-90"),
-    )?;
-    line_plot(
-        &dir.join("rmse_vs_samples.png"),
+        &file("rmse_vs_samples"),
         &Axes {
-            legend: plotters::chart::SeriesLabelPosition::LowerLeft,
+            legend: LowerLeft,
             ..Axes::new(
                 &title("RMSE vs ground truth over the penumbra"),
                 "shadow rays per pixel",
@@ -204,13 +182,13 @@ fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result
                 true,
             )
         },
-        &series(summaries, Some(radius), None, samples, "rmse"),
+        &series(summaries, at_radius, samples, "rmse", 1.0),
         &[],
     )?;
     line_plot(
-        &dir.join("rmse_vs_time.png"),
+        &file("rmse_vs_time"),
         &Axes {
-            legend: plotters::chart::SeriesLabelPosition::LowerLeft,
+            legend: LowerLeft,
             ..Axes::new(
                 &title("What accuracy costs: RMSE vs frame time"),
                 "median frame time (ms)",
@@ -219,24 +197,70 @@ fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result
                 true,
             )
         },
-        &series(summaries, Some(radius), None, |s| s.mean("frame_ms"), "rmse"),
+        &series(summaries, at_radius, |s| s.mean("frame_ms"), "rmse", 1.0),
         &[],
     )?;
-    let radii_mm = |s: &Summary| s.run.light_radius * 1e3;
+    let Some((ri, reference)) = r
+        .outcome
+        .references
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.light_radius == radius && x.lights == lights)
+    else {
+        return Ok(());
+    };
+    let Some(exact) = &reference.exact_profile else {
+        return Ok(());
+    };
+    let (lo, hi) = (
+        *spec.axes.samples.iter().min().unwrap_or(&1) as f64,
+        *spec.axes.samples.iter().max().unwrap_or(&1) as f64,
+    );
+    let flat = |name: &str, y: f64| {
+        vec![RefLine {
+            name: name.into(),
+            points: vec![(lo, y * 1e3), (hi, y * 1e3)],
+        }]
+    };
+    let (a, b) = exact.extent();
+    line_plot(
+        &file("width_vs_samples"),
+        &Axes::new(
+            &title("Visible penumbra extent"),
+            "shadow rays per pixel",
+            "extent width (mm)",
+            true,
+            false,
+        ),
+        &series(summaries, at_radius, samples, "extent_width", 1e3),
+        &flat("exact extent", b - a),
+    )?;
+    line_plot(
+        &file("width_10_90_vs_samples"),
+        &Axes::new(
+            &title("10-90 % width of the mean radial profile"),
+            "shadow rays per pixel",
+            "10-90 % width (mm)",
+            true,
+            false,
+        ),
+        &series(summaries, at_radius, samples, "width_10_90", 1e3),
+        &flat("exact 10-90 %", exact.width_10_90()),
+    )?;
     let mut exact_vs_radius: Vec<(f64, f64)> = r
         .outcome
         .references
         .iter()
-        .map(|x| {
-            (x.light_radius * 1e3, {
-                let (a, b) = x.exact_profile.extent();
-                (b - a) * 1e3
-            })
+        .filter(|x| x.lights == lights)
+        .filter_map(|x| {
+            x.exact_profile
+                .as_ref()
+                .map(|p| (x.light_radius * 1e3, (p.extent().1 - p.extent().0) * 1e3))
         })
         .collect();
     exact_vs_radius.sort_by(|a, b| a.0.total_cmp(&b.0));
     line_plot(
-        &dir.join("width_vs_radius.png"),
+        &file("width_vs_radius"),
         &Axes::new(
             &format!("Visible penumbra extent at {n} rays"),
             "light radius (mm)",
@@ -244,72 +268,73 @@ fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result
             false,
             false,
         ),
-        &to_mm(series(summaries, None, Some(n), radii_mm, "extent_width")),
+        &series(
+            summaries,
+            Filter {
+                radius: None,
+                samples: Some(n),
+                lights,
+            },
+            |s| s.run.light_radius * 1e3,
+            "extent_width",
+            1e3,
+        ),
         &[RefLine {
             name: "exact".into(),
             points: exact_vs_radius,
         }],
     )?;
-    if let Some((ri, reference)) = r
-        .outcome
-        .references
-        .iter()
-        .enumerate()
-        .find(|(_, x)| x.light_radius == radius)
-    {
-        let mut profiles = Vec::new();
-        for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
-            for pattern in Pattern::ALL {
-                if let Some(p) = r.outcome.profiles.get(&(*scheme, pattern, ri)) {
-                    let points = p
-                        .radius
-                        .iter()
-                        .zip(&p.mean)
-                        .map(|(x, y)| (x * 1e3, *y, f64::NAN))
-                        .collect();
-                    profiles.push((
-                        ci,
-                        Series {
-                            name: format!("{scheme} ({pattern})"),
-                            points,
-                            dashed: pattern == Pattern::Shared,
-                        },
-                    ));
-                }
+    let mut profiles = Vec::new();
+    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+        for pattern in Pattern::ALL {
+            if let Some(p) = r.outcome.profiles.get(&(*scheme, pattern, ri)) {
+                let points = p
+                    .radius
+                    .iter()
+                    .zip(&p.mean)
+                    .map(|(x, y)| (x * 1e3, *y, f64::NAN))
+                    .collect();
+                profiles.push((
+                    ci,
+                    Series {
+                        name: format!("{scheme} ({pattern})"),
+                        points,
+                        dashed: pattern == Pattern::Shared,
+                    },
+                ));
             }
         }
-        let e = &reference.exact_profile;
-        let exact = RefLine {
-            name: "exact".into(),
-            points: e
-                .radius
-                .iter()
-                .zip(&e.mean)
-                .map(|(x, y)| (x * 1e3, *y))
-                .filter(|p| p.1.is_finite())
-                .collect(),
-        };
-        line_plot(
-            &dir.join("profiles.png"),
-            &Axes {
-                x_range: reference.on_axis.as_ref().map(|o| {
-                    let (ru, rp) = (o.umbra_radius().max(0.0) * 1e3, o.penumbra_radius() * 1e3);
-                    (ru - 0.4 * (rp - ru), rp + 0.4 * (rp - ru))
-                }),
-                legend: plotters::chart::SeriesLabelPosition::LowerRight,
-                ..Axes::new(
-                    &format!("Radial profile at {n} rays (mean over seeds), light radius {radius} m"),
-                    "distance from shadow centre (mm)",
-                    "visibility",
-                    false,
-                    false,
-                )
-            },
-            &profiles,
-            &[exact],
-        )?;
     }
-    Ok(())
+    let exact_line = RefLine {
+        name: "exact".into(),
+        points: exact
+            .radius
+            .iter()
+            .zip(&exact.mean)
+            .map(|(x, y)| (x * 1e3, *y))
+            .filter(|p| p.1.is_finite())
+            .collect(),
+    };
+    let x_range = reference.on_axis.as_ref().map(|o| {
+        let (ru, rp) = (o.umbra_radius().max(0.0) * 1e3, o.penumbra_radius() * 1e3);
+        (ru - 0.4 * (rp - ru), rp + 0.4 * (rp - ru))
+    });
+    line_plot(
+        &file("profiles"),
+        &Axes {
+            x_range,
+            legend: LowerRight,
+            ..Axes::new(
+                &title(&format!("Radial profile at {n} rays (mean over seeds)")),
+                "distance from shadow centre (mm)",
+                "visibility",
+                false,
+                false,
+            )
+        },
+        &profiles,
+        &[exact_line],
+    )
 }
 
 fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
@@ -317,16 +342,16 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
     let (w, h) = (spec.measure.width, spec.measure.height);
+    let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
     if let Some((ri, reference)) = r
         .outcome
         .references
         .iter()
         .enumerate()
-        .find(|(_, x)| x.light_radius == radius)
+        .find(|(_, x)| x.light_radius == radius && x.lights == lights)
     {
         let gt = &reference.ground_truth;
         write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
-        write_exr(&dir.join("exact.exr"), &reference.exact, w, h)?;
         let mut tiles: Vec<(String, Rgb)> = Vec::new();
         let mut errors: Vec<(String, Rgb)> = Vec::new();
         for (scheme, pattern) in [
@@ -348,11 +373,11 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
             format!("ground truth, {} rays", spec.ground_truth.samples),
             grey(gt, w, h),
         ));
-        tiles.push(("exact".into(), grey(&reference.exact, w, h)));
-        errors.push((
-            "ground truth - exact (x100)".into(),
-            diverging(gt, &reference.exact, 0.005, w, h),
-        ));
+        if let Some(exact) = &reference.exact {
+            write_exr(&dir.join("exact.exr"), exact, w, h)?;
+            tiles.push(("exact".into(), grey(exact, w, h)));
+            errors.push(("ground truth - exact (x100)".into(), diverging(gt, exact, 0.005, w, h)));
+        }
         let columns = tiles.len().max(errors.len());
         let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
         image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
@@ -365,12 +390,6 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
             .collect();
         let refs: Vec<(String, &Rgb)> = tiles.iter().map(|(l, i)| (l.clone(), i)).collect();
         image_grid(&dir.join("fig2_picture.png"), &refs, 2)?;
-        for (i, (_, f)) in r.pictures.iter().enumerate() {
-            write_png(
-                &dir.join(format!("picture_{i}.png")),
-                &tonemap(&f.radiance, f.width, f.height),
-            )?;
-        }
     }
     Ok(())
 }

@@ -18,6 +18,40 @@ pub struct SceneFile {
     /// Light sources.
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// Triangle meshes from OBJ files.
+    #[serde(default)]
+    pub meshes: Vec<MeshDesc>,
+    /// obvhs build preset of the meshes' BVH.
+    #[serde(default)]
+    pub bvh_preset: crate::accel::Preset,
+}
+
+/// A mesh as written: an OBJ file (relative to the scene file), some of its groups, and a
+/// transform applied as scale, then rotations about x, y, z (degrees), then translation.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    /// OBJ file.
+    pub path: std::path::PathBuf,
+    /// Groups to keep (`g` names); all when empty.
+    #[serde(default)]
+    pub groups: Vec<String>,
+    /// Uniform scale (file units to metres).
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Rotation about x, y, z in degrees, applied in that order.
+    #[serde(default)]
+    pub rotate: [f64; 3],
+    /// Translation in metres.
+    #[serde(default)]
+    pub translate: [f64; 3],
+    /// Lambertian albedo in [0, 1].
+    #[serde(default = "default_albedo")]
+    pub albedo: f64,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// A camera as written.

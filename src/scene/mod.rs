@@ -6,13 +6,16 @@
 pub mod camera;
 pub mod description;
 
+use crate::accel::{Bvh, Preset};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
+use crate::mesh::{clean, obj, Skipped, Triangles};
 use camera::{Camera, Projection};
 use description::{LightDesc, ProjectionDesc, SceneFile};
-use glam::DVec3;
+use glam::{DMat4, DQuat, DVec3};
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// An analytic sphere.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,8 +93,21 @@ impl Light {
     }
 }
 
-/// A validated scene.
+/// A mesh of the scene (its triangles live in the scene's [`Bvh`]).
 #[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Where it came from, for messages.
+    pub source: String,
+    /// Lambertian albedo.
+    pub albedo: f64,
+    /// Triangles kept.
+    pub triangles: usize,
+    /// Triangles dropped as unhittable.
+    pub skipped: Skipped,
+}
+
+/// A validated scene.
+#[derive(Clone, Debug)]
 pub struct Scene {
     /// Cameras by name.
     pub cameras: BTreeMap<String, Camera>,
@@ -101,9 +117,55 @@ pub struct Scene {
     pub planes: Vec<Plane>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// Meshes; object ids follow the planes'.
+    pub meshes: Vec<Mesh>,
+    /// The BVH over every mesh triangle (None without meshes).
+    pub bvh: Option<Arc<Bvh>>,
+}
+
+impl std::fmt::Debug for Bvh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Bvh({} triangles, {} nodes, {})",
+            self.world.len(),
+            self.node_count(),
+            self.preset.name()
+        )
+    }
 }
 
 impl Scene {
+    /// A scene of analytic shapes and lights only.
+    pub fn analytic(spheres: Vec<Sphere>, planes: Vec<Plane>, lights: Vec<Light>) -> Scene {
+        Scene {
+            cameras: BTreeMap::new(),
+            spheres,
+            planes,
+            lights,
+            meshes: vec![],
+            bvh: None,
+        }
+    }
+
+    /// Sets the cameras.
+    pub fn with_cameras(mut self, cameras: BTreeMap<String, Camera>) -> Scene {
+        self.cameras = cameras;
+        self
+    }
+
+    /// Adds triangle meshes (world space) and builds their BVH with `preset`.
+    pub fn with_triangles(mut self, meshes: Vec<Mesh>, triangles: Triangles, preset: Preset) -> Scene {
+        self.bvh = (!triangles.positions.is_empty()).then(|| Arc::new(Bvh::build(&triangles, preset)));
+        self.meshes = meshes;
+        self
+    }
+
+    /// Object id of mesh `i` (after spheres and planes).
+    pub fn mesh_id(&self, i: usize) -> u32 {
+        (self.spheres.len() + self.planes.len() + i) as u32
+    }
+
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, ConfigError> {
         let source = Source::read(path)?;
@@ -191,17 +253,44 @@ impl Scene {
                 }),
             });
         }
-        Ok(Scene {
-            cameras,
-            spheres,
-            planes,
-            lights,
-        })
-    }
-
-    /// Number of objects that rays can hit.
-    pub fn object_count(&self) -> usize {
-        self.spheres.len() + self.planes.len()
+        let mut meshes = Vec::new();
+        let mut triangles = Triangles::default();
+        let dir = source.path.parent().unwrap_or(std::path::Path::new("."));
+        for (i, m) in file.meshes.iter().enumerate() {
+            let at = |k: &str| key_path!["meshes", i, k];
+            v.positive(m.scale, &at("scale"))?;
+            v.point(&m.rotate, &at("rotate"))?;
+            let translate = v.point(&m.translate, &at("translate"))?;
+            let albedo = v.albedo(m.albedo, &at("albedo"))?;
+            let path = dir.join(&m.path);
+            let raw = obj::load(&path)
+                .map_err(|e| source.error(&at("path"), e.to_string()))?
+                .select(&m.groups, &path)
+                .map_err(|e| source.error(&at("groups"), e.to_string()))?;
+            let [rx, ry, rz] = m.rotate.map(f64::to_radians);
+            let rotation = DQuat::from_rotation_z(rz) * DQuat::from_rotation_y(ry) * DQuat::from_rotation_x(rx);
+            let transform = DMat4::from_scale_rotation_translation(DVec3::splat(m.scale), rotation, translate);
+            let (kept, skipped) = clean(raw, &transform);
+            if skipped.degenerate + skipped.non_finite > 0 {
+                eprintln!(
+                    "warning: {}: skipped {} degenerate and {} non-finite triangles (they can never be hit)",
+                    path.display(),
+                    skipped.degenerate,
+                    skipped.non_finite
+                );
+            }
+            triangles.mesh_of.extend(std::iter::repeat_n(i as u32, kept.len()));
+            meshes.push(Mesh {
+                source: path.display().to_string(),
+                albedo,
+                triangles: kept.len(),
+                skipped,
+            });
+            triangles.positions.extend(kept);
+        }
+        Ok(Scene::analytic(spheres, planes, lights)
+            .with_cameras(cameras)
+            .with_triangles(meshes, triangles, file.bvh_preset))
     }
 
     /// Object id of plane `i` (ids are spheres first, then planes).
@@ -234,6 +323,14 @@ impl Scene {
         }
         for p in &mut out.planes {
             p.point = f(p.point);
+        }
+        if let Some(bvh) = &self.bvh {
+            let positions = bvh.world.iter().map(|t| t.map(&f)).collect();
+            let triangles = Triangles {
+                positions,
+                mesh_of: bvh.mesh_of.clone(),
+            };
+            out = out.with_triangles(self.meshes.clone(), triangles, bvh.preset);
         }
         for l in &mut out.lights {
             match l {

@@ -26,7 +26,32 @@ pub struct Params {
     pub cam_up: [f32; 3],
     pub half_y: f32,
     pub cam_forward: [f32; 3],
-    pub _pad: f32,
+    pub node_count: u32,
+    pub object_base: u32,
+    pub _pad: [u32; 3],
+}
+
+/// A BVH2 node: bounds, then the leaf's triangle count (0 for inner nodes) and the first child
+/// (inner) or first triangle (leaf). Children of an inner node are adjacent.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct GpuNode {
+    pub min: [f32; 3],
+    pub prim_count: u32,
+    pub max: [f32; 3],
+    pub first_index: u32,
+}
+
+/// A triangle as vertex + two edges in full f32, with its mesh, index and albedo.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+pub struct GpuTri {
+    pub v0: [f32; 3],
+    pub mesh: u32,
+    pub e1: [f32; 3],
+    pub index: u32,
+    pub e2: [f32; 3],
+    pub albedo: f32,
 }
 
 /// A sphere.
@@ -74,9 +99,11 @@ pub struct PassInfo {
 }
 
 /// Bytes per pixel of the hit buffer (WGSL `Hit`).
-pub const HIT_BYTES: u64 = 32;
+pub const HIT_BYTES: u64 = 48;
 
-const _: () = assert!(std::mem::size_of::<Params>() == 96);
+const _: () = assert!(std::mem::size_of::<Params>() == 112);
+const _: () = assert!(std::mem::size_of::<GpuNode>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuTri>() == 48);
 const _: () = assert!(std::mem::size_of::<GpuSphere>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuPlane>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 80);
@@ -138,6 +165,14 @@ pub struct Packed {
     pub planes: Vec<GpuPlane>,
     pub lights: Vec<GpuLight>,
     pub shared: Vec<[f32; 2]>,
+    pub nodes: Vec<GpuNode>,
+    pub triangles: Vec<GpuTri>,
+}
+
+/// The local frame of a render: (origin, scale) with world = origin + scale * local.
+pub fn local_frame(scene: &Scene, view: View) -> (DVec3, f64) {
+    let l = Local::new(scene, view);
+    (l.origin, l.scale)
 }
 
 /// Packs a scene, view and sampling choice into GPU structs.
@@ -166,7 +201,9 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
         cam_up: dir(frame.up),
         half_y: hy as f32,
         cam_forward: dir(frame.forward),
-        _pad: 0.0,
+        node_count: scene.bvh.as_ref().map_or(0, |b| b.node_count() as u32),
+        object_base: (scene.spheres.len() + scene.planes.len()) as u32,
+        _pad: [0; 3],
     };
     let spheres = scene
         .spheres
@@ -230,11 +267,62 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> Packed {
             }
         });
     }
+    let (nodes, triangles) = scene
+        .bvh
+        .as_ref()
+        .map_or((vec![], vec![]), |b| pack_bvh(scene, b, &local));
     Packed {
         params,
         spheres,
         planes,
         lights,
         shared,
+        nodes,
+        triangles,
     }
+}
+
+/// The BVH in the frame's local coordinates: node bounds converted through f64 and widened by
+/// a few f32 ulps so that no triangle pokes out of its node after rounding; triangles laid out
+/// in leaf order (obvhs' `primitive_indices`), so leaves index them directly.
+fn pack_bvh(scene: &Scene, bvh: &crate::accel::Bvh, local: &Local) -> (Vec<GpuNode>, Vec<GpuTri>) {
+    let to_local = |p: glam::Vec3A| (glam::Vec3::from(p).as_dvec3() + bvh.centre - local.origin) / local.scale;
+    let nodes = bvh
+        .tree
+        .nodes
+        .iter()
+        .map(|n| {
+            let (lo, hi) = (to_local(n.aabb.min), to_local(n.aabb.max));
+            let size = (hi - lo)
+                .max_element()
+                .max(lo.abs().max_element())
+                .max(hi.abs().max_element());
+            let pad = size * 4.0 * f32::EPSILON as f64;
+            GpuNode {
+                min: (lo - pad).as_vec3().to_array(),
+                prim_count: n.prim_count,
+                max: (hi + pad).as_vec3().to_array(),
+                first_index: n.first_index,
+            }
+        })
+        .collect();
+    let triangles = bvh
+        .tree
+        .primitive_indices
+        .iter()
+        .map(|&i| {
+            let t = &bvh.world[i as usize];
+            let mesh = bvh.mesh_of[i as usize];
+            let p = t.map(|c| (c - local.origin) / local.scale);
+            GpuTri {
+                v0: p[0].as_vec3().to_array(),
+                mesh,
+                e1: (p[1] - p[0]).as_vec3().to_array(),
+                index: i,
+                e2: (p[2] - p[0]).as_vec3().to_array(),
+                albedo: scene.meshes[mesh as usize].albedo as f32,
+            }
+        })
+        .collect();
+    (nodes, triangles)
 }

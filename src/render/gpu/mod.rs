@@ -24,6 +24,7 @@ pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 const SHADER: &str = concat!(
     include_str!("shaders/sampling.wgsl"),
     include_str!("shaders/geometry.wgsl"),
+    include_str!("shaders/bvh.wgsl"),
     include_str!("shaders/render.wgsl"),
 );
 
@@ -43,6 +44,7 @@ pub struct GpuBackend {
     primary: wgpu::ComputePipeline,
     shadow: wgpu::ComputePipeline,
     dump: wgpu::ComputePipeline,
+    probe: wgpu::ComputePipeline,
 }
 
 /// Per-frame GPU resources.
@@ -122,6 +124,7 @@ impl GpuBackend {
         let mut entries = vec![uniform(0)];
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
+        entries.extend((9..=11).map(|b| storage(b, true)));
         let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &entries,
@@ -145,7 +148,12 @@ impl GpuBackend {
                 cache: None,
             })
         };
-        let (primary, shadow, dump) = (pipeline("primary"), pipeline("shadow"), pipeline("dump_samples"));
+        let (primary, shadow, dump, probe) = (
+            pipeline("primary"),
+            pipeline("shadow"),
+            pipeline("dump_samples"),
+            pipeline("trace_probes"),
+        );
         let info = AdapterInfo {
             backend: "gpu".into(),
             name: ai.name.clone(),
@@ -163,6 +171,7 @@ impl GpuBackend {
             primary,
             shadow,
             dump,
+            probe,
         })
     }
 
@@ -191,7 +200,14 @@ impl GpuBackend {
         })
     }
 
-    fn check_limits(&self, view: View, lights: usize) -> anyhow::Result<()> {
+    fn check_limits(&self, scene: &crate::scene::Scene, view: View) -> anyhow::Result<()> {
+        let lights = scene.lights.len();
+        if let Some(b) = scene.bvh.as_ref().filter(|b| b.depth > 2 * 31) {
+            bail!(
+                "the BVH is {} levels deep; the GPU traversal stack holds 64 entries (depth 62 at most)",
+                b.depth
+            );
+        }
         let limits = self.device.limits();
         let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         for (what, bytes) in [
@@ -210,7 +226,7 @@ impl GpuBackend {
         Ok(())
     }
 
-    fn resources(&self, packed: &Packed, view: View) -> FrameResources {
+    fn resources(&self, packed: &Packed, view: View, probes: &[[f32; 4]]) -> FrameResources {
         let params = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
             contents: bytemuck::bytes_of(&packed.params),
@@ -222,7 +238,13 @@ impl GpuBackend {
         let shared = self.storage("shared points", &packed.shared, [0f32; 2]);
         let pixels = view.pixels() as u64;
         let hits = self.output("hits", pixels * HIT_BYTES);
-        let visibility = self.output("visibility", pixels * packed.lights.len().max(1) as u64 * 4);
+        let visibility = self.output(
+            "visibility",
+            (pixels * packed.lights.len().max(1) as u64).max(3 * (probes.len() / 2) as u64) * 4,
+        );
+        let nodes = self.storage("bvh nodes", &packed.nodes, bytemuck::Zeroable::zeroed());
+        let triangles = self.storage("triangles", &packed.triangles, bytemuck::Zeroable::zeroed());
+        let probe_rays = self.storage("probe rays", probes, [0f32; 4]);
         let radiance = self.output("radiance", pixels * 4);
         let counters = self.output("ray counters", (MAX_LIGHTS * 2 * 4) as u64);
         let buffers = [
@@ -235,6 +257,9 @@ impl GpuBackend {
             &visibility,
             &radiance,
             &counters,
+            &nodes,
+            &triangles,
+            &probe_rays,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -363,7 +388,8 @@ impl GpuBackend {
         Ok(bytes)
     }
 
-    fn frame_seconds(&self, r: &FrameResources) -> anyhow::Result<Option<f64>> {
+    /// (whole frame, primary pass) seconds from the timestamps around each pass.
+    fn frame_seconds(&self, r: &FrameResources) -> anyhow::Result<Option<(f64, f64)>> {
         let Some((set, resolve)) = &r.queries else {
             return Ok(None);
         };
@@ -373,18 +399,14 @@ impl GpuBackend {
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(resolve, resolve.size())?);
         let (first, last) = (ticks[0], ticks[ticks.len() - 1]);
         let period = self.queue.get_timestamp_period() as f64;
-        Ok(Some(last.saturating_sub(first) as f64 * period * 1e-9))
+        let seconds = |a: u64, b: u64| b.saturating_sub(a) as f64 * period * 1e-9;
+        Ok(Some((seconds(first, last), seconds(ticks[0], ticks[1]))))
     }
 
     /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
     /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
     pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
-        let scene = crate::scene::Scene {
-            cameras: Default::default(),
-            spheres: vec![],
-            planes: vec![],
-            lights: vec![],
-        };
+        let scene = crate::scene::Scene::analytic(vec![], vec![], vec![]);
         let cam = dummy_camera();
         let view = View {
             camera: &cam,
@@ -408,6 +430,7 @@ impl GpuBackend {
                 width: n,
                 height: 2,
             },
+            &[],
         );
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -432,6 +455,19 @@ fn set_count(resolve: &wgpu::Buffer) -> u32 {
     (resolve.size() / 8) as u32
 }
 
+/// A probe ray for [`GpuBackend::probe`]: origin, unit direction, farthest distance.
+pub type ProbeRay = (glam::DVec3, glam::DVec3, f64);
+
+/// What the GPU found along a probe ray: closest distance and triangle (if any), and whether the
+/// any-hit query reported a hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeHit {
+    /// Closest hit (distance, triangle index).
+    pub closest: Option<(f64, u32)>,
+    /// Any-hit result.
+    pub any: bool,
+}
+
 fn dummy_camera() -> crate::scene::camera::Camera {
     use glam::DVec3;
     crate::scene::camera::Camera {
@@ -442,6 +478,63 @@ fn dummy_camera() -> crate::scene::camera::Camera {
     }
 }
 
+impl GpuBackend {
+    /// Traces `rays` against the scene's mesh BVH with the WGSL closest-hit and any-hit
+    /// traversals, in the same local frame as a render: lets tests compare the GPU's traversal
+    /// with obvhs' and with brute force.
+    pub fn probe(&mut self, scene: &crate::scene::Scene, rays: &[ProbeRay]) -> anyhow::Result<Vec<ProbeHit>> {
+        let cam = scene.cameras.values().next().cloned().unwrap_or_else(dummy_camera);
+        let view = View {
+            camera: &cam,
+            width: rays.len() as u32,
+            height: 1,
+        };
+        let mut packed = pack(
+            scene,
+            view,
+            Sampling {
+                scheme: DiskScheme::Uniform,
+                pattern: crate::sampling::Pattern::PerPixel,
+                seed: 0,
+            },
+        );
+        packed.params.width = rays.len() as u32;
+        let (origin, scale) = layout::local_frame(scene, view);
+        let probes: Vec<[f32; 4]> = rays
+            .iter()
+            .flat_map(|(o, d, tmax)| {
+                let lo = ((*o - origin) / scale).as_vec3();
+                [
+                    [lo.x, lo.y, lo.z, (tmax / scale).min(f32::MAX as f64) as f32],
+                    [d.x as f32, d.y as f32, d.z as f32, 0.0],
+                ]
+            })
+            .collect();
+        let r = self.resources(&packed, view, &probes);
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: None,
+                timestamp_writes: None,
+            });
+            cp.set_pipeline(&self.probe);
+            cp.set_bind_group(0, &r.bind0, &[]);
+            cp.set_bind_group(1, &r.passes[0], &[]);
+            cp.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
+        }
+        self.submit(encoder, scope)?;
+        let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
+        Ok(raw
+            .chunks(3)
+            .map(|c| ProbeHit {
+                closest: (c[0] >= 0.0).then(|| (c[0] as f64 * scale, c[1].to_bits())),
+                any: c[2] > 0.0,
+            })
+            .collect())
+    }
+}
+
 impl Backend for GpuBackend {
     fn adapter(&self) -> &AdapterInfo {
         &self.info
@@ -449,10 +542,10 @@ impl Backend for GpuBackend {
 
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         RenderPlan::new(scene, view)?;
-        self.check_limits(view, scene.lights.len())?;
+        self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view);
+        let r = self.resources(&packed, view, &[]);
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.encode(&mut encoder, &r, view, lights);
@@ -478,7 +571,7 @@ impl Backend for GpuBackend {
             height: view.height,
             radiance,
             visibility: vis.chunks(pixels.max(1)).map(<[f32]>::to_vec).collect(),
-            hit: hits.chunks(8).map(|h| h[3]).collect(),
+            hit: hits.chunks((HIT_BYTES / 4) as usize).map(|h| h[3]).collect(),
             rays,
         })
     }
@@ -492,11 +585,11 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         RenderPlan::new(scene, view)?;
-        self.check_limits(view, scene.lights.len())?;
+        self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view);
-        let mut seconds = Vec::new();
+        let r = self.resources(&packed, view, &[]);
+        let (mut seconds, mut primary_seconds) = (Vec::new(), Vec::new());
         for i in 0..warmup + repeats {
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -504,13 +597,15 @@ impl Backend for GpuBackend {
             let start = Instant::now();
             self.submit(encoder, scope)?;
             let wall = start.elapsed().as_secs_f64();
-            let t = self.frame_seconds(&r)?.unwrap_or(wall);
+            let passes = self.frame_seconds(&r)?;
             if i >= warmup {
-                seconds.push(t);
+                seconds.push(passes.map_or(wall, |p| p.0));
+                primary_seconds.extend(passes.map(|p| p.1));
             }
         }
         Ok(Timing {
             seconds,
+            primary_seconds,
             clock: if self.timestamps {
                 Clock::GpuTimestamp
             } else {

@@ -18,7 +18,11 @@ struct Params {
     cam_up: vec3<f32>,
     half_y: f32,
     cam_forward: vec3<f32>,
-    _pad: f32,
+    node_count: u32,
+    object_base: u32,
+    _q0: u32,
+    _q1: u32,
+    _q2: u32,
 }
 
 struct Sphere {
@@ -57,6 +61,10 @@ struct Hit {
     object: u32,
     normal: vec3<f32>,
     albedo: f32,
+    triangle: u32,
+    _h0: u32,
+    _h1: u32,
+    _h2: u32,
 }
 
 struct PassInfo {
@@ -88,9 +96,9 @@ fn plane_t(origin: vec3<f32>, dir: vec3<f32>, pl: Plane) -> f32 {
     return dot(pl.point - origin, pl.normal) / denom;
 }
 
-// Any-hit along origin -> origin + d, skipping object `skip` (the convex receiver itself:
-// see shading::occluded for why no origin offset is used for spheres and planes).
-fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32) -> bool {
+// Any-hit along origin -> origin + d, skipping the receiver's own sphere or plane (`skip`) or
+// triangle (`skip_tri`); see shading::Receiver for why.
+fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
     let len = length(d);
     let dir = d / len;
     for (var i = 0u; i < params.sphere_count; i++) {
@@ -105,7 +113,7 @@ fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32) -> bool {
             return true;
         }
     }
-    return false;
+    return bvh_any(origin, dir, len, skip_tri);
 }
 
 @compute @workgroup_size(8, 8)
@@ -140,10 +148,25 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
             best = params.sphere_count + i;
         }
     }
+    let mesh_hit = bvh_closest(origin, dir, best_t, NO_HIT);
+    if (mesh_hit.slot != NO_HIT) {
+        best_t = mesh_hit.t;
+        best = params.object_base + tris[mesh_hit.slot].mesh;
+    }
     radiance[pixel] = 0.0;
     var hit: Hit;
     hit.object = best;
-    if (best != NO_HIT) {
+    hit.triangle = NO_HIT;
+    if (mesh_hit.slot != NO_HIT) {
+        let tri = tris[mesh_hit.slot];
+        hit.position = origin + best_t * dir;
+        hit.normal = normalize(cross(tri.e1, tri.e2));
+        hit.albedo = tri.albedo;
+        hit.triangle = tri.index;
+        if (dot(hit.normal, dir) > 0.0) {
+            hit.normal = -hit.normal;
+        }
+    } else if (best != NO_HIT) {
         let raw = origin + best_t * dir;
         if (best < params.sphere_count) {
             let s = spheres[best];
@@ -190,6 +213,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     let light = lights[li];
     let p = hit.position;
     let n = hit.normal;
+    let origin = select(p, offset_origin(p, n), hit.triangle != NO_HIT);
     var vis = 0.0;
     var irradiance = 0.0;
     var rays = 0u;
@@ -197,7 +221,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
         let d = light.center - p;
         if (dot(n, d) > 0.0) {
             rays = 1u;
-            if (!occluded(p, d, hit.object)) {
+            if (!occluded(origin, light.center - origin, hit.object, hit.triangle)) {
                 vis = 1.0;
                 irradiance = light.power / (4.0 * PI) * dot(n, normalize(d)) / dot(d, d);
             }
@@ -222,7 +246,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                     continue;
                 }
                 rays += 1u;
-                if (!occluded(p, d, hit.object)) {
+                if (!occluded(origin, q - origin, hit.object, hit.triangle)) {
                     visible += 1u;
                     let d2 = dot(d, d);
                     sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
@@ -249,4 +273,28 @@ fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = disk_point(params.scheme, params.width, k, stream);
     visibility[2u * k] = s.x;
     visibility[2u * k + 1u] = s.y;
+}
+
+// Test hook: closest and any hit of probe rays against the mesh BVH. Ray k is
+// probe_rays[2k] = (origin, tmax) and probe_rays[2k + 1] = (direction, 0); writes
+// visibility[3k..3k+3] = (t, triangle index as bits, any-hit flag).
+@group(0) @binding(11) var<storage, read> probe_rays: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn trace_probes(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let k = gid.x;
+    if (k >= params.width) {
+        return;
+    }
+    let o = probe_rays[2u * k].xyz;
+    let tmax = probe_rays[2u * k].w;
+    let d = probe_rays[2u * k + 1u].xyz;
+    let h = bvh_closest(o, d, tmax, NO_HIT);
+    var index = NO_HIT;
+    if (h.slot != NO_HIT) {
+        index = tris[h.slot].index;
+    }
+    visibility[3u * k] = select(-1.0, h.t, h.slot != NO_HIT);
+    visibility[3u * k + 1u] = bitcast<f32>(index);
+    visibility[3u * k + 2u] = select(0.0, 1.0, bvh_any(o, d, tmax, NO_HIT));
 }

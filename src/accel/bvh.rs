@@ -1,0 +1,306 @@
+//! A BVH2 over a scene's triangles, built by obvhs (PLOC with parallel reinsertion), traversed
+//! by obvhs on the CPU and by `shaders/bvh.wgsl` on the GPU from the same node array.
+//!
+//! Triangles keep full f32 positions for the GPU and f64 for the CPU's intersection tests:
+//! obvhs' compressed triangle stores edges in f16, which would move shadow boundaries, so it is
+//! not used. The tree is built in coordinates relative to the triangles' bounding-box centre so
+//! its f32 bounds stay precise wherever the mesh is placed.
+
+use crate::mesh::Triangles;
+use glam::{DVec3, Vec3A};
+use obvhs::bvh2::builder::build_bvh2_from_tris;
+use obvhs::bvh2::Bvh2;
+use obvhs::ray::Ray;
+use obvhs::triangle::Triangle;
+use obvhs::BvhBuildParams;
+use serde::Deserialize;
+use std::time::{Duration, Instant};
+
+/// obvhs build presets, fastest build to best tree. `medium` is obvhs' recommended default;
+/// `slow` and `very-slow` add spatial pre-splits of large triangles (duplicated references).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// One triangle per leaf, no reinsertion.
+    Fastest,
+    /// Minimal search, light reinsertion.
+    VeryFast,
+    /// Low search distance.
+    Fast,
+    /// Medium search distance and reinsertion (obvhs' default).
+    #[default]
+    Medium,
+    /// High search distance, pre-splits.
+    Slow,
+    /// Full reinsertion, pre-splits.
+    VerySlow,
+}
+
+impl Preset {
+    fn params(self) -> BvhBuildParams {
+        match self {
+            Preset::Fastest => BvhBuildParams::fastest_build(),
+            Preset::VeryFast => BvhBuildParams::very_fast_build(),
+            Preset::Fast => BvhBuildParams::fast_build(),
+            Preset::Medium => BvhBuildParams::medium_build(),
+            Preset::Slow => BvhBuildParams::slow_build(),
+            Preset::VerySlow => BvhBuildParams::very_slow_build(),
+        }
+    }
+
+    /// Name as written in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Fastest => "fastest",
+            Preset::VeryFast => "very-fast",
+            Preset::Fast => "fast",
+            Preset::Medium => "medium",
+            Preset::Slow => "slow",
+            Preset::VerySlow => "very-slow",
+        }
+    }
+
+    /// Every preset.
+    pub const ALL: [Preset; 6] = [
+        Preset::Fastest,
+        Preset::VeryFast,
+        Preset::Fast,
+        Preset::Medium,
+        Preset::Slow,
+        Preset::VerySlow,
+    ];
+}
+
+/// A built BVH with its triangles.
+#[derive(Clone)]
+pub struct Bvh {
+    /// The obvhs tree (node bounds relative to `centre`).
+    pub tree: Bvh2,
+    /// Triangles in f32 relative to `centre`, in input order.
+    pub local: Vec<Triangle>,
+    /// Triangles in f64 world space, in input order.
+    pub world: Vec<[DVec3; 3]>,
+    /// Mesh index per triangle.
+    pub mesh_of: Vec<u32>,
+    /// Origin of the tree's coordinates.
+    pub centre: DVec3,
+    /// The preset used.
+    pub preset: Preset,
+    /// Wall-clock build time (the core PLOC build and reinsertion, as obvhs reports it).
+    pub build_time: Duration,
+    /// Wall-clock time including conversion and pre-splitting.
+    pub total_time: Duration,
+    /// Longest root-to-leaf path (the GPU traversal's stack holds 64 entries).
+    pub depth: usize,
+}
+
+/// A closest hit: distance along the (unit) ray and the triangle's index.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriHit {
+    /// Distance.
+    pub t: f64,
+    /// Triangle index (input order).
+    pub triangle: u32,
+}
+
+/// Möller-Trumbore ray-triangle intersection in f64; the distance, or None. Both sides hit.
+pub fn intersect(origin: DVec3, dir: DVec3, tri: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (tri[1] - tri[0], tri[2] - tri[0]);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - tri[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(e2.dot(q) * inv)
+}
+
+fn depth(tree: &Bvh2) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1usize)];
+    while let Some((i, d)) = stack.pop() {
+        let Some(n) = tree.nodes.get(i) else { continue };
+        deepest = deepest.max(d);
+        if n.prim_count == 0 {
+            stack.push((n.first_index as usize, d + 1));
+            stack.push((n.first_index as usize + 1, d + 1));
+        }
+    }
+    deepest
+}
+
+impl Bvh {
+    /// Builds the tree over `triangles` with `preset`.
+    pub fn build(triangles: &Triangles, preset: Preset) -> Bvh {
+        let start = Instant::now();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for t in triangles.positions.iter().flatten() {
+            lo = lo.min(*t);
+            hi = hi.max(*t);
+        }
+        let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
+        let f = |p: DVec3| Vec3A::from((p - centre).as_vec3());
+        let local: Vec<Triangle> = triangles
+            .positions
+            .iter()
+            .map(|t| Triangle {
+                v0: f(t[0]),
+                v1: f(t[1]),
+                v2: f(t[2]),
+            })
+            .collect();
+        let mut build_time = Duration::default();
+        let tree = build_bvh2_from_tris(&local, preset.params(), &mut build_time);
+        let depth = depth(&tree);
+        Bvh {
+            depth,
+            tree,
+            local,
+            world: triangles.positions.clone(),
+            mesh_of: triangles.mesh_of.clone(),
+            centre,
+            preset,
+            build_time,
+            total_time: start.elapsed(),
+        }
+    }
+
+    fn ray(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Ray {
+        // Conservative f32 extent: node culling must never drop a hit the f64 test would find.
+        Ray::new(
+            Vec3A::from((origin - self.centre).as_vec3()),
+            Vec3A::from(dir.as_vec3()),
+            0.0,
+            (tmax * (1.0 + 1e-6)) as f32,
+        )
+    }
+
+    /// Closest triangle hit with 0 < t < `tmax` along unit `dir`, skipping triangle `skip`.
+    pub fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        if self.world.is_empty() {
+            return None;
+        }
+        let mut best: Option<TriHit> = None;
+        let mut hit = obvhs::ray::RayHit::none();
+        self.tree.ray_traverse(self.ray(origin, dir, tmax), &mut hit, |_, i| {
+            let tri = self.tree.primitive_indices[i];
+            match intersect(origin, dir, &self.world[tri as usize]) {
+                Some(t) if tri != skip && t > 0.0 && t < tmax && best.is_none_or(|b| t < b.t) => {
+                    best = Some(TriHit { t, triangle: tri });
+                    t as f32
+                }
+                _ => f32::INFINITY,
+            }
+        });
+        best
+    }
+
+    /// Whether any triangle other than `skip` is hit with 0 < t < `tmax`; stops at the first.
+    pub fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        if self.world.is_empty() {
+            return false;
+        }
+        !self.tree.ray_traverse_miss(self.ray(origin, dir, tmax), |_, i| {
+            let tri = self.tree.primitive_indices[i];
+            match intersect(origin, dir, &self.world[tri as usize]) {
+                Some(t) if tri != skip && t > 0.0 && t < tmax => 0.0,
+                _ => f32::INFINITY,
+            }
+        })
+    }
+
+    /// Closest hit by testing every triangle: the brute-force reference for tests.
+    pub fn brute_force(&self, origin: DVec3, dir: DVec3) -> Option<TriHit> {
+        self.world
+            .iter()
+            .enumerate()
+            .filter_map(|(i, t)| {
+                intersect(origin, dir, t)
+                    .filter(|t| *t > 0.0)
+                    .map(|t| TriHit { t, triangle: i as u32 })
+            })
+            .min_by(|a, b| a.t.total_cmp(&b.t))
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.tree.nodes.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed box of 12 triangles with a pyramid on top, plus triangles with a corner at the
+    /// origin and edges on the axes (the cases obvhs' own comment flags as leaky).
+    fn triangles() -> Triangles {
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let mut positions = Vec::new();
+        let quads = [
+            [c(0., 0., 0.), c(1., 0., 0.), c(1., 1., 0.), c(0., 1., 0.)],
+            [c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
+            [c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
+            [c(0., 1., 0.), c(1., 1., 0.), c(1., 1., 1.), c(0., 1., 1.)],
+            [c(0., 0., 0.), c(0., 1., 0.), c(0., 1., 1.), c(0., 0., 1.)],
+            [c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
+        ];
+        for q in quads {
+            positions.push([q[0], q[1], q[2]]);
+            positions.push([q[0], q[2], q[3]]);
+        }
+        positions.push([c(0., 0., 1.), c(1., 0., 1.), c(0.5, 0.5, 2.)]);
+        let n = positions.len();
+        Triangles {
+            positions,
+            mesh_of: vec![0; n],
+        }
+    }
+
+    /// Every preset agrees with brute force on seeded random rays (same triangle, same t).
+    #[test]
+    fn every_preset_matches_brute_force() {
+        let tris = triangles();
+        for preset in Preset::ALL {
+            let bvh = Bvh::build(&tris, preset);
+            let mut rng = 0x1234_5678u32;
+            let mut next = || {
+                rng = crate::sampling::rng::pcg(rng);
+                crate::sampling::rng::to_unit(rng)
+            };
+            for _ in 0..4000 {
+                let o = DVec3::new(next() * 6.0 - 3.0, next() * 6.0 - 3.0, next() * 6.0 - 2.0);
+                let target = DVec3::new(next() * 1.4 - 0.2, next() * 1.4 - 0.2, next() * 2.4 - 0.2);
+                let d = (target - o).normalize();
+                let (a, b) = (bvh.closest(o, d, f64::INFINITY, u32::MAX), bvh.brute_force(o, d));
+                assert_eq!(a.map(|h| h.triangle), b.map(|h| h.triangle), "{preset:?} o={o} d={d}");
+                if let (Some(a), Some(b)) = (a, b) {
+                    assert!((a.t - b.t).abs() < 1e-12);
+                }
+                assert_eq!(bvh.any_hit(o, d, f64::INFINITY, u32::MAX), b.is_some());
+            }
+        }
+    }
+
+    #[test]
+    fn skip_and_tmax_are_honoured() {
+        let bvh = Bvh::build(&triangles(), Preset::Medium);
+        let (o, d) = (DVec3::new(0.3, 0.4, -1.0), DVec3::Z);
+        let first = bvh.closest(o, d, f64::INFINITY, u32::MAX).unwrap();
+        assert!((first.t - 1.0).abs() < 1e-12);
+        let second = bvh.closest(o, d, f64::INFINITY, first.triangle).unwrap();
+        assert!((second.t - 2.0).abs() < 1e-12);
+        assert!(!bvh.any_hit(o, d, 0.999, u32::MAX));
+        assert!(bvh.any_hit(o, d, 1.001, u32::MAX));
+    }
+}

@@ -1,0 +1,192 @@
+//! A Wavefront OBJ reader for triangle meshes: `v` positions, `f` faces (any of the `v`,
+//! `v/vt`, `v//vn`, `v/vt/vn` forms, negative indices relative to the end), `g`/`o` groups.
+//! Polygons are split into triangle fans. Everything else (normals, texture coordinates,
+//! materials) is ignored. Errors name the file and line.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// An OBJ file that could not be read, located.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjError {
+    /// The file.
+    pub file: PathBuf,
+    /// 1-based line, when the error is on a line.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ObjError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{l}: {}", self.file.display(), self.message),
+            None => write!(f, "{}: {}", self.file.display(), self.message),
+        }
+    }
+}
+
+impl std::error::Error for ObjError {}
+
+/// Triangles of an OBJ file, as vertex positions, with the group each came from.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjMesh {
+    /// Triangle corner positions, in file units.
+    pub triangles: Vec<[[f64; 3]; 3]>,
+    /// Group index per triangle (into `groups`).
+    pub group_of: Vec<u32>,
+    /// Group names in order of first appearance (faces before any `g` are in group `default`).
+    pub groups: Vec<String>,
+}
+
+/// Parses OBJ text; `file` is only used in errors.
+pub fn parse(text: &str, file: &Path) -> Result<ObjMesh, ObjError> {
+    let err = |line: usize, message: String| ObjError {
+        file: file.to_path_buf(),
+        line: Some(line),
+        message,
+    };
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut mesh = ObjMesh::default();
+    let mut group: Option<u32> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line_no = i + 1;
+        let line = raw.split('#').next().unwrap_or("").trim();
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let mut p = [0.0; 3];
+                for c in &mut p {
+                    let w = words
+                        .next()
+                        .ok_or_else(|| err(line_no, "vertex needs 3 coordinates".into()))?;
+                    *c = w
+                        .parse()
+                        .map_err(|_| err(line_no, format!("bad vertex coordinate `{w}`")))?;
+                }
+                positions.push(p);
+            }
+            Some("f") => {
+                let mut corners = Vec::new();
+                for w in words {
+                    let idx = w.split('/').next().unwrap_or("");
+                    let k: i64 = idx.parse().map_err(|_| err(line_no, format!("bad face index `{w}`")))?;
+                    let n = positions.len() as i64;
+                    let resolved = if k > 0 { k - 1 } else { n + k };
+                    if k == 0 || resolved < 0 || resolved >= n {
+                        return Err(err(
+                            line_no,
+                            format!("face index {k} refers to no vertex ({n} defined so far)"),
+                        ));
+                    }
+                    corners.push(positions[resolved as usize]);
+                }
+                if corners.len() < 3 {
+                    return Err(err(
+                        line_no,
+                        format!("a face needs at least 3 vertices, got {}", corners.len()),
+                    ));
+                }
+                let g = *group.get_or_insert_with(|| {
+                    mesh.groups.push("default".into());
+                    mesh.groups.len() as u32 - 1
+                });
+                for k in 1..corners.len() - 1 {
+                    mesh.triangles.push([corners[0], corners[k], corners[k + 1]]);
+                    mesh.group_of.push(g);
+                }
+            }
+            Some("g") | Some("o") => {
+                let name = words.collect::<Vec<_>>().join(" ");
+                let name = if name.is_empty() { "default".to_string() } else { name };
+                group = Some(match mesh.groups.iter().position(|g| *g == name) {
+                    Some(i) => i as u32,
+                    None => {
+                        mesh.groups.push(name);
+                        mesh.groups.len() as u32 - 1
+                    }
+                });
+            }
+            _ => {}
+        }
+    }
+    Ok(mesh)
+}
+
+/// Reads an OBJ file.
+pub fn load(path: &Path) -> Result<ObjMesh, ObjError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ObjError {
+        file: path.to_path_buf(),
+        line: None,
+        message: format!("cannot read: {e}"),
+    })?;
+    parse(&text, path)
+}
+
+impl ObjMesh {
+    /// The triangles of the named groups (all triangles when `names` is empty); an unknown name
+    /// is an error listing the groups that exist.
+    pub fn select(&self, names: &[String], file: &Path) -> Result<Vec<[[f64; 3]; 3]>, ObjError> {
+        let mut wanted = Vec::new();
+        for n in names {
+            match self.groups.iter().position(|g| g == n) {
+                Some(i) => wanted.push(i as u32),
+                None => {
+                    return Err(ObjError {
+                        file: file.to_path_buf(),
+                        line: None,
+                        message: format!("no group `{n}`; the file has: {}", self.groups.join(", ")),
+                    })
+                }
+            }
+        }
+        Ok(self
+            .triangles
+            .iter()
+            .zip(&self.group_of)
+            .filter(|(_, g)| names.is_empty() || wanted.contains(g))
+            .map(|(t, _)| *t)
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quads_split_groups_and_index_forms() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\ng a\nf 1/1/1 2/2/2 3/3/3 4/4/4\ng b\nf -4//1 -3//1 -2//1\n";
+        let m = parse(text, Path::new("t.obj")).unwrap();
+        assert_eq!(m.triangles.len(), 3);
+        assert_eq!(m.groups, vec!["a", "b"]);
+        assert_eq!(m.group_of, vec![0, 0, 1]);
+        assert_eq!(m.triangles[1], [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(m.select(&["b".into()], Path::new("t.obj")).unwrap().len(), 1);
+        let e = m.select(&["c".into()], Path::new("t.obj")).unwrap_err();
+        assert!(e.message.contains("a, b"), "{e}");
+    }
+
+    #[test]
+    fn malformed_faces_are_located() {
+        for (text, line, what) in [
+            ("v 0 0 0\nv 1 0 0\nf 1 2\n", 3, "at least 3"),
+            ("v 0 0 0\nf 1 2 3\n", 2, "refers to no vertex"),
+            ("v 0 0\n", 1, "3 coordinates"),
+            ("v 0 0 x\n", 1, "bad vertex"),
+            ("v 0 0 0\nv 0 0 0\nv 0 0 0\n\nf 1 2 z\n", 5, "bad face index"),
+            ("v 0 0 0\nv 0 0 0\nv 0 0 0\nf 0 1 2\n", 4, "refers to no vertex"),
+        ] {
+            let e = parse(text, Path::new("m.obj")).unwrap_err();
+            assert_eq!(e.line, Some(line), "{text:?}: {e}");
+            assert!(e.message.contains(what), "{e}");
+            assert!(e.to_string().starts_with(&format!("m.obj:{line}:")));
+        }
+    }
+
+    #[test]
+    fn missing_file_is_named() {
+        let e = load(Path::new("/nonexistent/x.obj")).unwrap_err();
+        assert!(e.to_string().contains("/nonexistent/x.obj") && e.to_string().contains("cannot read"));
+    }
+}

@@ -1,0 +1,132 @@
+// BVH2 traversal over full-f32 triangles: closest hit for camera rays, any hit with early exit
+// for shadow rays. The node array is obvhs' (children of an inner node are adjacent); leaves
+// index the triangle array directly (laid out in leaf order). Twin of src/accel/bvh.rs.
+
+struct Node {
+    min: vec3<f32>,
+    prim_count: u32,
+    max: vec3<f32>,
+    first_index: u32,
+}
+
+struct Tri {
+    v0: vec3<f32>,
+    mesh: u32,
+    e1: vec3<f32>,
+    index: u32,
+    e2: vec3<f32>,
+    albedo: f32,
+}
+
+struct MeshHit {
+    t: f32,
+    slot: u32,
+}
+
+const STACK_SIZE: u32 = 64u;
+const BIG: f32 = 3.4e38;
+
+@group(0) @binding(9) var<storage, read> nodes: array<Node>;
+@group(0) @binding(10) var<storage, read> tris: array<Tri>;
+
+// Moller-Trumbore; the distance, or -1 on a miss. Both sides hit.
+fn tri_t(o: vec3<f32>, d: vec3<f32>, tri: Tri) -> f32 {
+    let p = cross(d, tri.e2);
+    let det = dot(tri.e1, p);
+    if (det == 0.0) {
+        return -1.0;
+    }
+    let inv = 1.0 / det;
+    let s = o - tri.v0;
+    let u = dot(s, p) * inv;
+    if (u < 0.0 || u > 1.0) {
+        return -1.0;
+    }
+    let q = cross(s, tri.e1);
+    let v = dot(d, q) * inv;
+    if (v < 0.0 || u + v > 1.0) {
+        return -1.0;
+    }
+    return dot(tri.e2, q) * inv;
+}
+
+// Entry distance into a node's box within [0, tmax], or BIG when missed.
+fn slab(o: vec3<f32>, inv_d: vec3<f32>, tmax: f32, n: Node) -> f32 {
+    let t1 = (n.min - o) * inv_d;
+    let t2 = (n.max - o) * inv_d;
+    let lo = max(max(min(t1.x, t2.x), min(t1.y, t2.y)), max(min(t1.z, t2.z), 0.0));
+    let hi = min(min(max(t1.x, t2.x), max(t1.y, t2.y)), min(max(t1.z, t2.z), tmax));
+    return select(BIG, lo, lo <= hi);
+}
+
+fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1e-30);
+    return 1.0 / select(d, select(-tiny, tiny, d >= vec3<f32>(0.0)), abs(d) < tiny);
+}
+
+// Closest triangle with 0 < t < tmax, skipping the triangle whose `index` is `skip`.
+fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
+    var best = MeshHit(tmax_in, NO_HIT);
+    if (params.node_count == 0u) {
+        return best;
+    }
+    let inv_d = safe_inverse(d);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 1u;
+    stack[0] = 0u;
+    while (sp > 0u) {
+        sp -= 1u;
+        let n = nodes[stack[sp]];
+        if (slab(o, inv_d, best.t, n) == BIG) {
+            continue;
+        }
+        if (n.prim_count > 0u) {
+            for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
+                let t = tri_t(o, d, tris[i]);
+                if (t > 0.0 && t < best.t && tris[i].index != skip) {
+                    best = MeshHit(t, i);
+                }
+            }
+        } else if (sp + 2u <= STACK_SIZE) {
+            // Visit the nearer child first.
+            let a = slab(o, inv_d, best.t, nodes[n.first_index]);
+            let b = slab(o, inv_d, best.t, nodes[n.first_index + 1u]);
+            let near_first = a <= b;
+            stack[sp] = select(n.first_index, n.first_index + 1u, near_first);
+            stack[sp + 1u] = select(n.first_index + 1u, n.first_index, near_first);
+            sp += 2u;
+        }
+    }
+    return best;
+}
+
+// Whether any triangle other than `skip` is hit with 0 < t < tmax; stops at the first.
+fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
+    if (params.node_count == 0u) {
+        return false;
+    }
+    let inv_d = safe_inverse(d);
+    var stack: array<u32, STACK_SIZE>;
+    var sp = 1u;
+    stack[0] = 0u;
+    while (sp > 0u) {
+        sp -= 1u;
+        let n = nodes[stack[sp]];
+        if (slab(o, inv_d, tmax, n) == BIG) {
+            continue;
+        }
+        if (n.prim_count > 0u) {
+            for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
+                let t = tri_t(o, d, tris[i]);
+                if (t > 0.0 && t < tmax && tris[i].index != skip) {
+                    return true;
+                }
+            }
+        } else if (sp + 2u <= STACK_SIZE) {
+            stack[sp] = n.first_index;
+            stack[sp + 1u] = n.first_index + 1u;
+            sp += 2u;
+        }
+    }
+    return false;
+}
