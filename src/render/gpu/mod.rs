@@ -12,7 +12,8 @@ use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, Vie
 use crate::sampling::DiskScheme;
 use anyhow::{anyhow, bail, Context};
 use bytemuck::Pod;
-use layout::{pack, Packed, PassInfo, HIT_BYTES};
+use bytemuck::Zeroable;
+use layout::{pack, GpuLight, Packed, PassInfo, HIT_BYTES};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -50,7 +51,8 @@ pub struct GpuBackend {
 /// Per-frame GPU resources.
 struct FrameResources {
     bind0: wgpu::BindGroup,
-    passes: Vec<wgpu::BindGroup>,
+    /// Per light, one bind group per dispatch of its samples.
+    passes: Vec<Vec<wgpu::BindGroup>>,
     hits: wgpu::Buffer,
     visibility: wgpu::Buffer,
     radiance: wgpu::Buffer,
@@ -274,24 +276,40 @@ impl GpuBackend {
             layout: &self.layout0,
             entries: &entries,
         });
-        let passes = (0..packed.lights.len().max(1))
-            .map(|light| {
-                let info = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("pass info"),
-                    contents: bytemuck::bytes_of(&PassInfo {
-                        light: light as u32,
-                        _pad: [0; 3],
-                    }),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("pass"),
-                    layout: &self.layout1,
-                    entries: &[wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: info.as_entire_binding(),
-                    }],
-                })
+        let chunk = layout::samples_per_dispatch(packed);
+        let one = [GpuLight::zeroed()];
+        let lights = if packed.lights.is_empty() {
+            &one[..]
+        } else {
+            &packed.lights[..]
+        };
+        let passes = lights
+            .iter()
+            .enumerate()
+            .map(|(light, l)| {
+                (0..l.samples.max(1).div_ceil(chunk))
+                    .map(|c| {
+                        let info = PassInfo {
+                            light: light as u32,
+                            first_sample: c * chunk,
+                            sample_count: chunk,
+                            _pad: 0,
+                        };
+                        let buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                            label: Some("pass info"),
+                            contents: bytemuck::bytes_of(&info),
+                            usage: wgpu::BufferUsages::UNIFORM,
+                        });
+                        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("pass"),
+                            layout: &self.layout1,
+                            entries: &[wgpu::BindGroupEntry {
+                                binding: 0,
+                                resource: buffer.as_entire_binding(),
+                            }],
+                        })
+                    })
+                    .collect()
             })
             .collect();
         let queries = self.timestamps.then(|| {
@@ -323,6 +341,7 @@ impl GpuBackend {
     /// Records the plan's passes into `encoder`: primary, then one shadow dispatch per light.
     fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, lights: usize) {
         encoder.clear_buffer(&r.counters, 0, None);
+        encoder.clear_buffer(&r.visibility, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
         for pass in 0..=lights {
             let timestamp_writes = r.queries.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
@@ -336,8 +355,16 @@ impl GpuBackend {
             });
             cp.set_pipeline(if pass == 0 { &self.primary } else { &self.shadow });
             cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[pass.saturating_sub(1)], &[]);
-            cp.dispatch_workgroups(groups.0, groups.1, 1);
+            // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
+            let chunks = if pass == 0 {
+                &r.passes[0][..1]
+            } else {
+                &r.passes[pass - 1][..]
+            };
+            for chunk in chunks {
+                cp.set_bind_group(1, chunk, &[]);
+                cp.dispatch_workgroups(groups.0, groups.1, 1);
+            }
         }
     }
 
@@ -441,7 +468,7 @@ impl GpuBackend {
             });
             cp.set_pipeline(&self.dump);
             cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[0], &[]);
+            cp.set_bind_group(1, &r.passes[0][0], &[]);
             cp.dispatch_workgroups(n.div_ceil(64), 1, 1);
         }
         self.submit(encoder, scope)?;
@@ -520,7 +547,7 @@ impl GpuBackend {
             });
             cp.set_pipeline(&self.probe);
             cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[0], &[]);
+            cp.set_bind_group(1, &r.passes[0][0], &[]);
             cp.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
         }
         self.submit(encoder, scope)?;

@@ -77,17 +77,15 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
     while (sp > 0u) {
         sp -= 1u;
         let n = nodes[stack[sp]];
-        if (slab(o, inv_d, best.t, n) == BIG) {
-            continue;
-        }
-        if (n.prim_count > 0u) {
+        let entered = slab(o, inv_d, best.t, n) != BIG;
+        if (entered && n.prim_count > 0u) {
             for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
                 let t = tri_t(o, d, tris[i]);
                 if (t > 0.0 && t < best.t && tris[i].index != skip) {
                     best = MeshHit(t, i);
                 }
             }
-        } else if (sp + 2u <= STACK_SIZE) {
+        } else if (entered && sp + 2u <= STACK_SIZE) {
             // Visit the nearer child first.
             let a = slab(o, inv_d, best.t, nodes[n.first_index]);
             let b = slab(o, inv_d, best.t, nodes[n.first_index + 1u]);
@@ -100,7 +98,9 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
     return best;
 }
 
-// Whether any triangle other than `skip` is hit with 0 < t < tmax; stops at the first.
+// Whether any triangle other than `skip` is hit with 0 < t < tmax; stops at the first. (Written
+// with a flag and structured exits rather than a return from inside the loops: lavapipe
+// miscompiled the early return under divergence, dropping whole workgroups' shadow rays.)
 fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     if (params.node_count == 0u) {
         return false;
@@ -109,24 +109,21 @@ fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     var stack: array<u32, STACK_SIZE>;
     var sp = 1u;
     stack[0] = 0u;
-    while (sp > 0u) {
+    var found = false;
+    while (sp > 0u && !found) {
         sp -= 1u;
         let n = nodes[stack[sp]];
-        if (slab(o, inv_d, tmax, n) == BIG) {
-            continue;
-        }
-        if (n.prim_count > 0u) {
+        let entered = slab(o, inv_d, tmax, n) != BIG;
+        if (entered && n.prim_count > 0u) {
             for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
                 let t = tri_t(o, d, tris[i]);
-                if (t > 0.0 && t < tmax && tris[i].index != skip) {
-                    return true;
-                }
+                found = found || (t > 0.0 && t < tmax && tris[i].index != skip);
             }
-        } else if (sp + 2u <= STACK_SIZE) {
+        } else if (entered && sp + 2u <= STACK_SIZE) {
             stack[sp] = n.first_index;
             stack[sp + 1u] = n.first_index + 1u;
             sp += 2u;
         }
     }
-    return false;
+    return found;
 }

@@ -1,5 +1,5 @@
-// The render plan's passes: `primary` (camera rays, closest hit) and `shadow` (one dispatch per
-// light, any-hit with early exit). Mirrors src/render/cpu.rs and src/render/shading.rs in f32,
+// The render plan's passes: `primary` (camera rays, closest hit) and `shadow` (per light, one
+// dispatch per chunk of its samples, any-hit with early exit). Mirrors src/render/cpu.rs and src/render/shading.rs in f32,
 // in coordinates re-based on the camera's look-at point so that large translations cost nothing.
 
 struct Params {
@@ -69,9 +69,9 @@ struct Hit {
 
 struct PassInfo {
     light: u32,
+    first_sample: u32,
+    sample_count: u32,
     _p0: u32,
-    _p1: u32,
-    _p2: u32,
 }
 
 const LIGHT_POINT: u32 = 0u;
@@ -217,7 +217,8 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     var vis = 0.0;
     var irradiance = 0.0;
     var rays = 0u;
-    if (light.kind == LIGHT_POINT) {
+    let first = pass_info.first_sample;
+    if (light.kind == LIGHT_POINT && first == 0u) {
         let d = light.center - p;
         if (dot(n, d) > 0.0) {
             rays = 1u;
@@ -226,14 +227,15 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                 irradiance = light.power / (4.0 * PI) * dot(n, normalize(d)) / dot(d, d);
             }
         }
-    } else {
+    } else if (light.kind != LIGHT_POINT) {
         let tilt = sqrt(max(1.0 - dot(n, light.normal) * dot(n, light.normal), 0.0));
         let reachable = dot(light.normal, p - light.center) > 0.0 && dot(n, light.center - p) + light.radius * tilt > 0.0;
         if (reachable) {
             let stream = stream_pixel(params.seed, li, pixel);
             var visible = 0u;
             var sum = 0.0;
-            for (var k = 0u; k < light.samples; k++) {
+            let last = min(first + pass_info.sample_count, light.samples);
+            for (var k = first; k < last; k++) {
                 var s: vec2<f32>;
                 if (params.shared_pattern != 0u) {
                     s = shared_points[light.shared_offset + k];
@@ -242,21 +244,21 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
                 let d = q - p;
-                if (dot(n, d) <= 0.0 || dot(light.normal, d) >= 0.0) {
-                    continue;
-                }
-                rays += 1u;
-                if (!occluded(origin, q - origin, hit.object, hit.triangle)) {
-                    visible += 1u;
-                    let d2 = dot(d, d);
-                    sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
+                if (dot(n, d) > 0.0 && dot(light.normal, d) < 0.0) {
+                    rays += 1u;
+                    if (!occluded(origin, q - origin, hit.object, hit.triangle)) {
+                        visible += 1u;
+                        let d2 = dot(d, d);
+                        sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
+                    }
                 }
             }
             vis = f32(visible) / f32(light.samples);
             irradiance = light.power / (PI * f32(light.samples)) * sum;
         }
     }
-    visibility[out] = vis;
+    // Sample chunks of one light accumulate (the buffer is cleared each frame).
+    visibility[out] += vis;
     radiance[pixel] += hit.albedo / PI * irradiance;
     add_rays(li, rays);
 }
