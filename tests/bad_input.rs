@@ -128,3 +128,29 @@ fn no_gpu_adapter() {
         "{runs}"
     );
 }
+
+#[test]
+fn frame_rate_experiment_errors_are_located() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
+    std::fs::copy(
+        common::repo("experiments/scenes/sphere.toml"),
+        dir.path().join("scenes/sphere.toml"),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(common::repo("experiments/fps.toml")).unwrap();
+    let one_scene = &text[..text.find("[[scenes]]\nname = \"body\"").unwrap()];
+    let text = one_scene.replace("scenes/sphere-two-lights.toml", "scenes/sphere.toml");
+    std::fs::write(dir.path().join("fps.toml"), &text).unwrap();
+    let (code, e) = common::sweep(&[
+        dir.path().join("fps.toml").as_os_str(),
+        OsStr::new("--out"),
+        dir.path().join("r").as_os_str(),
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        e.contains("fps.toml:") && e.contains("scenes[0].lights") && e.contains("1..=1"),
+        "{e}"
+    );
+    assert!(!dir.path().join("r").exists());
+}

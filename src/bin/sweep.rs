@@ -2,8 +2,10 @@
 
 use anyhow::Context;
 use clap::Parser;
+use penumbra::experiment::fps::{is_fps, run_fps, FpsSpec};
 use penumbra::experiment::{pictures::render_pictures, run_sweep, spec::BackendChoice, Spec};
 use penumbra::render::open_backend;
+use penumbra::report::fps::write_fps;
 use penumbra::report::markdown::verdict_radius;
 use penumbra::report::write::{write_all, Results};
 use std::path::PathBuf;
@@ -34,27 +36,55 @@ fn peak_rss() -> Option<u64> {
     line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
 }
 
-fn run(args: Args) -> anyhow::Result<()> {
-    let started = Instant::now();
-    let spec = Spec::load(&args.experiment)?;
-    let choice = match args.backend.as_deref() {
-        None => spec.backend,
+/// A frame-rate experiment (`kind = "fps"`): times configurations, no sweep.
+fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
+    let spec = FpsSpec::load(&args.experiment)?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    let mut backend = open_backend(backend_choice(args, BackendChoice::Auto)?)?;
+    let adapter = backend.adapter().clone();
+    let rows = run_fps(&spec, backend.as_mut())?;
+    write_fps(&spec, &rows, &adapter, started.elapsed().as_secs_f64(), &out)?;
+    eprintln!(
+        "{} configurations timed; wrote {}",
+        rows.len(),
+        out.join("report.md").display()
+    );
+    Ok(())
+}
+
+fn backend_choice(args: &Args, default: BackendChoice) -> anyhow::Result<BackendChoice> {
+    Ok(match args.backend.as_deref() {
+        None => default,
         Some("auto") => BackendChoice::Auto,
         Some("gpu") => BackendChoice::Gpu,
         Some("cpu") => BackendChoice::Cpu,
         Some(other) => anyhow::bail!("--backend must be auto, gpu or cpu, got `{other}`"),
-    };
-    let out = args.out.unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    })
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    if is_fps(&args.experiment) {
+        return run_fps_experiment(&args, started);
+    }
+    let spec = Spec::load(&args.experiment)?;
+    let choice = backend_choice(&args, spec.backend)?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
     let mut backend = open_backend(choice)?;
     let adapter = backend.adapter().clone();
     eprintln!(
         "{}: {} runs on {} ({}, {})",
         spec.name,
-        spec.axes.schemes.len()
-            * spec.axes.patterns.len()
-            * spec.axes.samples.len()
-            * spec.axes.light_radii.len()
-            * spec.axes.seeds.len(),
+        penumbra::experiment::run::expand(&spec)
+            .iter()
+            .map(|g| g.runs.len())
+            .sum::<usize>(),
         adapter.name,
         adapter.backend,
         adapter.api

@@ -62,8 +62,12 @@ impl Journal {
         ))
     }
 
-    /// Appends a completed group and flushes it to disk.
+    /// Appends a completed group and flushes it to disk (a group already journaled, such as one
+    /// rendered again for the figures, is not written twice).
     pub fn append(&mut self, records: &[Record], stats: &GroupStats) -> anyhow::Result<()> {
+        if self.groups.contains_key(&stats.key) {
+            return Ok(());
+        }
         append_rows(
             &self.dir.join("runs.csv"),
             &RUN_COLUMNS,
@@ -76,6 +80,8 @@ impl Journal {
             num(stats.variance),
         ];
         append_rows(&self.dir.join("groups.csv"), &GROUP_COLUMNS, std::iter::once(row))?;
+        self.groups
+            .insert(stats.key.clone(), (stats.seeds, stats.bias2, stats.variance));
         Ok(())
     }
 }

@@ -57,6 +57,9 @@ impl RenderPlan {
         if !scene.planes.is_empty() {
             shapes.push("plane");
         }
+        if scene.bvh.is_some() {
+            shapes.push("mesh (BVH)");
+        }
         let mut passes = vec![Pass::Primary { rays: pixels, shapes }];
         for (i, light) in scene.lights.iter().enumerate() {
             let n = light.samples();

@@ -394,7 +394,8 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn git_commit() -> String {
+/// The checkout's commit, suffixed `-dirty` when tracked files differ from it.
+pub fn git_commit() -> String {
     let run = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)

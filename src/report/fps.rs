@@ -1,0 +1,112 @@
+//! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
+//! numbers, report.md and the manifest.
+
+use super::files::{write_atomic, write_csv};
+use super::plots::{line_plot, Axes, Reference, Series};
+use crate::experiment::fps::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
+use crate::render::AdapterInfo;
+use std::path::Path;
+
+/// Writes fps.csv, plots/fps.png, report.md and manifest.toml under `out`.
+pub fn write_fps(
+    spec: &FpsSpec,
+    rows: &[FpsRow],
+    adapter: &AdapterInfo,
+    seconds: f64,
+    out: &Path,
+) -> anyhow::Result<()> {
+    write_csv(
+        &out.join("fps.csv"),
+        &FPS_COLUMNS,
+        rows.iter().map(|r| fps_row(spec, r, adapter)),
+    )?;
+    let mut series = Vec::new();
+    let mut refs = Vec::new();
+    let pixels: Vec<f64> = spec.resolutions.iter().map(|r| (r[0] * r[1]) as f64 / 1e6).collect();
+    let (lo, hi) = (
+        pixels.iter().copied().fold(f64::INFINITY, f64::min),
+        pixels.iter().copied().fold(0.0, f64::max),
+    );
+    let mut keys: Vec<(String, u32)> = rows.iter().map(|r| (r.scene.clone(), r.lights)).collect();
+    keys.dedup();
+    for (i, (scene, lights)) in keys.iter().enumerate() {
+        let of: Vec<&FpsRow> = rows
+            .iter()
+            .filter(|r| &r.scene == scene && r.lights == *lights)
+            .collect();
+        let points = of
+            .iter()
+            .map(|r| ((r.width * r.height) as f64 / 1e6, r.fps(), f64::NAN))
+            .collect();
+        series.push((
+            i,
+            Series {
+                name: format!("{scene}, {lights} light(s): ours"),
+                points,
+                dashed: false,
+            },
+        ));
+        if let Some(r) = of.first() {
+            refs.push(Reference {
+                name: format!("{scene}, {lights} light(s): paper (GTX 560M)"),
+                points: vec![(lo, r.paper_fps), (hi, r.paper_fps)],
+            });
+        }
+    }
+    let title = format!(
+        "Table 1 on {}: {} shadow rays per pixel per light",
+        adapter.name, spec.samples
+    );
+    line_plot(
+        &out.join("plots/fps.png"),
+        &Axes::new(&title, "megapixels", "frames per second", true, true),
+        &series,
+        &refs,
+    )?;
+    let mut md = format!("# {}: the soft-shadow paper's Table 1, measured\n\n", spec.name);
+    md += &format!(
+        "Experiment `{}` on **{}** ({}, {}, {}), {:.0} s. Each configuration renders {} shadow rays per pixel per light with the `{}` scheme ({} pattern) on 4 cm disk lights; {} untimed frames, then up to {} timed frames within {} s (at least 3); frame time is the median, from {}.\n\n",
+        spec.path.display(),
+        adapter.name,
+        adapter.backend,
+        adapter.api,
+        adapter.driver,
+        seconds,
+        spec.samples,
+        spec.sampling.scheme,
+        spec.sampling.pattern,
+        spec.warmup,
+        spec.frames,
+        spec.max_seconds,
+        rows.first().map_or("-", |r| r.clock.name())
+    );
+    md += "The paper (Vassilev 2012, Table 1) timed 100 frames with OptiX on a GTX 560M laptop GPU at an unstated resolution: sphere 15.95 / 9.39 fps, dressed body 8.36 / 6.13 fps with one / two lights.\n\n";
+    md += "| scene | lights | resolution | frames timed | median ms | fps (ours) | fps (paper) | shadow rays/s |\n|---|---|---|---|---|---|---|---|\n";
+    for r in rows {
+        md += &format!(
+            "| {} | {} | {}x{} | {} | {:.1} | {:.3} | {} | {:.3e} |\n",
+            r.scene,
+            r.lights,
+            r.width,
+            r.height,
+            r.frames,
+            r.median_s * 1e3,
+            r.fps(),
+            r.paper_fps,
+            r.shadow_rays_per_s()
+        );
+    }
+    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`.\n";
+    write_atomic(&out.join("report.md"), md.as_bytes())?;
+    let manifest = format!(
+        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\n[adapter]\nbackend = {:?}\nname = {:?}\ndriver = {:?}\napi = {:?}\n",
+        super::write::git_commit(),
+        spec.path.display().to_string(),
+        seconds,
+        adapter.backend,
+        adapter.name,
+        adapter.driver,
+        adapter.api
+    );
+    write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}
