@@ -1,5 +1,6 @@
-//! The sweep: for each light radius build the reference once, then render every run, measure
-//! it, and stream the records to a journal so an interrupted sweep resumes where it stopped.
+//! The sweep: for each (lights on, light radius) pair build the reference once, then render
+//! every run, measure it, and stream the records to a journal so an interrupted sweep resumes
+//! where it stopped.
 
 use super::journal::Journal;
 use super::reference::{shadow_image, Reference};
@@ -34,13 +35,13 @@ pub struct Outcome {
     pub records: Vec<Record>,
     /// Bias/variance per group.
     pub groups: Vec<GroupStats>,
-    /// The references, one per light radius.
+    /// The references, one per (lights on, light radius) pair, in sweep order.
     pub references: Vec<Reference>,
-    /// Seed-averaged radial profiles at the figure sample count: (scheme, pattern, radius index).
+    /// Seed-averaged radial profiles at the figure sample count: (scheme, pattern, reference index).
     pub profiles: BTreeMap<(DiskScheme, Pattern, usize), RadialProfile>,
     /// Measuring-view visibility of the first seed at the figure sample count.
     pub keep: BTreeMap<(DiskScheme, Pattern, usize), Vec<f32>>,
-    /// The render plan of the first run, logged with the results.
+    /// The render plan at the figure sample count with every swept light on, logged with the results.
     pub plan: RenderPlan,
     /// Runs that failed.
     pub failures: usize,

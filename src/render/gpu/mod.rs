@@ -42,8 +42,10 @@ pub struct GpuBackend {
     lost: Arc<AtomicBool>,
     layout0: wgpu::BindGroupLayout,
     layout1: wgpu::BindGroupLayout,
-    primary: wgpu::ComputePipeline,
-    shadow: wgpu::ComputePipeline,
+    /// The plan's passes, compiled with (`[1]`) and without (`[0]`) mesh traversal: a scene
+    /// without meshes runs shaders in which the BVH walks are constant-folded away.
+    primary: [wgpu::ComputePipeline; 2],
+    shadow: [wgpu::ComputePipeline; 2],
     dump: wgpu::ComputePipeline,
     probe: wgpu::ComputePipeline,
 }
@@ -58,6 +60,8 @@ struct FrameResources {
     radiance: wgpu::Buffer,
     counters: wgpu::Buffer,
     queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Whether the scene has meshes (selects the pipeline variant).
+    meshes: bool,
 }
 
 impl GpuBackend {
@@ -140,19 +144,24 @@ impl GpuBackend {
             bind_group_layouts: &[Some(&layout0), Some(&layout1)],
             immediate_size: 0,
         });
-        let pipeline = |entry: &str| {
+        let variant = |entry: &str, meshes: bool| {
+            let constants = [("MESHES", if meshes { 1.0 } else { 0.0 })];
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
                 module: &module,
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
                 cache: None,
             })
         };
+        let pipeline = |entry: &str| variant(entry, true);
         let (primary, shadow, dump, probe) = (
-            pipeline("primary"),
-            pipeline("shadow"),
+            [variant("primary", false), variant("primary", true)],
+            [variant("shadow", false), variant("shadow", true)],
             pipeline("dump_samples"),
             pipeline("trace_probes"),
         );
@@ -335,6 +344,7 @@ impl GpuBackend {
             radiance,
             counters,
             queries,
+            meshes: !packed.nodes.is_empty(),
         }
     }
 
@@ -353,7 +363,8 @@ impl GpuBackend {
                 label: None,
                 timestamp_writes,
             });
-            cp.set_pipeline(if pass == 0 { &self.primary } else { &self.shadow });
+            let pipelines = if pass == 0 { &self.primary } else { &self.shadow };
+            cp.set_pipeline(&pipelines[r.meshes as usize]);
             cp.set_bind_group(0, &r.bind0, &[]);
             // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
             let chunks = if pass == 0 {
@@ -430,6 +441,23 @@ impl GpuBackend {
         Ok(Some((seconds(first, last), seconds(ticks[0], ticks[1]))))
     }
 
+    /// Runs a one-dimensional test-hook kernel over `groups` workgroups.
+    fn run_hook(&self, pipeline: &wgpu::ComputePipeline, r: &FrameResources, groups: u32) -> anyhow::Result<()> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: None,
+                timestamp_writes: None,
+            });
+            cp.set_pipeline(pipeline);
+            cp.set_bind_group(0, &r.bind0, &[]);
+            cp.set_bind_group(1, &r.passes[0][0], &[]);
+            cp.dispatch_workgroups(groups, 1, 1);
+        }
+        self.submit(encoder, scope)
+    }
+
     /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
     /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
     pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
@@ -459,19 +487,7 @@ impl GpuBackend {
             },
             &[],
         );
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        {
-            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: None,
-                timestamp_writes: None,
-            });
-            cp.set_pipeline(&self.dump);
-            cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[0][0], &[]);
-            cp.dispatch_workgroups(n.div_ceil(64), 1, 1);
-        }
-        self.submit(encoder, scope)?;
+        self.run_hook(&self.dump, &r, n.div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
         Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
@@ -538,19 +554,7 @@ impl GpuBackend {
             })
             .collect();
         let r = self.resources(&packed, view, &probes);
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        {
-            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: None,
-                timestamp_writes: None,
-            });
-            cp.set_pipeline(&self.probe);
-            cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[0][0], &[]);
-            cp.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
-        }
-        self.submit(encoder, scope)?;
+        self.run_hook(&self.probe, &r, (rays.len() as u32).div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
         Ok(raw
             .chunks(3)

@@ -24,7 +24,15 @@ struct MeshHit {
 }
 
 const STACK_SIZE: u32 = 64u;
+
+// Pipeline constant: false compiles the walks away for scenes without meshes.
+override MESHES: bool = true;
 const BIG: f32 = 3.4e38;
+
+// One traversal stack per invocation, shared by both walks (never live at once). Module scope,
+// so it is zero-initialised once per invocation rather than at every call: a function-local
+// array is cleared on each call, which tripled the cost of analytic-only shadow rays on lavapipe.
+var<private> stack: array<u32, STACK_SIZE>;
 
 @group(0) @binding(9) var<storage, read> nodes: array<Node>;
 @group(0) @binding(10) var<storage, read> tris: array<Tri>;
@@ -67,11 +75,10 @@ fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
 // Closest triangle with 0 < t < tmax, skipping the triangle whose `index` is `skip`.
 fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
     var best = MeshHit(tmax_in, NO_HIT);
-    if (params.node_count == 0u) {
+    if (!MESHES || params.node_count == 0u) {
         return best;
     }
     let inv_d = safe_inverse(d);
-    var stack: array<u32, STACK_SIZE>;
     var sp = 1u;
     stack[0] = 0u;
     while (sp > 0u) {
@@ -102,11 +109,10 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
 // with a flag and structured exits rather than a return from inside the loops: lavapipe
 // miscompiled the early return under divergence, dropping whole workgroups' shadow rays.)
 fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
-    if (params.node_count == 0u) {
+    if (!MESHES || params.node_count == 0u) {
         return false;
     }
     let inv_d = safe_inverse(d);
-    var stack: array<u32, STACK_SIZE>;
     var sp = 1u;
     stack[0] = 0u;
     var found = false;
