@@ -221,13 +221,25 @@ impl GpuBackend {
         }
         let limits = self.device.limits();
         let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let (nodes, triangles) = scene
+            .bvh
+            .as_ref()
+            .map_or((0, 0), |b| (b.node_count(), b.tree.primitive_indices.len()));
         for (what, bytes) in [
             ("hit buffer", view.pixels() as u64 * HIT_BYTES),
             ("visibility buffer", (view.pixels() * lights.max(1)) as u64 * 4),
+            (
+                "BVH node buffer",
+                (nodes * std::mem::size_of::<layout::GpuNode>()) as u64,
+            ),
+            (
+                "triangle buffer",
+                (triangles * std::mem::size_of::<layout::GpuTri>()) as u64,
+            ),
         ] {
             if bytes > max {
                 bail!(
-                    "{}x{} needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
+                    "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
                     view.width,
                     view.height,
                     bytes - max
