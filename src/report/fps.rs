@@ -50,6 +50,7 @@ pub fn write_fps(
             refs.push(Reference {
                 name: format!("{scene}, {lights} light(s): paper (GTX 560M)"),
                 points: vec![(lo, r.paper_fps), (hi, r.paper_fps)],
+                colour: Some(i),
             });
         }
     }

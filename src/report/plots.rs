@@ -24,6 +24,8 @@ pub struct Reference {
     pub name: String,
     /// Either one y for all x, or a curve of (x, y).
     pub points: Vec<(f64, f64)>,
+    /// Colour of the series it belongs to (see [`colour`]), or black.
+    pub colour: Option<usize>,
 }
 
 /// A plot's labels and axis kinds.
@@ -202,7 +204,7 @@ where
             .map_err(|e| anyhow::anyhow!("{e}"))?;
     }
     for (i, r) in references.iter().enumerate() {
-        let style = BLACK.mix(0.75).stroke_width(2);
+        let style = r.colour.map_or(BLACK.mix(0.75), |c| colour(c).mix(0.9)).stroke_width(2);
         chart
             .draw_series(DashedLineSeries::new(r.points.clone(), 10 + 6 * i as u32, 6, style))
             .map_err(|e| anyhow::anyhow!("{e}"))?

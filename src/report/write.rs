@@ -220,6 +220,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
         vec![RefLine {
             name: name.into(),
             points: vec![(lo, y * 1e3), (hi, y * 1e3)],
+            colour: None,
         }]
     };
     let (a, b) = exact.extent();
@@ -282,6 +283,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
         &[RefLine {
             name: "exact".into(),
             points: exact_vs_radius,
+            colour: None,
         }],
     )?;
     let mut profiles = Vec::new();
@@ -314,6 +316,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
             .map(|(x, y)| (x * 1e3, *y))
             .filter(|p| p.1.is_finite())
             .collect(),
+        colour: None,
     };
     let x_range = reference.on_axis.as_ref().map(|o| {
         let (ru, rp) = (o.umbra_radius().max(0.0) * 1e3, o.penumbra_radius() * 1e3);
