@@ -128,6 +128,11 @@ fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn main() -> ExitCode {
+    // Mesa's software Vulkan driver prints "error: XDG_RUNTIME_DIR is invalid" on headless
+    // machines without one, though nothing fails; give it the temporary folder instead.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
     match run(Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -2,8 +2,9 @@
 //!
 //! Setup (adapter, device with the adapter's real limits, pipelines) happens once in
 //! [`GpuBackend::new`]; each frame uploads the packed scene, runs the plan's passes (primary,
-//! then one shadow dispatch per light) with a timestamp pair around each pass when the adapter
-//! supports timestamp queries, and reads the outputs back.
+//! then one shadow pass per light, split into dispatches of at most
+//! `layout::samples_per_dispatch` samples) with a timestamp pair around each pass when the
+//! adapter supports timestamp queries, and reads the outputs back.
 
 mod layout;
 
@@ -11,8 +12,7 @@ use super::plan::{RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
 use crate::sampling::DiskScheme;
 use anyhow::{anyhow, bail, Context};
-use bytemuck::Pod;
-use bytemuck::Zeroable;
+use bytemuck::{Pod, Zeroable};
 use layout::{pack, GpuLight, Packed, PassInfo, HIT_BYTES};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -360,7 +360,7 @@ impl GpuBackend {
         }
     }
 
-    /// Records the plan's passes into `encoder`: primary, then one shadow dispatch per light.
+    /// Records the plan's passes into `encoder`: primary, then one shadow pass per light.
     fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, lights: usize) {
         encoder.clear_buffer(&r.counters, 0, None);
         encoder.clear_buffer(&r.visibility, 0, None);
