@@ -109,7 +109,7 @@ impl Reference {
             crate::scene::camera::Projection::Perspective { .. } => unreachable!("validated orthographic"),
         };
         let receivers = Receivers::new(&scene, view, m.plane, &hit, centre, bin);
-        let exact = has_exact_answer(&scene).then(|| exact_image(&scene, view, m.plane, &receivers));
+        let exact = has_exact_answer(&scene).then(|| exact_image(&scene, view.pixels(), m.plane, &receivers));
         let mask = PenumbraMask::from_reference(&ground_truth);
         let gt_vs_exact = exact.as_ref().map(|e| ErrorMetrics::measure(&ground_truth, e, &mask));
         let gt_max_abs_all = exact.as_ref().map(|e| {
@@ -143,17 +143,13 @@ pub fn has_exact_answer(scene: &Scene) -> bool {
 
 /// Exact shadow image (mean over the scene's disk lights) at every receiver pixel (rayon; the
 /// penumbra dominates the cost).
-pub fn exact_image(scene: &Scene, view: View, plane: usize, receivers: &Receivers) -> Vec<f32> {
+pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> Vec<f32> {
     let pl = &scene.planes[plane];
     let points: Vec<(usize, glam::DVec3)> = receivers
         .pixels
         .iter()
-        .map(|&(i, _)| {
-            let (x, y) = ((i % view.width as usize) as u32, (i / view.width as usize) as u32);
-            let ray = view.camera.ray(x, y, view.width, view.height);
-            let t = crate::geometry::plane_t(ray.origin, ray.direction, pl).unwrap_or(0.0);
-            (i, crate::geometry::reproject_plane(ray.origin + ray.direction * t, pl))
-        })
+        .zip(&receivers.points)
+        .map(|(&(i, _), &p)| (i, crate::geometry::reproject_plane(p, pl)))
         .collect();
     let disks: Vec<_> = scene
         .lights
@@ -170,7 +166,7 @@ pub fn exact_image(scene: &Scene, view: View, plane: usize, receivers: &Receiver
             (i, (v / disks.len() as f64) as f32)
         })
         .collect();
-    let mut image = vec![NO_RECEIVER; view.pixels()];
+    let mut image = vec![NO_RECEIVER; pixels];
     for (i, v) in values {
         image[i] = v;
     }

@@ -176,7 +176,7 @@ fn run_group(
     let mut records = Vec::new();
     let mut images = Vec::new();
     for run in &group.runs {
-        let result = measure_run(spec, backend, run, reference);
+        let result = measure_run(spec, backend, run, reference, context);
         match result {
             Ok((record, image)) => {
                 records.push(record);
@@ -274,6 +274,7 @@ fn measure_run(
     backend: &mut dyn Backend,
     run: &Run,
     reference: &Reference,
+    context: &str,
 ) -> anyhow::Result<(Record, Vec<f32>)> {
     let scene = spec.scene_with(run.lights, run.light_radius, run.samples);
     let m = &spec.measure;
@@ -338,10 +339,7 @@ fn measure_run(
         build_ms,
         bytes,
     ]);
-    Ok((
-        assemble(spec, backend, run, &context_key(spec), "ok", &metrics, ""),
-        image,
-    ))
+    Ok((assemble(spec, backend, run, context, "ok", &metrics, ""), image))
 }
 
 /// The on-axis columns (closed-form radii, exact and measured extents and 10-90 widths, profile

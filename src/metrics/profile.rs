@@ -24,6 +24,8 @@ pub const MIN_BIN_PIXELS: usize = 8;
 pub struct Receivers {
     /// (pixel index, distance from the centre) for every pixel whose camera ray hits the plane.
     pub pixels: Vec<(usize, f64)>,
+    /// The ground point of each entry of `pixels`, where its camera ray meets the plane.
+    pub points: Vec<DVec3>,
     /// Bin width (m): one pixel of an orthographic view.
     pub bin_width: f64,
 }
@@ -34,7 +36,7 @@ impl Receivers {
     pub fn new(scene: &Scene, view: View, plane: usize, hit: &[u32], centre: DVec3, bin_width: f64) -> Self {
         let pl = &scene.planes[plane];
         let id = scene.plane_id(plane);
-        let mut pixels = Vec::new();
+        let (mut pixels, mut points) = (Vec::new(), Vec::new());
         for y in 0..view.height {
             for x in 0..view.width {
                 let i = (y * view.width + x) as usize;
@@ -43,11 +45,17 @@ impl Receivers {
                 }
                 let ray = view.camera.ray(x, y, view.width, view.height);
                 if let Some(t) = crate::geometry::plane_t(ray.origin, ray.direction, pl) {
-                    pixels.push((i, (ray.origin + ray.direction * t - centre).length()));
+                    let p = ray.origin + ray.direction * t;
+                    pixels.push((i, (p - centre).length()));
+                    points.push(p);
                 }
             }
         }
-        Receivers { pixels, bin_width }
+        Receivers {
+            pixels,
+            points,
+            bin_width,
+        }
     }
 
     /// Bin index of a radius.
@@ -154,7 +162,11 @@ mod tests {
     fn synthetic(values: &[(f64, f32)]) -> (Receivers, Vec<f32>) {
         let pixels = values.iter().enumerate().map(|(i, (r, _))| (i, *r)).collect();
         (
-            Receivers { pixels, bin_width: 1.0 },
+            Receivers {
+                pixels,
+                points: vec![],
+                bin_width: 1.0,
+            },
             values.iter().map(|v| v.1).collect(),
         )
     }

@@ -75,11 +75,6 @@ impl OnAxis {
         -self.light_radius + self.light_height * (beta + phi).tan()
     }
 
-    /// Geometric penumbra width r_p - max(r_u, 0).
-    pub fn penumbra_width(&self) -> f64 {
-        self.penumbra_radius() - self.umbra_radius().max(0.0)
-    }
-
     /// The receiver point at distance `r` from the shadow's centre.
     pub fn point_at(&self, r: f64) -> DVec3 {
         self.foot + self.radial * r

@@ -186,11 +186,6 @@ impl GpuBackend {
         })
     }
 
-    /// Whether frame times come from GPU timestamps (else a labelled wall-clock fallback).
-    pub fn has_timestamps(&self) -> bool {
-        self.timestamps
-    }
-
     fn storage<T: Pod>(&self, label: &str, data: &[T], zeroed: T) -> wgpu::Buffer {
         // WGSL runtime-sized arrays need a non-empty binding.
         let one = [zeroed];
