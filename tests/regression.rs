@@ -1,182 +1,163 @@
-//! Regression thresholds: runs experiments/ci.toml (small, a few seconds on lavapipe) and checks
-//! the committed bounds in experiments/ci-thresholds.toml. Times are recorded, never asserted.
+//! Regression thresholds: runs experiments/ci.toml (small, seconds on lavapipe) once and checks
+//! the committed bounds in experiments/ci-thresholds.toml; then, for every bound, breaks the
+//! property it protects and watches the check fail. Times are recorded, never asserted.
 
 mod common;
 
+use penumbra::experiment::reference::Reference;
+use penumbra::experiment::runner::{figure_samples, verdict_radius};
 use penumbra::experiment::{run_sweep, Spec};
-use penumbra::metrics::stats::mean_ci;
 use penumbra::render::open_backend;
-use penumbra::report::summary::{find, summarise};
-use penumbra::sampling::{DiskScheme, Pattern};
-use serde::Deserialize;
+use penumbra::report::summary::{summarise, Summary};
+use penumbra::report::thresholds::{Check, Thresholds};
+use penumbra::sampling::DiskScheme;
+use std::sync::OnceLock;
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Thresholds {
-    ground_truth: GroundTruth,
-    unbiased: Unbiased,
-    paper: Paper,
-    convergence: Convergence,
+struct Ci {
+    spec: Spec,
+    references: Vec<Reference>,
+    summaries: Vec<Summary>,
+    thresholds: Thresholds,
 }
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct GroundTruth {
-    max_abs_error: f64,
-    max_rmse: f64,
-    max_abs_bias: f64,
-    extent_tolerance_pixels: f64,
+
+/// The CI sweep, run once per test binary.
+fn ci() -> &'static Ci {
+    static CI: OnceLock<Ci> = OnceLock::new();
+    CI.get_or_init(|| {
+        // Hold the shared GPU (if any) so no other test in this binary uses it concurrently.
+        let _gpu = common::gpu();
+        let spec = Spec::load(&common::repo("experiments/ci.toml")).unwrap();
+        let thresholds = Thresholds::load(&common::repo("experiments/ci-thresholds.toml")).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let mut backend = open_backend(spec.backend).unwrap();
+        let out = run_sweep(
+            &spec,
+            backend.as_mut(),
+            &dir.path().join("journal"),
+            &dir.path().join("cache"),
+            true,
+        )
+        .unwrap();
+        assert_eq!(out.failures, 0);
+        let figure = (figure_samples(&spec), verdict_radius(&spec), 1);
+        let summaries = summarise(&out, &Default::default(), figure);
+        Ci {
+            spec,
+            references: out.references,
+            summaries,
+            thresholds,
+        }
+    })
 }
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Unbiased {
-    schemes: Vec<DiskScheme>,
-    max_bias_sigmas: f64,
-    bias_floor: f64,
-    min_samples: u32,
-    width_10_90_tolerance: f64,
+
+fn failures(checks: &[Check]) -> Vec<&Check> {
+    for c in checks {
+        eprintln!("{} {}", if c.ok { "ok  " } else { "FAIL" }, c.what);
+    }
+    checks.iter().filter(|c| !c.ok).collect()
 }
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Paper {
-    min_width_10_90_excess: f64,
-    max_width_10_90_excess: f64,
-}
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Convergence {
-    uniform_rmse_ratio_4_to_64: f64,
-    sobol_over_uniform_rmse_at_16: f64,
+
+fn radius() -> f64 {
+    ci().spec.axes.light_radii[0]
 }
 
 #[test]
 fn ci_experiment_stays_within_thresholds() {
-    // Hold the shared GPU (if any) so no other test in this binary uses it concurrently.
-    let _gpu = common::gpu();
-    let spec = Spec::load(&common::repo("experiments/ci.toml")).unwrap();
-    let t: Thresholds =
-        toml::from_str(&std::fs::read_to_string(common::repo("experiments/ci-thresholds.toml")).unwrap()).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let mut backend = open_backend(spec.backend).unwrap();
-    let out = run_sweep(
-        &spec,
-        backend.as_mut(),
-        &dir.path().join("journal"),
-        &dir.path().join("cache"),
-        true,
-    )
-    .unwrap();
-    assert_eq!(out.failures, 0);
-    let mut failures = Vec::new();
-    let mut check = |ok: bool, what: String| {
-        eprintln!("{} {what}", if ok { "ok  " } else { "FAIL" });
-        if !ok {
-            failures.push(what);
-        }
-    };
+    let c = ci();
+    let checks = c.thresholds.check_all(&c.references, &c.summaries, radius());
+    assert!(checks.len() >= 4 + 4 * 2 * 2 + 2 + 2, "{} checks", checks.len());
+    let failed = failures(&checks);
+    assert!(failed.is_empty(), "thresholds crossed: {failed:#?}");
+}
 
-    for r in &out.references {
-        let (gt_max, gt) = (r.gt_max_abs_all.unwrap(), r.gt_vs_exact.unwrap());
-        check(
-            gt_max <= t.ground_truth.max_abs_error,
-            format!(
-                "r={}: ground truth max |GT - exact| = {:.2e} <= {}",
-                r.light_radius, gt_max, t.ground_truth.max_abs_error
-            ),
-        );
-        check(
-            gt.rmse <= t.ground_truth.max_rmse,
-            format!(
-                "r={}: ground truth RMSE vs exact = {:.2e} <= {}",
-                r.light_radius, gt.rmse, t.ground_truth.max_rmse
-            ),
-        );
-        check(
-            gt.bias.abs() <= t.ground_truth.max_abs_bias,
-            format!(
-                "r={}: ground truth mean (GT - exact) = {:+.2e}, |.| <= {}",
-                r.light_radius, gt.bias, t.ground_truth.max_abs_bias
-            ),
-        );
-        let o = r.on_axis.as_ref().expect("the CI scene is on-axis");
-        let (inner, outer) = r.gt_profile.as_ref().unwrap().extent();
-        let tol = t.ground_truth.extent_tolerance_pixels * r.receivers.bin_width;
-        check(
-            (inner - o.umbra_radius()).abs() <= tol && (outer - o.penumbra_radius()).abs() <= tol,
-            format!(
-                "r={}: ground-truth extent [{inner:.5}, {outer:.5}] vs closed form [{:.5}, {:.5}] within {tol:.2e}",
-                r.light_radius,
-                o.umbra_radius(),
-                o.penumbra_radius()
-            ),
+#[test]
+fn the_unbiased_check_rejects_the_papers_biased_patterns() {
+    let c = ci();
+    for scheme in [DiskScheme::Paper, DiskScheme::PaperLiteral] {
+        let checks = c.thresholds.check_unbiased(&c.summaries, scheme, radius());
+        failures(&checks);
+        let bias_checks: Vec<&Check> = checks.iter().filter(|x| x.what.contains("squared bias")).collect();
+        assert!(!bias_checks.is_empty());
+        assert!(
+            bias_checks.iter().all(|x| !x.ok),
+            "{scheme} passed an unbiasedness check: {bias_checks:#?}"
         );
     }
+}
 
-    let summaries = summarise(&out);
-    let radius = spec.axes.light_radii[0];
-    for &scheme in &t.unbiased.schemes {
-        for pattern in [Pattern::PerPixel] {
-            for &n in spec.axes.samples.iter().filter(|&&n| n >= t.unbiased.min_samples) {
-                let biases: Vec<f64> = out
-                    .records
-                    .iter()
-                    .filter(|r| {
-                        r.get("scheme") == scheme.name()
-                            && r.get("pattern") == pattern.name()
-                            && r.num("samples") == n as f64
-                    })
-                    .map(|r| r.num("profile_bias"))
-                    .collect();
-                let (mean, ci) = mean_ci(&biases);
-                let se = ci / penumbra::metrics::stats::t975(biases.len() - 1);
-                let bound = t.unbiased.max_bias_sigmas * se + t.unbiased.bias_floor;
-                check(
-                    mean.abs() <= bound,
-                    format!("{scheme} ({pattern}) n={n}: mean profile bias {mean:+.2e} within {bound:.2e}"),
-                );
-                let s = find(&summaries, scheme, pattern, n, radius, 1).unwrap();
-                let rel = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
-                check(
-                    rel.abs() <= t.unbiased.width_10_90_tolerance,
-                    format!(
-                        "{scheme} ({pattern}) n={n}: 10-90 width {rel:+.3} relative to exact, within {}",
-                        t.unbiased.width_10_90_tolerance
-                    ),
-                );
+/// Each ground-truth bound fails for a ground truth broken in the way it guards against.
+#[test]
+fn the_ground_truth_checks_reject_broken_ground_truths() {
+    let c = ci();
+    let (w, h) = (c.spec.measure.width as usize, c.spec.measure.height as usize);
+    let reference = &c.references[0];
+    let failing = |r: &Reference| -> Vec<String> {
+        failures(&c.thresholds.check_ground_truth(r))
+            .iter()
+            .map(|x| x.what.clone())
+            .collect()
+    };
+    assert!(failing(reference).is_empty());
+    let on_receivers = |f: &dyn Fn(usize, f32) -> f32| {
+        let mut r = reference.clone();
+        for &(i, _) in &reference.receivers.pixels {
+            r.ground_truth[i] = f(i, reference.ground_truth[i]);
+        }
+        r
+    };
+    // The old shadow-ray offset: visibility biased by +7e-4 everywhere in the penumbra.
+    let offset = on_receivers(&|_, v| if v > 0.0 && v < 1.0 { v + 7e-4 } else { v });
+    assert!(failing(&offset).iter().any(|f| f.contains("mean (GT - exact)")));
+    // Too few rays: noise of 0.01 per pixel.
+    let noisy = on_receivers(&|i, v| {
+        let u = penumbra::sampling::Stream::new(3, 0, None).unit(i as u32);
+        (v + 0.02 * (u as f32 - 0.5) * 1.7).clamp(0.0, 1.0)
+    });
+    assert!(failing(&noisy).iter().any(|f| f.contains("GT RMSE")));
+    // One wrong pixel.
+    let mid = reference.mask.pixels[reference.mask.pixels.len() / 2];
+    let spike = on_receivers(&|i, v| if i == mid { (v - 0.05).max(0.0) } else { v });
+    let spiked = failing(&spike);
+    assert!(spiked.iter().any(|f| f.contains("max |GT - exact|")), "{spiked:?}");
+    // A blurred ground truth (a 7x7 box filter): its penumbra spreads past the closed-form radii.
+    let blurred = on_receivers(&|i, _| {
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        let mut sum = (0.0, 0);
+        for dy in -3..=3i64 {
+            for dx in -3..=3i64 {
+                let (u, v) = (x + dx, y + dy);
+                if u >= 0 && v >= 0 && (u as usize) < w && (v as usize) < h {
+                    let val = reference.ground_truth[v as usize * w + u as usize];
+                    if val >= 0.0 {
+                        sum = (sum.0 + val, sum.1 + 1);
+                    }
+                }
             }
         }
-    }
-    for &n in spec.axes.samples.iter().filter(|&&n| n >= 16) {
-        let s = find(&summaries, DiskScheme::Paper, Pattern::PerPixel, n, radius, 1).unwrap();
-        let excess = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
-        check(
-            excess >= t.paper.min_width_10_90_excess && excess <= t.paper.max_width_10_90_excess,
-            format!(
-                "paper (per-pixel) n={n}: 10-90 width excess {excess:+.3} in [{}, {}]",
-                t.paper.min_width_10_90_excess, t.paper.max_width_10_90_excess
-            ),
-        );
-    }
-    let rmse = |s: DiskScheme, n: u32| {
-        find(&summaries, s, Pattern::PerPixel, n, radius, 1)
-            .unwrap()
-            .mean("rmse")
-    };
-    let ratio = rmse(DiskScheme::Uniform, 64) / rmse(DiskScheme::Uniform, 4);
-    check(
-        ratio <= t.convergence.uniform_rmse_ratio_4_to_64,
-        format!(
-            "uniform RMSE(64)/RMSE(4) = {ratio:.3} <= {}",
-            t.convergence.uniform_rmse_ratio_4_to_64
-        ),
-    );
-    let ratio = rmse(DiskScheme::Sobol, 16) / rmse(DiskScheme::Uniform, 16);
-    check(
-        ratio <= t.convergence.sobol_over_uniform_rmse_at_16,
-        format!(
-            "sobol/uniform RMSE at 16 = {ratio:.3} <= {}",
-            t.convergence.sobol_over_uniform_rmse_at_16
-        ),
-    );
+        sum.0 / sum.1 as f32
+    });
+    assert!(failing(&blurred).iter().any(|f| f.contains("GT extent")));
+}
 
-    assert!(failures.is_empty(), "thresholds crossed:\n{}", failures.join("\n"));
+#[test]
+fn the_paper_width_check_rejects_an_unbiased_scheme() {
+    let c = ci();
+    let checks = c
+        .thresholds
+        .check_paper_width(&c.summaries, DiskScheme::Uniform, radius());
+    failures(&checks);
+    assert!(!checks.is_empty() && checks.iter().all(|x| !x.ok), "{checks:#?}");
+}
+
+#[test]
+fn the_convergence_checks_reject_a_scheme_that_stops_converging() {
+    let c = ci();
+    let checks = c.thresholds.check_convergence(
+        &c.summaries,
+        DiskScheme::PaperLiteral,
+        (DiskScheme::Uniform, DiskScheme::Uniform),
+        radius(),
+    );
+    failures(&checks);
+    assert!(checks.iter().all(|x| !x.ok), "{checks:#?}");
 }

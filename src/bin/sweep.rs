@@ -103,7 +103,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let results = Results {
         spec: &spec,
         outcome: &outcome,
-        pictures: &pictures,
+        pictures: pictures.as_ref(),
         adapter: &adapter,
         seconds,
         peak_rss: peak_rss(),

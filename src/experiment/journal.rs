@@ -1,22 +1,27 @@
 //! The resumable journal: completed groups are appended (records and bias/variance stats) and
 //! flushed as they finish, so an interrupted sweep picks up where it stopped. A group is taken
-//! from the journal only if every one of its run keys is there: a changed scene, view, ground
-//! truth or axis gives different keys and the group is rendered again.
+//! from the journal only if every one of its run keys is there: a changed scene, mesh file, view,
+//! ground truth, axis or device gives different keys and the group is rendered again. Timed
+//! frames are journaled apart, under the timing settings' key, when the timing phase finishes.
 
 use super::run::{num, Group, Record, RUN_COLUMNS};
 use super::runner::GroupStats;
+use super::timing::ConfigTiming;
+use crate::metrics::BiasVariance;
 use std::collections::HashMap;
 use std::fs::{self, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-const GROUP_COLUMNS: [&str; 4] = ["group_key", "seeds", "bias2", "variance"];
+const GROUP_COLUMNS: [&str; 5] = ["group_key", "seeds", "bias2", "bias2_ci95", "variance"];
+const TIMING_COLUMNS: [&str; 5] = ["key", "settings", "frame_seconds", "primary_seconds", "clock"];
 
-/// Appending journal in a folder (`runs.csv`, `groups.csv`).
+/// Appending journal in a folder (`runs.csv`, `groups.csv`, `timings.csv`).
 pub struct Journal {
     dir: PathBuf,
     runs: HashMap<String, Record>,
-    groups: HashMap<String, (usize, f64, f64)>,
+    groups: HashMap<String, BiasVariance>,
+    timings: HashMap<(String, String), ConfigTiming>,
 }
 
 impl Journal {
@@ -30,21 +35,66 @@ impl Journal {
             dir: dir.to_path_buf(),
             runs: HashMap::new(),
             groups: HashMap::new(),
+            timings: HashMap::new(),
         };
         for row in read_rows(&j.dir.join("runs.csv"), &RUN_COLUMNS) {
             j.runs.insert(row[0].clone(), Record(row));
         }
+        let float = |s: &str| if s.is_empty() { Some(f64::NAN) } else { s.parse().ok() };
         for row in read_rows(&j.dir.join("groups.csv"), &GROUP_COLUMNS) {
-            if let (Ok(k), Ok(b), Ok(v)) = (row[1].parse(), row[2].parse::<f64>(), row[3].parse::<f64>()) {
-                j.groups.insert(row[0].clone(), (k, b, v));
+            if let (Ok(seeds), Some(bias2), Some(bias2_ci), Some(variance)) =
+                (row[1].parse(), float(&row[2]), float(&row[3]), float(&row[4]))
+            {
+                let bv = BiasVariance {
+                    seeds,
+                    bias2,
+                    bias2_ci,
+                    variance,
+                };
+                j.groups.insert(row[0].clone(), bv);
+            }
+        }
+        let list = |s: &str| -> Option<Vec<f64>> { s.split_whitespace().map(|x| x.parse().ok()).collect() };
+        for row in read_rows(&j.dir.join("timings.csv"), &TIMING_COLUMNS) {
+            if let (Some(frame_seconds), Some(primary_seconds)) = (list(&row[2]), list(&row[3])) {
+                let t = ConfigTiming {
+                    frame_seconds,
+                    primary_seconds,
+                    clock: row[4].clone(),
+                };
+                j.timings.insert((row[0].clone(), row[1].clone()), t);
             }
         }
         Ok(j)
     }
 
+    /// The timed frames journaled for `key` under timing settings `settings`.
+    pub fn timing(&self, key: &str, settings: &str) -> Option<&ConfigTiming> {
+        self.timings.get(&(key.to_string(), settings.to_string()))
+    }
+
+    /// Appends timed configurations and flushes them to disk.
+    pub fn append_timings(&mut self, settings: &str, timings: &[(String, ConfigTiming)]) -> anyhow::Result<()> {
+        let join = |v: &[f64]| v.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(" ");
+        let rows = timings.iter().map(|(key, t)| {
+            vec![
+                key.clone(),
+                settings.to_string(),
+                join(&t.frame_seconds),
+                join(&t.primary_seconds),
+                t.clock.clone(),
+            ]
+        });
+        append_rows(&self.dir.join("timings.csv"), &TIMING_COLUMNS, rows)?;
+        for (key, t) in timings {
+            self.timings.insert((key.clone(), settings.to_string()), t.clone());
+        }
+        Ok(())
+    }
+
     /// The records and stats of `group` if it completed in an earlier sweep.
     pub fn completed(&self, group_key: &str, group: &Group, context: &str) -> Option<(Vec<Record>, GroupStats)> {
-        let &(seeds, bias2, variance) = self.groups.get(group_key)?;
+        let &split = self.groups.get(group_key)?;
         let records: Option<Vec<Record>> = group
             .runs
             .iter()
@@ -55,9 +105,7 @@ impl Journal {
             GroupStats {
                 key: group_key.to_string(),
                 run: *group.head(),
-                seeds,
-                bias2,
-                variance,
+                split,
             },
         ))
     }
@@ -73,15 +121,16 @@ impl Journal {
             &RUN_COLUMNS,
             records.iter().map(|r| r.0.clone()),
         )?;
+        let s = &stats.split;
         let row = vec![
             stats.key.clone(),
-            stats.seeds.to_string(),
-            num(stats.bias2),
-            num(stats.variance),
+            s.seeds.to_string(),
+            num(s.bias2),
+            num(s.bias2_ci),
+            num(s.variance),
         ];
         append_rows(&self.dir.join("groups.csv"), &GROUP_COLUMNS, std::iter::once(row))?;
-        self.groups
-            .insert(stats.key.clone(), (stats.seeds, stats.bias2, stats.variance));
+        self.groups.insert(stats.key.clone(), *s);
         Ok(())
     }
 }

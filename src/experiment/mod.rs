@@ -3,11 +3,13 @@
 
 pub mod fps;
 pub mod journal;
+pub mod measure;
 pub mod pictures;
 pub mod reference;
 pub mod run;
 pub mod runner;
 pub mod spec;
+pub mod timing;
 
 pub use run::{Record, Run};
 pub use runner::{run_sweep, Outcome};

@@ -2,8 +2,9 @@
 //! how far the ground truth is from the exact answer (the check that lets it judge the runs).
 
 use super::spec::Spec;
+use crate::fingerprint::fnv1a;
 use crate::metrics::{ErrorMetrics, PenumbraMask, RadialProfile, Receivers};
-use crate::reference::{visible_fraction, OnAxis};
+use crate::reference::{visible_fraction_estimate, Estimate, OnAxis};
 use crate::render::{Backend, Sampling, View, NO_RECEIVER};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::{Light, Scene};
@@ -15,6 +16,7 @@ use std::path::Path;
 pub const GROUND_TRUTH_SEED: u32 = 0x6a09_e667;
 
 /// Everything the runs of one (lights on, light radius) pair are judged against.
+#[derive(Clone)]
 pub struct Reference {
     /// Lights on.
     pub lights: u32,
@@ -26,20 +28,16 @@ pub struct Reference {
     /// Exact shadow image of receiver-plane pixels ([`NO_RECEIVER`] elsewhere), when the scene
     /// has an exact answer: disk lights and analytic shapes only.
     pub exact: Option<Vec<f32>>,
+    /// The exact image's quadrature accuracy, when there is an exact image.
+    pub exact_quality: Option<ExactQuality>,
     /// Receiver-plane pixels and their radii from the shadow's centre.
     pub receivers: Receivers,
-    /// Penumbra pixels of the ground truth (any surface).
+    /// Penumbra pixels of the ground truth on the receiver: every run is judged over these.
     pub mask: PenumbraMask,
     /// Closed-form radii, when one light is on and the scene is on-axis.
     pub on_axis: Option<OnAxis>,
     /// Radial profile of the exact image (on-axis scenes).
     pub exact_profile: Option<RadialProfile>,
-    /// Ground truth against exact over the penumbra.
-    pub gt_vs_exact: Option<ErrorMetrics>,
-    /// Largest |ground truth - exact| over every receiver pixel.
-    pub gt_max_abs_all: Option<f64>,
-    /// Radial profile of the ground truth (on-axis scenes).
-    pub gt_profile: Option<RadialProfile>,
 }
 
 /// The shadow image of a frame: per pixel, the mean visibility over its lights; pixels with no
@@ -66,6 +64,7 @@ impl Reference {
         lights: u32,
         radius: f64,
         cache: &Path,
+        context: &str,
     ) -> anyhow::Result<Reference> {
         let scene = spec.scene_with(lights, radius, spec.ground_truth.samples);
         let m = &spec.measure;
@@ -75,13 +74,8 @@ impl Reference {
             width: m.width,
             height: m.height,
         };
-        let key = format!(
-            "{};lights={lights};r={radius:e};{};build={:016x}",
-            super::run::context_key(spec),
-            backend.adapter().name,
-            build_id()
-        );
-        let file = cache.join(format!("ground-truth-{:016x}.bin", super::run::fnv1a(key.as_bytes())));
+        let key = format!("{context};lights={lights};r={radius:e};build={:016x}", build_id());
+        let file = cache.join(format!("ground-truth-{:016x}.bin", fnv1a(key.as_bytes())));
         let (ground_truth, hit) = match load_cached(&file, view) {
             Some(cached) => cached,
             None => {
@@ -109,30 +103,78 @@ impl Reference {
             crate::scene::camera::Projection::Perspective { .. } => unreachable!("validated orthographic"),
         };
         let receivers = Receivers::new(&scene, view, m.plane, &hit, centre, bin);
-        let exact = has_exact_answer(&scene).then(|| exact_image(&scene, view.pixels(), m.plane, &receivers));
-        let mask = PenumbraMask::from_reference(&ground_truth);
-        let gt_vs_exact = exact.as_ref().map(|e| ErrorMetrics::measure(&ground_truth, e, &mask));
-        let gt_max_abs_all = exact.as_ref().map(|e| {
-            receivers
-                .pixels
-                .iter()
-                .map(|&(i, _)| (ground_truth[i] - e[i]).abs() as f64)
-                .fold(0.0, f64::max)
-        });
-        let profile = |image: &[f32]| on_axis.is_some().then(|| RadialProfile::new(&receivers, image));
+        let (exact, exact_quality) = match has_exact_answer(&scene) {
+            true => {
+                let (image, quality) = exact_image(&scene, view.pixels(), m.plane, &receivers);
+                (Some(image), Some(quality))
+            }
+            false => (None, None),
+        };
+        let mask = PenumbraMask::new(&ground_truth, &receivers);
+        let exact_profile = exact
+            .as_deref()
+            .filter(|_| on_axis.is_some())
+            .map(|e| RadialProfile::new(&receivers, e));
         Ok(Reference {
             lights,
             light_radius: radius,
-            exact_profile: exact.as_deref().and_then(profile),
-            gt_profile: profile(&ground_truth),
+            exact_profile,
             ground_truth,
             exact,
+            exact_quality,
             receivers,
             mask,
             on_axis,
-            gt_vs_exact,
-            gt_max_abs_all,
         })
+    }
+
+    /// Ground truth against exact over the exact image's penumbra (on the receiver).
+    pub fn gt_vs_exact(&self) -> Option<ErrorMetrics> {
+        let e = self.exact.as_ref()?;
+        Some(ErrorMetrics::measure(
+            &self.ground_truth,
+            e,
+            &PenumbraMask::new(e, &self.receivers),
+        ))
+    }
+
+    /// Largest |ground truth - exact| over every receiver pixel.
+    pub fn gt_max_abs_all(&self) -> Option<f64> {
+        let e = self.exact.as_ref()?;
+        Some(
+            self.receivers
+                .pixels
+                .iter()
+                .map(|&(i, _)| (self.ground_truth[i] - e[i]).abs() as f64)
+                .fold(0.0, f64::max),
+        )
+    }
+
+    /// Radial profile of the ground truth (on-axis scenes).
+    pub fn gt_profile(&self) -> Option<RadialProfile> {
+        self.on_axis
+            .as_ref()
+            .map(|_| RadialProfile::new(&self.receivers, &self.ground_truth))
+    }
+}
+
+impl Reference {
+    /// What the log must say about this reference's own accuracy: where the exact quadrature
+    /// reached its depth limit, and its worst error bound.
+    pub fn warnings(&self) -> Vec<String> {
+        let Some(q) = self.exact_quality.filter(|q| q.depth_limited_pixels > 0) else {
+            return vec![];
+        };
+        vec![format!(
+            "{} light(s) of radius {} m: the exact quadrature reached its depth limit ({}) at {} of {} receiver pixels (a silhouette tangency or a discontinuity); worst error bound {:.1e} (tolerance {:.0e}), in ground_truth.csv",
+            self.lights,
+            self.light_radius,
+            crate::reference::quadrature::MAX_DEPTH,
+            q.depth_limited_pixels,
+            self.receivers.pixels.len(),
+            q.max_error_bound,
+            crate::reference::visibility::TOLERANCE
+        )]
     }
 }
 
@@ -141,9 +183,18 @@ pub fn has_exact_answer(scene: &Scene) -> bool {
     scene.bvh.is_none() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
 }
 
-/// Exact shadow image (mean over the scene's disk lights) at every receiver pixel (rayon; the
-/// penumbra dominates the cost).
-pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> Vec<f32> {
+/// How accurate an exact image is, from its quadrature's own estimates.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ExactQuality {
+    /// Worst error bound of a receiver pixel's visibility.
+    pub max_error_bound: f64,
+    /// Receiver pixels where some quadrature panel reached the depth limit.
+    pub depth_limited_pixels: usize,
+}
+
+/// Exact shadow image (mean over the scene's disk lights) at every receiver pixel, with its
+/// quadrature's accuracy (rayon; the penumbra dominates the cost).
+pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> (Vec<f32>, ExactQuality) {
     let pl = &scene.planes[plane];
     let points: Vec<(usize, glam::DVec3)> = receivers
         .pixels
@@ -156,21 +207,32 @@ pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Recei
         .iter()
         .filter_map(|l| if let Light::Disk(d) = l { Some(d) } else { None })
         .collect();
-    let values: Vec<(usize, f32)> = points
+    let values: Vec<(usize, f32, Estimate)> = points
         .par_iter()
         .map(|&(i, p)| {
-            let v: f64 = disks
+            let e = disks
                 .iter()
-                .map(|l| visible_fraction(p, pl.normal, l, &scene.spheres, &scene.planes))
-                .sum();
-            (i, (v / disks.len() as f64) as f32)
+                .map(|l| visible_fraction_estimate(p, pl.normal, l, &scene.spheres, &scene.planes))
+                .fold(Estimate::default(), |a, b| a + b);
+            let k = disks.len() as f64;
+            (
+                i,
+                (e.value / k) as f32,
+                Estimate {
+                    error: e.error / k,
+                    ..e
+                },
+            )
         })
         .collect();
     let mut image = vec![NO_RECEIVER; pixels];
-    for (i, v) in values {
+    let mut quality = ExactQuality::default();
+    for (i, v, e) in values {
         image[i] = v;
+        quality.max_error_bound = quality.max_error_bound.max(e.error);
+        quality.depth_limited_pixels += (e.depth_limited > 0) as usize;
     }
-    image
+    (image, quality)
 }
 
 const MAGIC: &[u8; 8] = b"PNBRGT01";
@@ -182,7 +244,7 @@ fn build_id() -> u64 {
     *ID.get_or_init(|| {
         std::env::current_exe()
             .and_then(std::fs::read)
-            .map_or(0, |bytes| super::run::fnv1a(&bytes))
+            .map_or(0, |bytes| fnv1a(&bytes))
     })
 }
 

@@ -2,6 +2,8 @@
 //! plain data, one record per row of runs.csv in tidy form.
 
 use super::spec::Spec;
+use crate::fingerprint::fnv1a;
+use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 
 /// One point of the sweep.
@@ -68,21 +70,25 @@ pub fn expand(spec: &Spec) -> Vec<Group> {
     groups
 }
 
-/// 64-bit FNV-1a: a stable hash (std's hasher may change between releases).
-pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
-/// Everything besides the run's own axes that determines its result.
-pub fn context_key(spec: &Spec) -> String {
+/// Everything besides the run's own axes that determines its result: the scene file and the
+/// content of every file it reads, the measuring view, the ground truth, and the device that
+/// renders (another backend or adapter never resumes this one's rows). Timing settings key the
+/// timing journal instead (see `timing`), so changing them re-times without re-rendering.
+pub fn context_key(spec: &Spec, adapter: &AdapterInfo) -> String {
+    let meshes: Vec<String> = spec
+        .scene
+        .meshes
+        .iter()
+        .map(|m| format!("{:016x}", m.file_fnv1a))
+        .collect();
     format!(
-        "scene={:016x};measure={:?};gt={};plane={}",
+        "scene={:016x};meshes=[{}];measure={:?};gt={};plane={};device={:?}",
         fnv1a(spec.scene_text.as_bytes()),
+        meshes.join(","),
         (&spec.measure.camera, spec.measure.width, spec.measure.height),
         spec.ground_truth.samples,
-        spec.measure.plane
+        spec.measure.plane,
+        (&adapter.backend, &adapter.name, &adapter.driver, &adapter.api),
     )
 }
 
@@ -108,7 +114,7 @@ pub fn num(x: f64) -> String {
 }
 
 /// Columns of runs.csv, in order. Each is defined in `metrics` or README.md.
-pub const RUN_COLUMNS: [&str; 41] = [
+pub const RUN_COLUMNS: [&str; 44] = [
     "run_key",
     "status",
     "scheme",
@@ -138,6 +144,9 @@ pub const RUN_COLUMNS: [&str; 41] = [
     "primary_rays",
     "shadow_rays",
     "frame_ms",
+    "frame_ms_q1",
+    "frame_ms_q3",
+    "timed_frames",
     "rays_per_s",
     "primary_rays_per_s",
     "shadow_rays_per_s",
@@ -172,5 +181,11 @@ impl Record {
     /// The value of `column` as a number (NaN when empty).
     pub fn num(&self, column: &str) -> f64 {
         self.get(column).parse().unwrap_or(f64::NAN)
+    }
+
+    /// Sets `column` to `value`.
+    pub fn set(&mut self, column: &str, value: String) {
+        let i = RUN_COLUMNS.iter().position(|c| *c == column).expect("known column");
+        self.0[i] = value;
     }
 }

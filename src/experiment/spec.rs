@@ -83,20 +83,24 @@ pub struct GroundTruth {
     pub samples: u32,
 }
 
-/// Frame timing.
+/// Frame timing (see `experiment::timing`).
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TimingSpec {
-    /// Untimed frames before the timed ones (beyond the frame read back for metrics).
+    /// Untimed frames rendered right before each timed frame.
     pub warmup: u32,
-    /// Timed frames; their median is reported. 0 disables timing (runs.csv is then
-    /// byte-reproducible: times are the only values that vary between identical runs).
+    /// Interleaved rounds, one timed frame per configuration each; the median and quartiles
+    /// are reported. 0 disables timing (runs.csv is then byte-reproducible: times are the only
+    /// values that vary between identical runs); otherwise at least [`MIN_TIMED_REPEATS`].
     pub repeats: u32,
 }
 
+/// Fewest timed frames per configuration that give a median and an interquartile range.
+pub const MIN_TIMED_REPEATS: u32 = 5;
+
 impl Default for TimingSpec {
     fn default() -> Self {
-        TimingSpec { warmup: 1, repeats: 3 }
+        TimingSpec { warmup: 1, repeats: 5 }
     }
 }
 
@@ -260,6 +264,22 @@ impl Spec {
             return Err(err(
                 &key_path!["ground_truth", "samples"],
                 format!("must be in 1..={MAX_SAMPLES}"),
+            ));
+        }
+        let t = &f.timing;
+        if t.repeats != 0 && !(MIN_TIMED_REPEATS..=1000).contains(&t.repeats) {
+            return Err(err(
+                &key_path!["timing", "repeats"],
+                format!(
+                    "must be 0 (no timing) or in {MIN_TIMED_REPEATS}..=1000 (a median and quartiles need at least {MIN_TIMED_REPEATS} frames), got {}",
+                    t.repeats
+                ),
+            ));
+        }
+        if t.warmup > 100 {
+            return Err(err(
+                &key_path!["timing", "warmup"],
+                format!("must be in 0..=100, got {}", t.warmup),
             ));
         }
         if let Some(fig) = &f.figures {

@@ -2,8 +2,12 @@
 //! the submodule that computes it; the runner combines them into one record per run.
 
 pub mod error;
+pub mod extent;
+pub mod flip;
 pub mod profile;
+pub mod seeds;
 pub mod stats;
 
-pub use error::{ErrorMetrics, PenumbraMask};
+pub use error::{penumbra_coverage, ErrorMetrics, PenumbraMask};
 pub use profile::{RadialProfile, Receivers};
+pub use seeds::BiasVariance;

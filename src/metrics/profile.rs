@@ -3,10 +3,9 @@
 //!
 //! - Profile: V(r_b) = mean of the visibility of receiver pixels whose distance from the shadow's
 //!   centre falls in bin b (bins one pixel wide).
-//! - Extent ("how far partial shadow reaches", as an eye reads an image): inner = the first bin,
-//!   going outwards, in which at least [`SHARE`] of the pixels see some light (V > 0); outer =
-//!   the last bin in which at least [`SHARE`] of the pixels are shadowed (V < 1). For the exact
-//!   image these are the umbra and penumbra radii r_u and r_p.
+//! - Extent: see [`super::extent`] (a sliding one-pixel annulus).
+//! - Profile bias: mean of (profile - exact profile) over the bins inside the exact extent, signed
+//!   and absolute.
 //! - 10-90 % width: r(V = 0.9) - r(V = 0.1), each the first crossing going outwards, linearly
 //!   interpolated between bin centres.
 
@@ -14,10 +13,7 @@ use crate::render::View;
 use crate::scene::Scene;
 use glam::DVec3;
 
-/// Share of a bin's pixels that must show (partial) shadow or light to count towards the extent.
-pub const SHARE: f64 = 0.05;
-/// Bins with fewer pixels are left out of the extent (patch corners).
-pub const MIN_BIN_PIXELS: usize = 8;
+use super::extent::Annuli;
 
 /// The receiver-plane pixels of a view: their ground points and distances from the shadow centre.
 #[derive(Clone, Debug)]
@@ -76,7 +72,7 @@ impl Receivers {
     }
 }
 
-/// A radial profile with the per-bin counts the extent needs.
+/// A radial profile (per-bin means) and the pixels the extent is read from.
 #[derive(Clone, Debug)]
 pub struct RadialProfile {
     /// Bin centres (m).
@@ -85,10 +81,8 @@ pub struct RadialProfile {
     pub mean: Vec<f64>,
     /// Pixels per bin.
     pub count: Vec<usize>,
-    /// Pixels with V < 1 per bin.
-    pub shadowed: Vec<usize>,
-    /// Pixels with V > 0 per bin.
-    pub lit: Vec<usize>,
+    /// The pixels themselves, for the extent.
+    pub annuli: Annuli,
 }
 
 impl RadialProfile {
@@ -100,16 +94,19 @@ impl RadialProfile {
             radius: bins.clone().map(|b| receivers.bin_centre(b)).collect(),
             mean: vec![0.0; n],
             count: vec![0; n],
-            shadowed: vec![0; n],
-            lit: vec![0; n],
+            annuli: Annuli::new(
+                receivers
+                    .pixels
+                    .iter()
+                    .map(|&(i, r)| (r, visibility[i] as f64))
+                    .collect(),
+                receivers.bin_width,
+            ),
         };
         for &(i, r) in &receivers.pixels {
             let b = receivers.bin(r) - bins.start;
-            let v = visibility[i] as f64;
-            p.mean[b] += v;
+            p.mean[b] += visibility[i] as f64;
             p.count[b] += 1;
-            p.shadowed[b] += (v < 1.0) as usize;
-            p.lit[b] += (v > 0.0) as usize;
         }
         for (m, &c) in p.mean.iter_mut().zip(&p.count) {
             *m = if c > 0 { *m / c as f64 } else { f64::NAN };
@@ -117,18 +114,9 @@ impl RadialProfile {
         p
     }
 
-    /// Inner and outer extent of partial shadow (m); NaN when no bin qualifies.
+    /// Inner and outer extent of partial shadow (m), see [`super::extent`].
     pub fn extent(&self) -> (f64, f64) {
-        let ok = |b: usize| self.count[b] >= MIN_BIN_PIXELS;
-        let share = |k: usize, b: usize| k as f64 / self.count[b] as f64;
-        let inner = (0..self.radius.len()).find(|&b| ok(b) && share(self.lit[b], b) >= SHARE);
-        let outer = (0..self.radius.len())
-            .rev()
-            .find(|&b| ok(b) && share(self.shadowed[b], b) >= SHARE);
-        (
-            inner.map_or(f64::NAN, |b| self.radius[b]),
-            outer.map_or(f64::NAN, |b| self.radius[b]),
-        )
+        self.annuli.extent()
     }
 
     /// First radius, going outwards, where the mean profile reaches `level` (interpolated).
@@ -152,6 +140,25 @@ impl RadialProfile {
     /// 10-90 % width (m).
     pub fn width_10_90(&self) -> f64 {
         self.crossing(0.9) - self.crossing(0.1)
+    }
+
+    /// Signed and absolute mean of (self - exact) over the bins inside the exact profile's extent;
+    /// NaN when no bin is.
+    pub fn bias_against(&self, exact: &RadialProfile) -> (f64, f64) {
+        let (lo, hi) = exact.extent();
+        let diffs: Vec<f64> = (0..self.radius.len().min(exact.radius.len()))
+            .filter(|&b| self.radius[b] >= lo && self.radius[b] <= hi)
+            .map(|b| self.mean[b] - exact.mean[b])
+            .filter(|d| !d.is_nan())
+            .collect();
+        if diffs.is_empty() {
+            return (f64::NAN, f64::NAN);
+        }
+        let n = diffs.len() as f64;
+        (
+            diffs.iter().sum::<f64>() / n,
+            diffs.iter().map(|d| d.abs()).sum::<f64>() / n,
+        )
     }
 }
 
@@ -183,7 +190,52 @@ mod tests {
         let (rec, vis) = synthetic(&values);
         let p = RadialProfile::new(&rec, &vis);
         assert!((p.width_10_90() - 8.0).abs() < 1e-6, "{}", p.width_10_90());
+        // Every pixel of a bin sits at its centre, so an annulus's share jumps from 0 to 1 when it
+        // reaches the first lit (r = 2.5) or last shadowed (r = 11.5) pixels: at 2.0 and 12.0.
         let (inner, outer) = p.extent();
-        assert_eq!((inner, outer), (2.5, 11.5));
+        assert!(
+            (inner - 2.0).abs() < 1.0 / 32.0 && (outer - 12.0).abs() < 1.0 / 32.0,
+            "{inner} {outer}"
+        );
+    }
+
+    /// 100 pixels spread evenly inside each of 10 bins, with visibility `v(r)`.
+    fn radial(v: impl Fn(f64) -> f64) -> (Receivers, Vec<f32>) {
+        let values: Vec<(f64, f32)> = (0..10 * 100)
+            .map(|k| {
+                let r = (k as f64 + 0.5) / 100.0;
+                (r, v(r) as f32)
+            })
+            .collect();
+        synthetic(&values)
+    }
+
+    #[test]
+    fn bias_against_the_exact_profile_covers_its_extent_only() {
+        // Exact penumbra from r = 3 to 7: extent [2.55, 7.45], bins 3 to 6 inside.
+        let (rec, exact) = radial(|r| ((r - 3.0) / 4.0).clamp(0.0, 1.0));
+        let exact_profile = RadialProfile::new(&rec, &exact);
+        // Add 0.1 to every pixel of bin 4 and subtract 0.3 in bin 8, outside the exact extent.
+        let mut image = exact.clone();
+        for &(i, r) in &rec.pixels {
+            if (4.0..5.0).contains(&r) {
+                image[i] += 0.1;
+            }
+            if (8.0..9.0).contains(&r) {
+                image[i] -= 0.3;
+            }
+        }
+        let (lo, hi) = exact_profile.extent();
+        let inside: Vec<usize> = (0..exact_profile.radius.len())
+            .filter(|&b| exact_profile.radius[b] >= lo && exact_profile.radius[b] <= hi)
+            .collect();
+        assert_eq!(inside, vec![3, 4, 5, 6], "extent [{lo}, {hi}]");
+        let (signed, abs) = RadialProfile::new(&rec, &image).bias_against(&exact_profile);
+        assert!(
+            (signed - 0.025).abs() < 1e-6 && (abs - 0.025).abs() < 1e-6,
+            "{signed} {abs}"
+        );
+        let (signed, _) = RadialProfile::new(&rec, &exact).bias_against(&exact_profile);
+        assert_eq!(signed, 0.0);
     }
 }

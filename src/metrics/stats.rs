@@ -1,4 +1,5 @@
-//! Summary statistics over seeds: means with 95 % Student-t confidence intervals, medians.
+//! Summary statistics: means over seeds with 95 % Student-t confidence intervals; medians and
+//! quartiles of repeated timings.
 
 /// Two-sided 97.5 % quantiles of Student's t for 1..=30 degrees of freedom.
 const T975: [f64; 30] = [
@@ -42,6 +43,22 @@ pub fn median(values: &[f64]) -> f64 {
     }
 }
 
+/// First quartile, median and third quartile (linear interpolation between order statistics,
+/// Hyndman & Fan's type 7, as R and numpy default to); NaN when empty.
+pub fn quartiles(values: &[f64]) -> (f64, f64, f64) {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| {
+        if v.is_empty() {
+            return f64::NAN;
+        }
+        let h = p * (v.len() - 1) as f64;
+        let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+        v[lo] + (h - lo as f64) * (v[hi] - v[lo])
+    };
+    (q(0.25), q(0.5), q(0.75))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,5 +78,14 @@ mod tests {
         assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
         assert!(median(&[]).is_nan());
+    }
+
+    #[test]
+    fn quartiles_of_known_samples() {
+        assert_eq!(quartiles(&[5.0, 1.0, 3.0, 2.0, 4.0]), (2.0, 3.0, 4.0));
+        // numpy.percentile([1, 2, 3, 4], [25, 50, 75]) = 1.75, 2.5, 3.25.
+        assert_eq!(quartiles(&[4.0, 1.0, 2.0, 3.0]), (1.75, 2.5, 3.25));
+        assert_eq!(quartiles(&[7.0]), (7.0, 7.0, 7.0));
+        assert!(quartiles(&[]).1.is_nan());
     }
 }

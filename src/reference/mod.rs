@@ -9,4 +9,5 @@ pub mod quadrature;
 pub mod visibility;
 
 pub use on_axis::OnAxis;
-pub use visibility::visible_fraction;
+pub use quadrature::Estimate;
+pub use visibility::{visible_fraction, visible_fraction_estimate};

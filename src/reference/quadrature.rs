@@ -44,26 +44,58 @@ fn panel(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
     (k * h, ((k - g) * h).abs())
 }
 
+/// Bisection depth at which a panel is accepted whatever its error estimate.
+pub const MAX_DEPTH: u32 = 40;
+
+/// An integral with what the adaptive rule knows of its accuracy.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    /// The integral.
+    pub value: f64,
+    /// Sum of |Kronrod - Gauss| over the accepted panels: the rule's (usually pessimistic) bound
+    /// on |value - integral|.
+    pub error: f64,
+    /// Panels accepted at [`MAX_DEPTH`] with their error still above their share of the
+    /// tolerance: where the integrand could not be resolved (a jump, or a tolerance below what
+    /// f64 can deliver). Never silent: callers report it.
+    pub depth_limited: u32,
+}
+
+impl std::ops::Add for Estimate {
+    type Output = Estimate;
+    fn add(self, o: Estimate) -> Estimate {
+        Estimate {
+            value: self.value + o.value,
+            error: self.error + o.error,
+            depth_limited: self.depth_limited + o.depth_limited,
+        }
+    }
+}
+
 /// Integral of `f` over [a, b] to absolute tolerance `tol`, starting from `panels` equal panels
 /// (a feature narrower than all 15 nodes of a panel can be missed by any adaptive rule; the
 /// initial grid bounds how narrow that is) and bisecting panels whose error estimate exceeds
-/// their share of `tol`, down to depth 40.
-pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels: u32) -> f64 {
+/// their share of `tol`, down to [`MAX_DEPTH`].
+pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels: u32) -> Estimate {
     let h = (b - a) / panels as f64;
     (0..panels)
         .map(|i| {
             let (x0, x1) = (a + h * i as f64, a + h * (i + 1) as f64);
             integrate(&f, x0, x1, tol / panels as f64)
         })
-        .sum()
+        .fold(Estimate::default(), |acc, e| acc + e)
 }
 
 /// Integral of `f` over [a, b] to absolute tolerance `tol` (bisecting panels whose error
-/// estimate exceeds their share), stopping at depth 40.
-pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
-    fn rec(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> f64 {
-        if whole.1 <= tol || depth >= 40 {
-            return whole.0;
+/// estimate exceeds their share), stopping at [`MAX_DEPTH`].
+pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Estimate {
+    fn rec(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> Estimate {
+        if whole.1 <= tol || depth >= MAX_DEPTH {
+            return Estimate {
+                value: whole.0,
+                error: whole.1,
+                depth_limited: (whole.1 > tol) as u32,
+            };
         }
         let m = 0.5 * (a + b);
         let (l, r) = (panel(f, a, m), panel(f, m, b));
@@ -76,12 +108,42 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// The estimate is within its own error bound of the known integral and the bound is within
+    /// the tolerance asked for.
+    fn converges(e: Estimate, exact: f64, tol: f64) {
+        assert!(
+            (e.value - exact).abs() <= e.error + 4.0 * f64::EPSILON * exact.abs(),
+            "{e:?} vs {exact}"
+        );
+        assert!(e.error <= tol, "{e:?}");
+    }
+
     #[test]
     fn smooth_and_kinked_integrands() {
-        assert!((integrate(|x| x.sin(), 0.0, std::f64::consts::PI, 1e-13) - 2.0).abs() < 1e-12);
-        assert!((integrate(|x| (x - 0.3).abs(), 0.0, 1.0, 1e-12) - 0.29).abs() < 1e-11);
-        // Square-root endpoint behaviour, as at a tangency of the occluder's silhouette.
-        let v = integrate(|x| (1.0 - x * x).max(0.0).sqrt(), -1.0, 1.0, 1e-11);
-        assert!((v - std::f64::consts::FRAC_PI_2).abs() < 1e-9, "{v}");
+        let e = integrate(|x| x.sin(), 0.0, std::f64::consts::PI, 1e-13);
+        converges(e, 2.0, 1e-13);
+        assert_eq!(e.depth_limited, 0);
+        let e = integrate(|x| (x - 0.3).abs(), 0.0, 1.0, 1e-12);
+        converges(e, 0.29, 1e-12);
+        assert_eq!(e.depth_limited, 0);
+        // Square-root endpoint behaviour, as at a tangency of the occluder's silhouette: the
+        // panels touching the endpoints reach the depth limit (their share of the tolerance
+        // halves with every bisection, faster than their error falls), yet the total meets it.
+        let e = integrate(|x| (1.0 - x * x).max(0.0).sqrt(), -1.0, 1.0, 1e-11);
+        converges(e, std::f64::consts::FRAC_PI_2, 1e-11);
+        assert!(e.depth_limited > 0, "{e:?}");
+        let e = integrate_panels(|x| x.exp(), 0.0, 1.0, 1e-12, 16);
+        converges(e, std::f64::consts::E - 1.0, 1e-12);
+    }
+
+    #[test]
+    fn a_jump_reaches_the_depth_limit_and_says_so() {
+        let e = integrate(|x| if x < 1.0 / 3.0 { 0.0 } else { 1.0 }, 0.0, 1.0, 1e-13);
+        assert!(e.depth_limited >= 1, "{e:?}");
+        assert!((e.value - 2.0 / 3.0).abs() <= e.error + 1e-15, "{e:?}");
+        assert!(e.error < 1e-10, "the limit still bounds the damage: {e:?}");
+        // A tolerance below f64 resolution cannot be met.
+        let e = integrate(|x| x.sqrt(), 0.0, 1.0, 1e-30);
+        assert!(e.depth_limited > 0 && e.error > 1e-30, "{e:?}");
     }
 }

@@ -10,7 +10,7 @@
 //! known-facts.md, generalised to any number of spheres and planes and to lights that touch or
 //! enter an occluder.
 
-use super::quadrature::integrate_panels;
+use super::quadrature::{integrate_panels, Estimate};
 use crate::scene::{DiskLight, Plane, Sphere};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
@@ -26,14 +26,30 @@ const PANELS: u32 = 128;
 /// horizon counts as an occluder), with `spheres` and `planes` as occluders. Planes through `p`
 /// are the receiver itself and are skipped.
 pub fn visible_fraction(p: DVec3, n: DVec3, light: &DiskLight, spheres: &[Sphere], planes: &[Plane]) -> f64 {
+    visible_fraction_estimate(p, n, light, spheres, planes).value
+}
+
+/// [`visible_fraction`] with the quadrature's error bound and depth-limited panels (in units of
+/// V: the integral's divided by the disk's area).
+pub fn visible_fraction_estimate(
+    p: DVec3,
+    n: DVec3,
+    light: &DiskLight,
+    spheres: &[Sphere],
+    planes: &[Plane],
+) -> Estimate {
+    let exactly = |value: f64| Estimate {
+        value,
+        ..Default::default()
+    };
     if light.normal.dot(p - light.center) <= 0.0 {
-        return 0.0; // behind the one-sided emitter
+        return exactly(0.0); // behind the one-sided emitter
     }
     if spheres
         .iter()
         .any(|s| (p - s.center).length_squared() < s.radius * s.radius)
     {
-        return 0.0;
+        return exactly(0.0);
     }
     let scale = (p - light.center).length().max(light.radius);
     let occluding_planes: Vec<&Plane> = planes
@@ -41,7 +57,7 @@ pub fn visible_fraction(p: DVec3, n: DVec3, light: &DiskLight, spheres: &[Sphere
         .filter(|pl| (p - pl.point).dot(pl.normal).abs() > 1e-12 * scale.max(pl.point.length()))
         .collect();
     if occluding_planes.is_empty() && unoccluded_and_above_horizon(p, n, light, spheres) {
-        return 1.0;
+        return exactly(1.0);
     }
     let (u, v) = light.basis();
     let a = light.radius;
@@ -57,7 +73,12 @@ pub fn visible_fraction(p: DVec3, n: DVec3, light: &DiskLight, spheres: &[Sphere
         )
     };
     let total = integrate_panels(chord, 0.0, TAU, TOLERANCE * PI * a * a, PANELS);
-    (total / (PI * a * a)).clamp(0.0, 1.0)
+    let area = PI * a * a;
+    Estimate {
+        value: (total.value / area).clamp(0.0, 1.0),
+        error: total.error / area,
+        depth_limited: total.depth_limited,
+    }
 }
 
 /// Conservative test that nothing can hide any part of the light: the whole disk is above the
@@ -174,6 +195,32 @@ mod tests {
         let a2 = r2 * r2 * ((d * d + r2 * r2 - r1 * r1) / (2.0 * d * r2)).acos();
         let k = 0.5 * ((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2)).sqrt();
         a1 + a2 - k
+    }
+
+    /// Across the shipped sphere scene's penumbra (r_u = 0.3306 m to r_p = 0.3455 m and a little
+    /// beyond), the quadrature's own error bound meets the tolerance asked for. Panels next to a
+    /// tangency of the sphere's silhouette with the disk's rim (a square-root endpoint) reach the
+    /// depth limit with errors far below the tolerance; they are counted, not hidden.
+    #[test]
+    fn error_bounds_of_the_shipped_scene_meet_the_tolerance() {
+        let l = down_light(DVec3::new(0.0, 0.0, 2.0), 0.02);
+        let s = [Sphere {
+            center: DVec3::new(0.0, 0.0, 0.5),
+            radius: 0.25,
+            albedo: 0.8,
+        }];
+        let (mut partial, mut limited) = (0, 0);
+        for k in 0..300 {
+            let (r, phi) = (0.328 + 0.02 * k as f64 / 300.0, 2.399_963 * k as f64);
+            let p = DVec3::new(r * phi.cos(), r * phi.sin(), 0.0);
+            let e = visible_fraction_estimate(p, DVec3::Z, &l, &s, &[]);
+            assert!(e.error <= TOLERANCE, "r = {r}: {e:?}");
+            assert_eq!(e.value, visible_fraction(p, DVec3::Z, &l, &s, &[]));
+            partial += (e.value > 0.0 && e.value < 1.0) as u32;
+            limited += (e.depth_limited > 0) as u32;
+        }
+        assert!(partial > 200, "{partial} of 300 points in the penumbra");
+        eprintln!("{limited} of 300 points reached the depth limit somewhere");
     }
 
     #[test]

@@ -39,12 +39,21 @@ pub fn grey(values: &[f32], width: u32, height: u32) -> Rgb {
     Rgb { width, height, data }
 }
 
-/// Radiance tone-mapped for display: x / (1 + x) after scaling the 99th percentile to 1, then
-/// sRGB-like gamma 1/2.2.
+/// Radiance tone-mapped for display with its own exposure ([`exposure`]).
 pub fn tonemap(values: &[f32], width: u32, height: u32) -> Rgb {
+    tonemap_with(values, width, height, exposure(values))
+}
+
+/// The exposure of a picture: the 99th percentile of its positive radiance.
+pub fn exposure(values: &[f32]) -> f64 {
     let mut sorted: Vec<f32> = values.iter().copied().filter(|v| *v > 0.0).collect();
     sorted.sort_by(f32::total_cmp);
-    let p99 = sorted.get(sorted.len() * 99 / 100).copied().unwrap_or(1.0).max(1e-12) as f64;
+    sorted.get(sorted.len() * 99 / 100).copied().unwrap_or(1.0).max(1e-12) as f64
+}
+
+/// Radiance tone-mapped for display: x / (1 + x) after scaling `p99` to 1, then sRGB-like gamma
+/// 1/2.2. Pictures compared with each other share one exposure (the reference's).
+pub fn tonemap_with(values: &[f32], width: u32, height: u32, p99: f64) -> Rgb {
     let data = values
         .iter()
         .flat_map(|&v| {

@@ -1,25 +1,19 @@
 //! report.md: what was run, the scene's acceleration structure, how far the ground truth is
 //! from the exact answer, the verdict, what accuracy costs in time, and where the outputs are.
 
+use super::numbers::or_na;
 use super::summary::{find, Summary};
 use super::verdict::Verdict;
 use crate::experiment::runner::{figure_samples, Outcome};
+use crate::experiment::timing::faster;
 use crate::experiment::Spec;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 
-/// The light radius the verdict is read at: the paper's 2 cm if swept, else the nearest.
-pub fn verdict_radius(spec: &Spec) -> f64 {
-    *spec
-        .axes
-        .light_radii
-        .iter()
-        .min_by(|a, b| (*a - 0.02).abs().total_cmp(&(*b - 0.02).abs()))
-        .expect("non-empty")
-}
+pub use crate::experiment::runner::verdict_radius;
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
-    x.filter(|v| v.is_finite()).map_or("n/a".into(), f)
+    or_na(x.unwrap_or(f64::NAN), f)
 }
 
 /// The report's markdown.
@@ -71,19 +65,23 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
         "Ground truth: jittered sampling, {} shadow rays per pixel per light, {}x{} pixels. Exact: adaptive quadrature of the visible part of each disk (tolerance 1e-10), available for disk lights over spheres and planes; mesh scenes are judged against the ground truth alone.\n\n",
         spec.ground_truth.samples, spec.measure.width, spec.measure.height
     );
-    s += "| lights | light radius (m) | r_u closed form (m) | r_p closed form (m) | GT max abs error (receiver pixels) | GT RMSE (penumbra) | GT mean error (penumbra) | penumbra pixels |\n|---|---|---|---|---|---|---|---|\n";
+    s += "GT errors are over receiver pixels; RMSE and mean error over the exact image's penumbra. The exact image's own error is the quadrature's bound (its worst pixel), with the pixels where a panel reached the depth limit.\n\n";
+    s += "| lights | light radius (m) | r_u closed form (m) | r_p closed form (m) | GT max abs error | GT RMSE (penumbra) | GT mean error (penumbra) | penumbra pixels | exact error bound | depth-limited pixels |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for r in &outcome.references {
         let o = r.on_axis.as_ref();
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.lights,
             r.light_radius,
             opt(o.map(|o| o.umbra_radius()), |x| format!("{x:.5}")),
             opt(o.map(|o| o.penumbra_radius()), |x| format!("{x:.5}")),
-            opt(r.gt_max_abs_all, |x| format!("{x:.2e}")),
-            opt(r.gt_vs_exact.map(|e| e.rmse), |x| format!("{x:.2e}")),
-            opt(r.gt_vs_exact.map(|e| e.bias), |x| format!("{x:+.1e}")),
-            r.mask.pixels.len()
+            opt(r.gt_max_abs_all(), |x| format!("{x:.2e}")),
+            opt(r.gt_vs_exact().map(|e| e.rmse), |x| format!("{x:.2e}")),
+            opt(r.gt_vs_exact().map(|e| e.bias), |x| format!("{x:+.1e}")),
+            r.mask.pixels.len(),
+            opt(r.exact_quality.map(|q| q.max_error_bound), |x| format!("{x:.1e}")),
+            r.exact_quality
+                .map_or("n/a".into(), |q| q.depth_limited_pixels.to_string()),
         );
     }
     let verdicts: Vec<Verdict> = [Pattern::PerPixel, Pattern::Shared]
@@ -101,7 +99,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
         }
     }
     for &lights in &spec.axes.light_counts {
-        s += &cost_section(summaries, n, radius, lights);
+        s += &cost_section(outcome, summaries, n, radius, lights);
     }
     s += "\n## Outputs\n\n- `runs.csv`: one row per run; `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
     s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time (any scene).\n";
@@ -109,14 +107,45 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     s
 }
 
+/// "12.3 ms [11.9, 12.8]": median and interquartile range of a frame time.
+fn ms_iqr((q1, med, q3): (f64, f64, f64)) -> String {
+    if med.is_finite() {
+        format!("{med:.2} ms [{q1:.2}, {q3:.2}]")
+    } else {
+        "n/a".into()
+    }
+}
+
+/// The noise floor: one configuration's spread over the whole timing phase.
+fn noise_floor(outcome: &Outcome) -> String {
+    let Some((run, t)) = &outcome.timings.noise else {
+        return String::new();
+    };
+    let (q1, med, q3) = t.frame_ms();
+    format!(
+        "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint; otherwise they are equal within timing noise.\n\n",
+        t.frame_seconds.len() / crate::experiment::timing::NOISE_VISITS as usize,
+        t.clock,
+        run.scheme,
+        run.pattern,
+        run.samples,
+        run.light_radius,
+        t.frame_seconds.len(),
+        ms_iqr((q1, med, q3)),
+        100.0 * (q3 - q1) / med
+    )
+}
+
 /// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
-/// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count.
-fn cost_section(summaries: &[Summary], n: u32, radius: f64, lights: u32) -> String {
+/// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked
+/// against uniform's time only where the interquartile ranges are disjoint.
+fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, lights: u32) -> String {
     let mut s = format!(
-        "\n## What accuracy costs ({lights} light(s))\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra; `lost`: share of the true penumbra shown fully lit or fully dark. `to match uniform@{n}`: the fewest swept rays at which the scheme's RMSE is at or below uniform's at {n} rays, and that configuration's median frame time.\n\n"
+        "\n## What accuracy costs ({lights} light(s))\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [first, third quartile] of the timed frames. `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and how it ranks against uniform@{n}'s.\n\n"
     );
-    s += &format!("| scheme | RMSE @{n} | lost @{n} | frame ms @{n} | rays/s @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|\n");
-    let target = find(summaries, DiskScheme::Uniform, Pattern::PerPixel, n, radius, lights).map(|u| u.mean("rmse"));
+    s += &noise_floor(outcome);
+    s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays/s @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|---|\n");
+    let uniform = find(summaries, DiskScheme::Uniform, Pattern::PerPixel, n, radius, lights);
     for scheme in DiskScheme::ALL {
         let Some(at) = find(summaries, scheme, Pattern::PerPixel, n, radius, lights) else {
             continue;
@@ -131,18 +160,27 @@ fn cost_section(summaries: &[Summary], n: u32, radius: f64, lights: u32) -> Stri
             })
             .collect();
         rows.sort_by_key(|x| x.run.samples);
-        let matched = target
-            .and_then(|t| rows.iter().find(|x| x.mean("rmse") <= t))
-            .map_or("not reached".to_string(), |x| {
-                format!("{} rays, {:.2} ms", x.run.samples, x.mean("frame_ms"))
+        let matched = uniform
+            .and_then(|u| rows.iter().find(|x| x.mean("rmse") <= u.mean("rmse")).map(|x| (x, u)))
+            .map_or("not reached".to_string(), |(x, u)| {
+                let rank = match (&x.timing, &u.timing) {
+                    (Some(a), Some(b)) => match faster(a, b) {
+                        Some(true) => "faster than uniform",
+                        Some(false) => "slower than uniform",
+                        None => "equal within timing noise",
+                    },
+                    _ => "untimed",
+                };
+                format!("{} rays, {}, {rank}", x.run.samples, ms_iqr(x.frame_ms()))
             });
         s += &format!(
-            "| {} | {:.4} | {:.3} | {:.2} | {:.3e} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
             scheme,
-            at.mean("rmse"),
-            at.mean("penumbra_lost_share"),
-            at.mean("frame_ms"),
-            at.mean("rays_per_s"),
+            or_na(at.mean("rmse"), |x| format!("{x:.4}")),
+            or_na(at.flip.0, |x| format!("{x:.4}")),
+            or_na(at.mean("penumbra_lost_share"), |x| format!("{x:.3}")),
+            ms_iqr(at.frame_ms()),
+            or_na(at.rays_per_s[0], |x| format!("{x:.3e}")),
             matched
         );
     }

@@ -1,14 +1,17 @@
-//! summary.csv: the runs of each configuration aggregated over seeds, means with 95 % CIs,
-//! and the per-pixel bias/variance split of the group.
+//! summary.csv: the runs of each configuration aggregated over seeds (means with 95 % CIs), its
+//! frame time (median and quartiles of its interleaved timed frames), the per-pixel bias/variance
+//! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
 use crate::experiment::run::num;
 use crate::experiment::runner::{GroupStats, Outcome};
+use crate::experiment::timing::ConfigTiming;
 use crate::experiment::{Record, Run};
 use crate::metrics::stats::mean_ci;
 use crate::sampling::{DiskScheme, Pattern};
+use std::collections::BTreeMap;
 
-/// Metrics aggregated as mean and CI half-width.
-pub const AGGREGATED: [&str; 14] = [
+/// Metrics aggregated over seeds as mean and CI half-width.
+pub const AGGREGATED: [&str; 10] = [
     "extent_width",
     "width_10_90",
     "profile_bias",
@@ -19,11 +22,10 @@ pub const AGGREGATED: [&str; 14] = [
     "rmse_exact",
     "penumbra_area_ratio",
     "penumbra_lost_share",
-    "frame_ms",
-    "rays_per_s",
-    "primary_rays_per_s",
-    "shadow_rays_per_s",
 ];
+
+/// FLIP of each seed's picture, per (scheme, pattern) at the figure ray count.
+pub type PictureFlip = BTreeMap<(DiskScheme, Pattern), Vec<f64>>;
 
 /// One configuration (all axes but the seed) summarised.
 #[derive(Clone, Debug)]
@@ -34,12 +36,20 @@ pub struct Summary {
     pub seeds: usize,
     /// (mean, ci95 half-width) per [`AGGREGATED`] metric.
     pub values: Vec<(f64, f64)>,
-    /// Exact 10-90 width and extent width of the configuration's light radius.
+    /// Exact 10-90 width of the configuration's light radius.
     pub exact_width_10_90: f64,
-    /// Exact extent width (r_p - r_u from the exact image).
+    /// Exact extent width (from the exact image, read with the same annulus as the runs).
     pub exact_extent_width: f64,
+    /// Closed-form penumbra width r_p - r_u (on-axis scenes).
+    pub closed_form_width: f64,
     /// Bias/variance split.
     pub stats: GroupStats,
+    /// Timed frames of the configuration, if timed.
+    pub timing: Option<ConfigTiming>,
+    /// Rays per second at the median frame time: all, primary, shadow.
+    pub rays_per_s: [f64; 3],
+    /// Mean and 95 % CI half-width of the FLIP of its pictures over seeds (NaN without pictures).
+    pub flip: (f64, f64),
 }
 
 impl Summary {
@@ -52,14 +62,22 @@ impl Summary {
     pub fn ci(&self, name: &str) -> f64 {
         self.values[index(name)].1
     }
+
+    /// First quartile, median and third quartile of the frame time (ms); NaN when untimed.
+    pub fn frame_ms(&self) -> (f64, f64, f64) {
+        self.timing
+            .as_ref()
+            .map_or((f64::NAN, f64::NAN, f64::NAN), ConfigTiming::frame_ms)
+    }
 }
 
 fn index(name: &str) -> usize {
     AGGREGATED.iter().position(|m| *m == name).expect("aggregated metric")
 }
 
-/// Summaries of every group of the outcome, in canonical order.
-pub fn summarise(outcome: &Outcome) -> Vec<Summary> {
+/// Summaries of every group of the outcome, in canonical order; `flip` gives the picture errors
+/// of the configurations at (`samples`, `radius`, `lights`) that have pictures.
+pub fn summarise(outcome: &Outcome, flip: &PictureFlip, figure: (u32, f64, u32)) -> Vec<Summary> {
     outcome
         .groups
         .iter()
@@ -74,13 +92,22 @@ pub fn summarise(outcome: &Outcome) -> Vec<Summary> {
                 .map(|m| mean_ci(&rows.iter().map(|r| r.num(m)).collect::<Vec<_>>()))
                 .collect();
             let first = |c: &str| rows.first().map_or(f64::NAN, |r| r.num(c));
+            let at_figure = (g.run.samples, g.run.light_radius, g.run.lights) == figure;
+            let flip = flip
+                .get(&(g.run.scheme, g.run.pattern))
+                .filter(|_| at_figure)
+                .map_or((f64::NAN, f64::NAN), |v| mean_ci(v));
             Summary {
                 run: g.run,
                 seeds: rows.len(),
                 values,
                 exact_width_10_90: first("exact_width_10_90"),
                 exact_extent_width: first("exact_extent_width"),
+                closed_form_width: first("exact_penumbra_radius") - first("exact_umbra_radius"),
                 stats: g.clone(),
+                timing: outcome.timings.configs.get(&g.key).cloned(),
+                rays_per_s: ["rays_per_s", "primary_rays_per_s", "shadow_rays_per_s"].map(first),
+                flip,
             }
         })
         .collect()
@@ -131,7 +158,24 @@ pub fn header() -> Vec<String> {
         h.push(format!("{m}_mean"));
         h.push(format!("{m}_ci95"));
     }
-    h.extend(["bias2", "variance", "pixel_std"].map(String::from));
+    h.extend(
+        [
+            "frame_ms_median",
+            "frame_ms_q1",
+            "frame_ms_q3",
+            "timed_frames",
+            "rays_per_s",
+            "primary_rays_per_s",
+            "shadow_rays_per_s",
+            "bias2",
+            "bias2_ci95",
+            "variance",
+            "pixel_std",
+            "flip_mean",
+            "flip_ci95",
+        ]
+        .map(String::from),
+    );
     h
 }
 
@@ -151,6 +195,24 @@ pub fn row(s: &Summary) -> Vec<String> {
         r.push(num(*m));
         r.push(num(*c));
     }
-    r.extend([num(s.stats.bias2), num(s.stats.variance), num(s.stats.variance.sqrt())]);
+    let (q1, med, q3) = s.frame_ms();
+    let split = &s.stats.split;
+    r.extend([
+        num(med),
+        num(q1),
+        num(q3),
+        s.timing
+            .as_ref()
+            .map_or(String::new(), |t| t.frame_seconds.len().to_string()),
+    ]);
+    r.extend(s.rays_per_s.map(num));
+    r.extend([
+        num(split.bias2),
+        num(split.bias2_ci),
+        num(split.variance),
+        num(split.variance.sqrt()),
+        num(s.flip.0),
+        num(s.flip.1),
+    ]);
     r
 }

@@ -2,14 +2,17 @@
 //! the manifest last.
 
 use super::files::{write_atomic, write_csv};
-use super::images::{diverging, grey, tonemap, write_exr, Rgb};
+use super::images::{diverging, grey, write_exr, Rgb};
 use super::markdown::{report, verdict_radius};
+use super::pictures::{picture_flip, write_fig2_picture};
 use super::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
 use super::summary::{self, Summary};
+use crate::experiment::pictures::Pictures;
 use crate::experiment::run::{num, RUN_COLUMNS};
 use crate::experiment::runner::{figure_samples, Outcome};
+use crate::experiment::timing::ConfigTiming;
 use crate::experiment::Spec;
-use crate::render::{AdapterInfo, Frame};
+use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
@@ -19,8 +22,8 @@ pub struct Results<'a> {
     pub spec: &'a Spec,
     /// The sweep's outcome.
     pub outcome: &'a Outcome,
-    /// Fig. 2-style pictures.
-    pub pictures: &'a [(String, Frame)],
+    /// Fig. 2-style pictures, when the experiment has `[figures]`.
+    pub pictures: Option<&'a Pictures>,
     /// The device.
     pub adapter: &'a AdapterInfo,
     /// Wall-clock seconds of the sweep.
@@ -31,7 +34,13 @@ pub struct Results<'a> {
 
 /// Writes every output under `out`.
 pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
-    let summaries = summary::summarise(r.outcome);
+    let flip = match r.pictures {
+        Some(p) => picture_flip(p)?,
+        None => Default::default(),
+    };
+    let lights = *r.spec.axes.light_counts.iter().max().expect("validated non-empty");
+    let figure = (figure_samples(r.spec), verdict_radius(r.spec), lights);
+    let summaries = summary::summarise(r.outcome, &flip, figure);
     write_csv(
         &out.join("runs.csv"),
         &RUN_COLUMNS,
@@ -44,6 +53,7 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
         summaries.iter().map(summary::row),
     )?;
     write_ground_truth(r, out)?;
+    write_timings(r, out)?;
     write_plots(r, &summaries, &out.join("plots"))?;
     write_images(r, &out.join("images"))?;
     write_atomic(
@@ -70,6 +80,8 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
         "gt_rmse_penumbra",
         "gt_bias_penumbra",
         "penumbra_pixels",
+        "exact_max_error_bound",
+        "exact_depth_limited_pixels",
     ];
     let nan2 = (f64::NAN, f64::NAN);
     let rows = r.outcome.references.iter().map(|x| {
@@ -78,7 +90,7 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
             .as_ref()
             .map_or(nan2, |o| (o.umbra_radius(), o.penumbra_radius()));
         let (ei, eo) = x.exact_profile.as_ref().map_or(nan2, |p| p.extent());
-        let (gi, go) = x.gt_profile.as_ref().map_or(nan2, |p| p.extent());
+        let (gi, go) = x.gt_profile().map_or(nan2, |p| p.extent());
         vec![
             x.lights.to_string(),
             num(x.light_radius),
@@ -90,14 +102,67 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
             num(x.exact_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90())),
             num(gi),
             num(go),
-            num(x.gt_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90())),
-            num(x.gt_max_abs_all.unwrap_or(f64::NAN)),
-            num(x.gt_vs_exact.map_or(f64::NAN, |e| e.rmse)),
-            num(x.gt_vs_exact.map_or(f64::NAN, |e| e.bias)),
+            num(x.gt_profile().map_or(f64::NAN, |p| p.width_10_90())),
+            num(x.gt_max_abs_all().unwrap_or(f64::NAN)),
+            num(x.gt_vs_exact().map_or(f64::NAN, |e| e.rmse)),
+            num(x.gt_vs_exact().map_or(f64::NAN, |e| e.bias)),
             x.mask.pixels.len().to_string(),
+            num(x.exact_quality.map_or(f64::NAN, |q| q.max_error_bound)),
+            x.exact_quality
+                .map_or(String::new(), |q| q.depth_limited_pixels.to_string()),
         ]
     });
     write_csv(&out.join("ground_truth.csv"), &header, rows)
+}
+
+/// timings.csv: every timed frame, one row each, so the spread behind each median can be seen.
+fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
+    let t = &r.outcome.timings;
+    if t.configs.is_empty() {
+        return Ok(());
+    }
+    let header = [
+        "scheme",
+        "pattern",
+        "samples",
+        "light_radius",
+        "lights",
+        "noise_probe",
+        "frame",
+        "frame_ms",
+        "primary_ms",
+        "clock",
+    ];
+    let rows = |run: &crate::experiment::Run, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
+        c.frame_seconds
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                vec![
+                    run.scheme.to_string(),
+                    run.pattern.to_string(),
+                    run.samples.to_string(),
+                    num(run.light_radius),
+                    run.lights.to_string(),
+                    probe.to_string(),
+                    i.to_string(),
+                    num(s * 1e3),
+                    num(c.primary_seconds.get(i).map_or(f64::NAN, |p| p * 1e3)),
+                    c.clock.clone(),
+                ]
+            })
+            .collect()
+    };
+    let mut all = Vec::new();
+    for g in &r.outcome.groups {
+        if let Some(c) = t.configs.get(&g.key) {
+            all.extend(rows(&g.run, false, c));
+        }
+    }
+    if let Some((run, c)) = &t.noise {
+        all.extend(rows(run, true, c));
+    }
+    write_csv(&out.join("timings.csv"), &header, all)
 }
 
 /// Which summaries a plot shows.
@@ -197,7 +262,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
                 true,
             )
         },
-        &series(summaries, at_radius, |s| s.mean("frame_ms"), "rmse", 1.0),
+        &series(summaries, at_radius, |s| s.frame_ms().1, "rmse", 1.0),
         &[],
     )?;
     let Some((ri, reference)) = r
@@ -385,14 +450,8 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
         let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
         image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
     }
-    if !r.pictures.is_empty() {
-        let tiles: Vec<(String, Rgb)> = r
-            .pictures
-            .iter()
-            .map(|(l, f)| (l.clone(), tonemap(&f.radiance, f.width, f.height)))
-            .collect();
-        let refs: Vec<(String, &Rgb)> = tiles.iter().map(|(l, i)| (l.clone(), i)).collect();
-        image_grid(&dir.join("fig2_picture.png"), &refs, 2)?;
+    if let Some(p) = r.pictures {
+        write_fig2_picture(p, spec.axes.seeds[0], &dir.join("fig2_picture.png"))?;
     }
     Ok(())
 }
@@ -423,7 +482,7 @@ pub fn git_commit() -> String {
 fn manifest(r: &Results) -> String {
     let s = r.spec;
     let a = r.adapter;
-    let hash = |t: &str| format!("{:016x}", crate::experiment::run::fnv1a(t.as_bytes()));
+    let hash = |t: &str| format!("{:016x}", crate::fingerprint::fnv1a(t.as_bytes()));
     let experiment_text = std::fs::read_to_string(&s.path).unwrap_or_default();
     let q = |t: &str| format!("{t:?}");
     let list = |v: Vec<String>| format!("[{}]", v.join(", "));
@@ -452,6 +511,12 @@ fn manifest(r: &Results) -> String {
     m += &format!(
         "seeds = {}\n",
         list(s.axes.seeds.iter().map(|x| x.to_string()).collect())
+    );
+    m += &format!(
+        "timing_warmup = {}\ntiming_repeats = {}\ntiming_order_seed = {}\n",
+        s.timing.warmup,
+        s.timing.repeats,
+        crate::experiment::timing::ORDER_SEED
     );
     m += &format!(
         "ground_truth_samples = {}\nground_truth_seed = {}\n",

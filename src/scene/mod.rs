@@ -98,6 +98,8 @@ impl Light {
 pub struct Mesh {
     /// Where it came from, for messages.
     pub source: String,
+    /// FNV-1a of the file's bytes: keys cached and resumed results, so an edited file is re-run.
+    pub file_fnv1a: u64,
     /// Lambertian albedo.
     pub albedo: f64,
     /// Triangles kept.
@@ -280,8 +282,10 @@ impl Scene {
                 );
             }
             triangles.mesh_of.extend(std::iter::repeat_n(i as u32, kept.len()));
+            let bytes = std::fs::read(&path).map_err(|e| source.error(&at("path"), e.to_string()))?;
             meshes.push(Mesh {
                 source: path.display().to_string(),
+                file_fnv1a: crate::fingerprint::fnv1a(&bytes),
                 albedo,
                 triangles: kept.len(),
                 skipped,

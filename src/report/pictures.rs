@@ -1,0 +1,63 @@
+//! The Fig. 2 pictures as a person sees them: tone-mapped with the ground-truth picture's
+//! exposure, tiled into fig2_picture.png, and each measured against the ground-truth picture
+//! with FLIP (Andersson et al. 2020), the perceptual stand-in for the paper's "equal quality".
+
+use super::images::{exposure, tonemap_with, Rgb};
+use super::plots::image_grid;
+use super::summary::PictureFlip;
+use crate::experiment::pictures::{Picture, Pictures};
+use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
+use crate::sampling::{DiskScheme, Pattern};
+use std::path::Path;
+
+fn display(p: &Picture, p99: f64) -> Rgb {
+    tonemap_with(&p.frame.radiance, p.frame.width, p.frame.height, p99)
+}
+
+/// Mean FLIP of every picture against the ground-truth picture, per (scheme, pattern), one value
+/// per seed in seed order.
+pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
+    let gt = &pictures.ground_truth;
+    let p99 = exposure(&gt.frame.radiance);
+    let reference = display(gt, p99);
+    let mut out = PictureFlip::new();
+    for p in &pictures.runs {
+        let test = display(p, p99);
+        let e = flip_mean(
+            &reference.data,
+            &test.data,
+            reference.width,
+            reference.height,
+            PIXELS_PER_DEGREE,
+        )?;
+        out.entry((p.scheme, p.pattern)).or_default().push(e);
+    }
+    Ok(out)
+}
+
+/// fig2_picture.png: uniform (per-pixel), the paper's pattern (shared and per-pixel) at the first
+/// seed, and the ground truth, all at the ground truth's exposure.
+pub fn write_fig2_picture(pictures: &Pictures, seed: u32, path: &Path) -> anyhow::Result<()> {
+    let gt = &pictures.ground_truth;
+    let p99 = exposure(&gt.frame.radiance);
+    let mut tiles: Vec<(String, Rgb)> = Vec::new();
+    for (scheme, pattern) in [
+        (DiskScheme::Uniform, Pattern::PerPixel),
+        (DiskScheme::Paper, Pattern::Shared),
+        (DiskScheme::Paper, Pattern::PerPixel),
+    ] {
+        let found = pictures
+            .runs
+            .iter()
+            .find(|p| p.scheme == scheme && p.pattern == pattern && p.seed == seed);
+        if let Some(p) = found {
+            tiles.push((format!("{scheme} ({pattern}), {} rays", p.samples), display(p, p99)));
+        }
+    }
+    tiles.push((
+        format!("jittered (ground truth), {} rays", gt.samples),
+        display(gt, p99),
+    ));
+    let refs: Vec<(String, &Rgb)> = tiles.iter().map(|(l, i)| (l.clone(), i)).collect();
+    image_grid(path, &refs, 2)
+}

@@ -1,0 +1,80 @@
+//! The summary and the verdict, checked against values recomputed by hand from the runs of small
+//! CPU sweeps: means and Student-t intervals over seeds, the exact MSE = bias^2 + variance
+//! identity through the whole pipeline, and a verdict that never claims what its seeds cannot
+//! support and never prints NaN.
+
+mod common;
+
+use penumbra::experiment::{run_sweep, Outcome, Spec};
+use penumbra::render::cpu::CpuBackend;
+use penumbra::report::summary::{find, summarise, Summary};
+use penumbra::report::verdict::Verdict;
+use penumbra::sampling::{DiskScheme, Pattern};
+
+fn sweep(seeds: &str) -> (Outcome, Vec<Summary>) {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t.replace("seeds = [1, 2]", seeds));
+    let spec = Spec::load(&exp).unwrap();
+    let mut cpu = CpuBackend::default();
+    let out = run_sweep(&spec, &mut cpu, &dir.path().join("j"), &dir.path().join("c"), true).unwrap();
+    let summaries = summarise(&out, &Default::default(), (16, 0.02, 1));
+    (out, summaries)
+}
+
+#[test]
+fn summaries_match_the_runs_recomputed_by_hand() {
+    let (out, summaries) = sweep("seeds = [1, 2, 3]");
+    for s in &summaries {
+        let rows: Vec<_> = out
+            .records
+            .iter()
+            .filter(|r| {
+                r.get("scheme") == s.run.scheme.name()
+                    && r.get("pattern") == s.run.pattern.name()
+                    && r.num("samples") == s.run.samples as f64
+            })
+            .collect();
+        assert_eq!((rows.len(), s.seeds), (3, 3));
+        let x: Vec<f64> = rows.iter().map(|r| r.num("rmse")).collect();
+        let mean = x.iter().sum::<f64>() / 3.0;
+        let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        assert!((s.mean("rmse") - mean).abs() < 1e-15);
+        // Student's t for 2 degrees of freedom: 4.303.
+        assert!((s.ci("rmse") - 4.303 * sd / 3f64.sqrt()).abs() < 1e-12);
+        // Over the same mask, the mean of the runs' MSE is exactly bias^2 + variance.
+        let mse = x.iter().map(|v| v * v).sum::<f64>() / 3.0;
+        let split = s.stats.split;
+        assert!(
+            (mse - (split.bias2 + split.variance)).abs() < 1e-6 * mse,
+            "{mse} vs {split:?}"
+        );
+        assert!(split.bias2_ci.is_finite() && split.bias2_ci > 0.0);
+        // Untimed (repeats = 0): no frame time, not a zero one.
+        assert!(s.frame_ms().1.is_nan() && s.timing.is_none());
+    }
+}
+
+#[test]
+fn the_verdict_needs_two_seeds_and_never_prints_nan() {
+    let (_, one) = sweep("seeds = [1]");
+    let v = Verdict::new(&one, 16, 0.02, Pattern::PerPixel).unwrap();
+    let text = v.markdown();
+    assert!(text.contains("No verdict"), "{text}");
+    assert!(
+        !text.contains("disjoint") && !text.contains("NaN") && !text.contains("± 0.00"),
+        "{text}"
+    );
+    assert!(text.contains("± n/a"), "{text}");
+    assert!(!v.wider() && !v.extent.a_below());
+
+    let (_, three) = sweep("seeds = [1, 2, 3]");
+    let v = Verdict::new(&three, 16, 0.02, Pattern::PerPixel).unwrap();
+    let text = v.markdown();
+    assert!(!text.contains("No verdict") && !text.contains("NaN"), "{text}");
+    // Squared biases read as values with their intervals, never bare (or negative) numbers.
+    for scheme in [DiskScheme::Paper, DiskScheme::Uniform] {
+        let s = find(&three, scheme, Pattern::PerPixel, 16, 0.02, 1).unwrap();
+        let b = penumbra::report::numbers::bias2(&s.stats.split);
+        assert!(b.contains(" ± ") && text.contains(&b), "{b} not in {text}");
+    }
+}

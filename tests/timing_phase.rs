@@ -1,0 +1,112 @@
+//! The timing phase, against a backend whose clock drifts: every configuration is timed once
+//! (not once per seed) in interleaved rounds with warm-up frames, the noise probe is visited
+//! across the rounds, drift does not rank configurations that do the same work, and a resumed
+//! sweep reuses the journaled timings.
+
+mod common;
+
+use penumbra::experiment::timing::{faster, NOISE_VISITS};
+use penumbra::experiment::{run_sweep, Spec};
+use penumbra::render::cpu::CpuBackend;
+use penumbra::render::{AdapterInfo, Backend, Clock, Frame, Sampling, Timing, View};
+use penumbra::sampling::DiskScheme;
+use penumbra::scene::Scene;
+
+/// Renders on the CPU; `time` returns 10 ms plus a drift of 0.1 ms per call, and logs its calls.
+struct Drifting {
+    cpu: CpuBackend,
+    calls: Vec<(Sampling, u32, u32, u32)>,
+}
+
+impl Backend for Drifting {
+    fn adapter(&self) -> &AdapterInfo {
+        self.cpu.adapter()
+    }
+    fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
+        self.cpu.render(scene, view, s)
+    }
+    fn time(&mut self, scene: &Scene, _: View, s: Sampling, warmup: u32, repeats: u32) -> anyhow::Result<Timing> {
+        let samples = match &scene.lights[0] {
+            penumbra::scene::Light::Disk(d) => d.samples,
+            _ => 1,
+        };
+        self.calls.push((s, samples, warmup, repeats));
+        let t = 10e-3 + 1e-4 * self.calls.len() as f64;
+        Ok(Timing {
+            seconds: vec![t; repeats as usize],
+            primary_seconds: vec![],
+            clock: Clock::WallClock,
+        })
+    }
+}
+
+#[test]
+fn configurations_are_timed_once_in_interleaved_rounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| {
+        t.replace("warmup = 0\nrepeats = 0", "warmup = 2\nrepeats = 5")
+    });
+    let spec = Spec::load(&exp).unwrap();
+    let mut backend = Drifting {
+        cpu: CpuBackend::default(),
+        calls: vec![],
+    };
+    let (journal, cache) = (dir.path().join("j"), dir.path().join("c"));
+    let out = run_sweep(&spec, &mut backend, &journal, &cache, true).unwrap();
+    // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 5 rounds,
+    // plus the noise probe's visits.
+    let configs = 8;
+    let per_round = configs + NOISE_VISITS as usize;
+    assert_eq!(backend.calls.len(), 5 * per_round);
+    assert!(
+        backend.calls.iter().all(|c| c.2 == 2 && c.3 == 1),
+        "warm-up frames, one timed frame"
+    );
+    assert!(
+        backend.calls.iter().all(|c| c.0.seed == 1),
+        "timed with the first seed only"
+    );
+    let rounds: Vec<Vec<(DiskScheme, u32)>> = backend
+        .calls
+        .chunks(per_round)
+        .map(|r| r.iter().map(|c| (c.0.scheme, c.1)).collect())
+        .collect();
+    assert!(rounds.windows(2).all(|w| w[0] != w[1]), "every round has its own order");
+    assert_eq!(out.timings.configs.len(), configs);
+    let (probe, noise) = out.timings.noise.as_ref().expect("a noise probe");
+    assert_eq!(noise.frame_seconds.len(), 5 * NOISE_VISITS as usize);
+    assert_eq!((probe.scheme, probe.samples), (DiskScheme::Uniform, 16));
+    for r in &out.records {
+        assert_eq!(r.get("timed_frames"), "5");
+        let (q1, med, q3) = (r.num("frame_ms_q1"), r.num("frame_ms"), r.num("frame_ms_q3"));
+        assert!(q1 <= med && med <= q3 && q1 > 10.0, "{q1} {med} {q3}");
+    }
+    // Every configuration does the same (fake) work; the drift must not rank any two of them.
+    let all: Vec<_> = out.timings.configs.values().collect();
+    for a in &all {
+        for b in &all {
+            assert_eq!(faster(a, b), None, "{:?} vs {:?}", a.frame_ms(), b.frame_ms());
+        }
+    }
+    // A resumed sweep takes the timings from the journal and times nothing.
+    backend.calls.clear();
+    let again = run_sweep(&spec, &mut backend, &journal, &cache, false).unwrap();
+    assert!(backend.calls.is_empty(), "{} frames re-timed", backend.calls.len());
+    assert_eq!(again.timings.configs, out.timings.configs);
+    assert_eq!(again.timings.noise.as_ref().map(|n| &n.1), Some(noise));
+    let frame_ms = |o: &penumbra::experiment::Outcome| -> Vec<String> {
+        o.records.iter().map(|r| r.get("frame_ms").to_string()).collect()
+    };
+    assert_eq!(frame_ms(&again), frame_ms(&out));
+}
+
+#[test]
+fn timing_asks_for_at_least_five_repeats() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 3"));
+    let e = Spec::load(&exp).unwrap_err().to_string();
+    assert!(
+        e.contains("tiny.toml:") && e.contains("timing.repeats") && e.contains("at least 5"),
+        "{e}"
+    );
+}
