@@ -25,6 +25,7 @@ impl Default for CpuBackend {
                 name: "penumbra f64 reference".into(),
                 driver: format!("rayon, {} threads", rayon::current_num_threads()),
                 api: "cpu".into(),
+                loop_cap: None,
             },
         }
     }

@@ -125,6 +125,8 @@ pub struct AdapterInfo {
     pub driver: String,
     /// Graphics API under wgpu (Vulkan, Metal, ...), or the CPU thread count.
     pub api: String,
+    /// Iterations after which the adapter leaves a loop, where it caps them (Mesa's llvmpipe).
+    pub loop_cap: Option<u32>,
 }
 
 /// A renderer of scenes into frames.

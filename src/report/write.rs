@@ -530,6 +530,9 @@ fn manifest(r: &Results) -> String {
         q(&a.driver),
         q(&a.api)
     );
+    if let Some(cap) = a.loop_cap {
+        m += &format!("loop_iteration_cap = {cap}\n");
+    }
     m += &format!("[plan]\nfirst_run = {}\n", q(r.outcome.plan.to_string().trim()));
     m
 }

@@ -126,9 +126,29 @@ impl DiskScheme {
 /// successive spiral points never line up radially (Vogel 1979).
 pub const GOLDEN_TURN: u32 = 0x61c8_8647;
 
+/// floor(sqrt(n)) exactly, digit by digit: the same integer algorithm as the WGSL twin, where a
+/// float sqrt may land an ULP low on some drivers.
+pub fn isqrt(n: u32) -> u32 {
+    let (mut rest, mut root) = (n, 0u32);
+    let mut bit = 1u32 << 30;
+    while bit > n {
+        bit >>= 2;
+    }
+    while bit != 0 {
+        if rest >= root + bit {
+            rest -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
+}
+
 /// Grid of equal strata for n jittered samples: (rows, cols), rows <= cols, rows * cols = n.
 pub fn strata(n: u32) -> (u32, u32) {
-    let mut rows = (n as f64).sqrt().floor() as u32;
+    let mut rows = isqrt(n);
     while rows > 1 && n % rows != 0 {
         rows -= 1;
     }
@@ -271,6 +291,23 @@ mod tests {
             // Same angle and random a; radius 0.3 + r versus centre (0.3, 0.3) with radius r.
             let r = a[k].length() - 0.3;
             assert!(((b[k] - DVec2::splat(0.3)).length() - r).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn integer_square_roots_are_exact() {
+        for n in 0..=(1u32 << 20) {
+            assert_eq!(isqrt(n), n.isqrt(), "{n}");
+        }
+        for n in [
+            u32::MAX,
+            u32::MAX - 1,
+            65535 * 65535,
+            65536 * 65535,
+            (1 << 31) - 1,
+            1 << 31,
+        ] {
+            assert_eq!(isqrt(n), n.isqrt(), "{n}");
         }
     }
 

@@ -100,19 +100,6 @@ pub struct PassInfo {
     pub _pad: u32,
 }
 
-/// Shadow rays per receiver in one dispatch. Mesa's llvmpipe (lavapipe) caps the iterations
-/// a loop may run per invocation at 65535, counting an inner loop's iterations across every
-/// pass of the loop around it, and then quietly leaves the loop for the whole SIMD row: with a
-/// BVH walk of a few hundred steps per shadow ray, a 1024-ray loop lost about half its rays.
-/// Splitting the sample loop over dispatches keeps every loop well under the cap.
-pub fn samples_per_dispatch(packed: &Packed) -> u32 {
-    if packed.nodes.is_empty() {
-        1024
-    } else {
-        32
-    }
-}
-
 /// Bytes per pixel of the hit buffer (WGSL `Hit`).
 pub const HIT_BYTES: u64 = 48;
 

@@ -1,23 +1,27 @@
 //! The wgpu compute backend: headless, on any adapter wgpu supports (Mesa's lavapipe in CI).
 //!
-//! Setup (adapter, device with the adapter's real limits, pipelines) happens once in
-//! [`GpuBackend::new`]; each frame uploads the packed scene, runs the plan's passes (primary,
-//! then one shadow pass per light, split into dispatches of at most
-//! `layout::samples_per_dispatch` samples) with a timestamp pair around each pass when the
-//! adapter supports timestamp queries, and reads the outputs back.
+//! Setup (adapter, device with the adapter's real limits, pipelines, the loop-cap probe) happens
+//! once in [`GpuBackend::new`]; the scene's geometry is uploaded once and stays resident
+//! ([`resources`]); each frame runs the plan's passes (primary, then one shadow pass per light,
+//! in one dispatch or, on adapters that cap loop iterations, several) with a timestamp pair
+//! around each pass when the adapter supports timestamp queries, and reads the outputs back.
 
+mod hooks;
 mod layout;
+pub mod loop_cap;
+mod resources;
 
 use super::plan::{RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
 use crate::sampling::DiskScheme;
 use anyhow::{anyhow, bail, Context};
-use bytemuck::{Pod, Zeroable};
-use layout::{pack, GpuLight, Packed, PassInfo, HIT_BYTES};
+use layout::{pack, HIT_BYTES};
+use resources::{FrameResources, SceneBuffers};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use wgpu::util::DeviceExt;
+
+pub use hooks::{ProbeHit, ProbeRay};
 
 /// How long one frame may run before it is reported as a GPU timeout.
 pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
@@ -28,6 +32,18 @@ const SHADER: &str = concat!(
     include_str!("shaders/bvh.wgsl"),
     include_str!("shaders/render.wgsl"),
 );
+
+/// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`] and prepended
+/// to the shaders, so Rust and WGSL share one list.
+pub fn scheme_prelude() -> String {
+    DiskScheme::ALL
+        .iter()
+        .map(|s| {
+            let name = s.name().to_uppercase().replace('-', "_");
+            format!("const SCHEME_{name}: u32 = {}u;\n", s.gpu_id())
+        })
+        .collect()
+}
 
 /// What to install when no adapter is found, for the error message.
 pub const NO_ADAPTER_HELP: &str = "no GPU adapter found; on Debian install the software Vulkan driver with \
@@ -42,26 +58,20 @@ pub struct GpuBackend {
     lost: Arc<AtomicBool>,
     layout0: wgpu::BindGroupLayout,
     layout1: wgpu::BindGroupLayout,
+    /// The test hooks' own group (probe rays), outside the render layout.
+    hook_layout: wgpu::BindGroupLayout,
     /// The plan's passes, compiled with (`[1]`) and without (`[0]`) mesh traversal: a scene
     /// without meshes runs shaders in which the BVH walks are constant-folded away.
     primary: [wgpu::ComputePipeline; 2],
     shadow: [wgpu::ComputePipeline; 2],
     dump: wgpu::ComputePipeline,
     probe: wgpu::ComputePipeline,
-}
-
-/// Per-frame GPU resources.
-struct FrameResources {
-    bind0: wgpu::BindGroup,
-    /// Per light, one bind group per dispatch of its samples.
-    passes: Vec<Vec<wgpu::BindGroup>>,
-    hits: wgpu::Buffer,
-    visibility: wgpu::Buffer,
-    radiance: wgpu::Buffer,
-    counters: wgpu::Buffer,
-    queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    /// Whether the scene has meshes (selects the pipeline variant).
-    meshes: bool,
+    /// Iterations after which the adapter leaves a loop, if it caps them ([`loop_cap`]).
+    loop_cap: Option<u32>,
+    /// The resident static scene data.
+    scene: Option<SceneBuffers>,
+    /// Times static scene data was uploaded.
+    static_uploads: u64,
 }
 
 impl GpuBackend {
@@ -103,9 +113,10 @@ impl GpuBackend {
         device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
             eprintln!("penumbra: uncaptured GPU error: {e}")
         }));
+        let loop_cap = loop_cap::detect(&device, &queue).context("probing the adapter's loop limits")?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl((scheme_prelude() + SHADER).into()),
         });
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
@@ -130,7 +141,7 @@ impl GpuBackend {
         let mut entries = vec![uniform(0)];
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
-        entries.extend((9..=11).map(|b| storage(b, true)));
+        entries.extend((9..=10).map(|b| storage(b, true)));
         let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
             entries: &entries,
@@ -139,16 +150,25 @@ impl GpuBackend {
             label: Some("pass"),
             entries: &[uniform(0)],
         });
+        let hook_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("test hooks"),
+            entries: &[storage(0, true)],
+        });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("render"),
             bind_group_layouts: &[Some(&layout0), Some(&layout1)],
             immediate_size: 0,
         });
-        let variant = |entry: &str, meshes: bool| {
+        let hooks_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("test hooks"),
+            bind_group_layouts: &[Some(&layout0), Some(&layout1), Some(&hook_layout)],
+            immediate_size: 0,
+        });
+        let compile = |entry: &str, meshes: bool, layout: &wgpu::PipelineLayout| {
             let constants = [("MESHES", if meshes { 1.0 } else { 0.0 })];
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
-                layout: Some(&pipeline_layout),
+                layout: Some(layout),
                 module: &module,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
@@ -158,18 +178,19 @@ impl GpuBackend {
                 cache: None,
             })
         };
-        let pipeline = |entry: &str| variant(entry, true);
+        let variant = |entry: &str, meshes: bool| compile(entry, meshes, &pipeline_layout);
         let (primary, shadow, dump, probe) = (
             [variant("primary", false), variant("primary", true)],
             [variant("shadow", false), variant("shadow", true)],
-            pipeline("dump_samples"),
-            pipeline("trace_probes"),
+            compile("dump_samples", true, &hooks_layout),
+            compile("trace_probes", true, &hooks_layout),
         );
         let info = AdapterInfo {
             backend: "gpu".into(),
             name: ai.name.clone(),
             driver: format!("{} {}", ai.driver, ai.driver_info).trim().to_string(),
             api: format!("{:?}", ai.backend),
+            loop_cap,
         };
         Ok(GpuBackend {
             device,
@@ -179,31 +200,31 @@ impl GpuBackend {
             lost,
             layout0,
             layout1,
+            hook_layout,
             primary,
             shadow,
             dump,
             probe,
+            loop_cap,
+            scene: None,
+            static_uploads: 0,
         })
     }
 
-    fn storage<T: Pod>(&self, label: &str, data: &[T], zeroed: T) -> wgpu::Buffer {
-        // WGSL runtime-sized arrays need a non-empty binding.
-        let one = [zeroed];
-        let data: &[T] = if data.is_empty() { &one } else { data };
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(data),
-            usage: wgpu::BufferUsages::STORAGE,
-        })
+    /// Iterations after which this adapter leaves a loop, if the probe found a cap.
+    pub fn loop_cap(&self) -> Option<u32> {
+        self.loop_cap
     }
 
-    fn output(&self, label: &str, size: u64) -> wgpu::Buffer {
-        self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(16),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
+    /// Overrides the probe's finding (`None`: one dispatch per light whatever the adapter does).
+    /// For experiments on the workaround itself: on a capped adapter it loses rays.
+    pub fn set_loop_cap(&mut self, cap: Option<u32>) {
+        self.loop_cap = cap;
+    }
+
+    /// How many times static scene data (geometry, BVH) has been uploaded.
+    pub fn static_uploads(&self) -> u64 {
+        self.static_uploads
     }
 
     fn check_limits(&self, scene: &crate::scene::Scene, view: View) -> anyhow::Result<()> {
@@ -242,117 +263,6 @@ impl GpuBackend {
             }
         }
         Ok(())
-    }
-
-    fn resources(&self, packed: &Packed, view: View, probes: &[[f32; 4]]) -> FrameResources {
-        let params = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: bytemuck::bytes_of(&packed.params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let spheres = self.storage("spheres", &packed.spheres, bytemuck::Zeroable::zeroed());
-        let planes = self.storage("planes", &packed.planes, bytemuck::Zeroable::zeroed());
-        let lights = self.storage("lights", &packed.lights, bytemuck::Zeroable::zeroed());
-        let shared = self.storage("shared points", &packed.shared, [0f32; 2]);
-        let pixels = view.pixels() as u64;
-        let hits = self.output("hits", pixels * HIT_BYTES);
-        let visibility = self.output(
-            "visibility",
-            (pixels * packed.lights.len().max(1) as u64).max(3 * (probes.len() / 2) as u64) * 4,
-        );
-        let nodes = self.storage("bvh nodes", &packed.nodes, bytemuck::Zeroable::zeroed());
-        let triangles = self.storage("triangles", &packed.triangles, bytemuck::Zeroable::zeroed());
-        let probe_rays = self.storage("probe rays", probes, [0f32; 4]);
-        let radiance = self.output("radiance", pixels * 4);
-        let counters = self.output("ray counters", (MAX_LIGHTS * 2 * 4) as u64);
-        let buffers = [
-            &params,
-            &spheres,
-            &planes,
-            &lights,
-            &shared,
-            &hits,
-            &visibility,
-            &radiance,
-            &counters,
-            &nodes,
-            &triangles,
-            &probe_rays,
-        ];
-        let entries: Vec<_> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind0 = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &self.layout0,
-            entries: &entries,
-        });
-        let chunk = layout::samples_per_dispatch(packed);
-        let one = [GpuLight::zeroed()];
-        let lights = if packed.lights.is_empty() {
-            &one[..]
-        } else {
-            &packed.lights[..]
-        };
-        let passes = lights
-            .iter()
-            .enumerate()
-            .map(|(light, l)| {
-                (0..l.samples.max(1).div_ceil(chunk))
-                    .map(|c| {
-                        let info = PassInfo {
-                            light: light as u32,
-                            first_sample: c * chunk,
-                            sample_count: chunk,
-                            _pad: 0,
-                        };
-                        let buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                            label: Some("pass info"),
-                            contents: bytemuck::bytes_of(&info),
-                            usage: wgpu::BufferUsages::UNIFORM,
-                        });
-                        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some("pass"),
-                            layout: &self.layout1,
-                            entries: &[wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: buffer.as_entire_binding(),
-                            }],
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
-        let queries = self.timestamps.then(|| {
-            let count = 2 * (packed.lights.len() as u32 + 1);
-            let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("timestamps"),
-                ty: wgpu::QueryType::Timestamp,
-                count,
-            });
-            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamp resolve"),
-                size: count as u64 * 8,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (set, resolve)
-        });
-        FrameResources {
-            bind0,
-            passes,
-            hits,
-            visibility,
-            radiance,
-            counters,
-            queries,
-            meshes: !packed.nodes.is_empty(),
-        }
     }
 
     /// Records the plan's passes into `encoder`: primary, then one shadow pass per light.
@@ -447,130 +357,11 @@ impl GpuBackend {
         let seconds = |a: u64, b: u64| b.saturating_sub(a) as f64 * period * 1e-9;
         Ok(Some((seconds(first, last), seconds(ticks[0], ticks[1]))))
     }
-
-    /// Runs a one-dimensional test-hook kernel over `groups` workgroups.
-    fn run_hook(&self, pipeline: &wgpu::ComputePipeline, r: &FrameResources, groups: u32) -> anyhow::Result<()> {
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        {
-            let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: None,
-                timestamp_writes: None,
-            });
-            cp.set_pipeline(pipeline);
-            cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(1, &r.passes[0][0], &[]);
-            cp.dispatch_workgroups(groups, 1, 1);
-        }
-        self.submit(encoder, scope)
-    }
-
-    /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
-    /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
-    pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
-        let scene = crate::scene::Scene::analytic(vec![], vec![], vec![]);
-        let cam = dummy_camera();
-        let view = View {
-            camera: &cam,
-            width: n,
-            height: 1,
-        };
-        let mut packed = pack(
-            &scene,
-            view,
-            Sampling {
-                scheme,
-                pattern: crate::sampling::Pattern::PerPixel,
-                seed,
-            },
-        );
-        packed.params.height = pixel;
-        let r = self.resources(
-            &packed,
-            View {
-                camera: &cam,
-                width: n,
-                height: 2,
-            },
-            &[],
-        );
-        self.run_hook(&self.dump, &r, n.div_ceil(64))?;
-        let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
-        Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
-    }
 }
 
 /// Timestamps a resolve buffer holds.
 fn set_count(resolve: &wgpu::Buffer) -> u32 {
     (resolve.size() / 8) as u32
-}
-
-/// A probe ray for [`GpuBackend::probe`]: origin, unit direction, farthest distance.
-pub type ProbeRay = (glam::DVec3, glam::DVec3, f64);
-
-/// What the GPU found along a probe ray: closest distance and triangle (if any), and whether the
-/// any-hit query reported a hit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProbeHit {
-    /// Closest hit (distance, triangle index).
-    pub closest: Option<(f64, u32)>,
-    /// Any-hit result.
-    pub any: bool,
-}
-
-fn dummy_camera() -> crate::scene::camera::Camera {
-    use glam::DVec3;
-    crate::scene::camera::Camera {
-        position: DVec3::Z,
-        look_at: DVec3::ZERO,
-        up: DVec3::Y,
-        projection: crate::scene::camera::Projection::Orthographic { width: 1.0 },
-    }
-}
-
-impl GpuBackend {
-    /// Traces `rays` against the scene's mesh BVH with the WGSL closest-hit and any-hit
-    /// traversals, in the same local frame as a render: lets tests compare the GPU's traversal
-    /// with obvhs' and with brute force.
-    pub fn probe(&mut self, scene: &crate::scene::Scene, rays: &[ProbeRay]) -> anyhow::Result<Vec<ProbeHit>> {
-        let cam = scene.cameras.values().next().cloned().unwrap_or_else(dummy_camera);
-        let view = View {
-            camera: &cam,
-            width: rays.len() as u32,
-            height: 1,
-        };
-        let mut packed = pack(
-            scene,
-            view,
-            Sampling {
-                scheme: DiskScheme::Uniform,
-                pattern: crate::sampling::Pattern::PerPixel,
-                seed: 0,
-            },
-        );
-        packed.params.width = rays.len() as u32;
-        let (origin, scale) = layout::local_frame(scene, view);
-        let probes: Vec<[f32; 4]> = rays
-            .iter()
-            .flat_map(|(o, d, tmax)| {
-                let lo = ((*o - origin) / scale).as_vec3();
-                [
-                    [lo.x, lo.y, lo.z, (tmax / scale).min(f32::MAX as f64) as f32],
-                    [d.x as f32, d.y as f32, d.z as f32, 0.0],
-                ]
-            })
-            .collect();
-        let r = self.resources(&packed, view, &probes);
-        self.run_hook(&self.probe, &r, (rays.len() as u32).div_ceil(64))?;
-        let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
-        Ok(raw
-            .chunks(3)
-            .map(|c| ProbeHit {
-                closest: (c[0] >= 0.0).then(|| (c[0] as f64 * scale, c[1].to_bits())),
-                any: c[2] > 0.0,
-            })
-            .collect())
-    }
 }
 
 impl Backend for GpuBackend {
@@ -583,7 +374,7 @@ impl Backend for GpuBackend {
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view, &[]);
+        let r = self.resources(&packed, view, 0);
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         self.encode(&mut encoder, &r, view, lights);
@@ -626,7 +417,7 @@ impl Backend for GpuBackend {
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view, &[]);
+        let r = self.resources(&packed, view, 0);
         let (mut seconds, mut primary_seconds) = (Vec::new(), Vec::new());
         for i in 0..warmup + repeats {
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);

@@ -280,7 +280,7 @@ fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
 // Test hook: closest and any hit of probe rays against the mesh BVH. Ray k is
 // probe_rays[2k] = (origin, tmax) and probe_rays[2k + 1] = (direction, 0); writes
 // visibility[3k..3k+3] = (t, triangle index as bits, any-hit flag).
-@group(0) @binding(11) var<storage, read> probe_rays: array<vec4<f32>>;
+@group(2) @binding(0) var<storage, read> probe_rays: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn trace_probes(@builtin(global_invocation_id) gid: vec3<u32>) {

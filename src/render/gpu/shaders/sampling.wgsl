@@ -1,12 +1,7 @@
 // Disk sampling schemes and counter-based random numbers: the WGSL twin of src/sampling/.
 // Every function here must return, bit for bit in its integer part, what the Rust one does.
 
-const SCHEME_UNIFORM: u32 = 0u;
-const SCHEME_PAPER: u32 = 1u;
-const SCHEME_PAPER_LITERAL: u32 = 2u;
-const SCHEME_JITTERED: u32 = 3u;
-const SCHEME_SOBOL: u32 = 4u;
-const SCHEME_SPIRAL: u32 = 5u;
+// The SCHEME_* ids are generated from the Rust list (gpu::scheme_prelude) and prepended.
 
 const TAU: f32 = 6.283185307179586;
 const PI: f32 = 3.141592653589793;
@@ -51,12 +46,28 @@ fn concentric(u: f32, v: f32) -> vec2<f32> {
     return polar(b, 0.5 * PI - 0.25 * PI * (a / b));
 }
 
-fn strata_rows(n: u32) -> u32 {
-    var rows = u32(floor(sqrt(f32(n))));
-    // f32 sqrt can land one above the integer root; step down like the f64 version would.
-    if (rows * rows > n) {
-        rows = rows - 1u;
+// floor(sqrt(n)) exactly, digit by digit (sampling::isqrt): a float sqrt may land an ULP low.
+fn isqrt(n: u32) -> u32 {
+    var rest = n;
+    var root = 0u;
+    var bit = 1u << 30u;
+    while (bit > n) {
+        bit = bit >> 2u;
     }
+    while (bit != 0u) {
+        if (rest >= root + bit) {
+            rest = rest - (root + bit);
+            root = (root >> 1u) + bit;
+        } else {
+            root = root >> 1u;
+        }
+        bit = bit >> 2u;
+    }
+    return root;
+}
+
+fn strata_rows(n: u32) -> u32 {
+    var rows = isqrt(n);
     while (rows > 1u && n % rows != 0u) {
         rows = rows - 1u;
     }
@@ -101,12 +112,12 @@ fn scrambled_sobol_2d(index: u32, seed: u32) -> vec2<u32> {
 // Sample k of n on the unit disk (see DiskScheme::point).
 fn disk_point(scheme: u32, n: u32, k: u32, stream: u32) -> vec2<f32> {
     switch scheme {
-        case 0u: {
+        case SCHEME_UNIFORM: {
             let u = stream_unit(stream, 2u * k);
             let v = stream_unit(stream, 2u * k + 1u);
             return polar(sqrt(u), TAU * v);
         }
-        case 1u, 2u: {
+        case SCHEME_PAPER, SCHEME_PAPER_LITERAL: {
             if (k == 0u) {
                 return vec2<f32>(0.0);
             }
@@ -117,22 +128,26 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32) -> vec2<f32> {
             }
             return vec2<f32>(0.3) + polar(r, theta);
         }
-        case 3u: {
+        case SCHEME_JITTERED: {
             let rows = strata_rows(n);
             let cols = n / rows;
             let u = (f32(k % cols) + stream_unit(stream, 2u * k)) / f32(cols);
             let v = (f32(k / cols) + stream_unit(stream, 2u * k + 1u)) / f32(rows);
             return concentric(u, v);
         }
-        case 4u: {
+        case SCHEME_SOBOL: {
             let s = scrambled_sobol_2d(k, stream_u32(stream, 0x7fffffffu));
             return concentric(to_unit(s.x), to_unit(s.y));
         }
-        default: {
+        case SCHEME_SPIRAL: {
             let turn = k * GOLDEN_TURN + stream_u32(stream, 0x7ffffffeu);
             let offset = stream_unit(stream, 0x7ffffffdu);
             let r = sqrt((f32(k) + offset) / f32(n));
             return polar(r, TAU * to_unit(turn));
+        }
+        default: {
+            // An id no scheme has: NaN, which no test or metric mistakes for a point.
+            return vec2<f32>(bitcast<f32>(0x7fc00000u));
         }
     }
 }

@@ -1,0 +1,211 @@
+//! GPU resources split as wgpu's examples split them: the scene's static data (spheres, planes,
+//! BVH nodes, triangles) is uploaded once and stays resident while its packed content is
+//! unchanged; per-frame data (parameters, lights, shared sample points, pass infos, outputs,
+//! timestamp queries) is made for each call. Timed repeats and warm-up frames of one call run
+//! over the same resources, and successive calls on one scene upload no geometry.
+
+use super::layout::{GpuLight, Packed, PassInfo, HIT_BYTES};
+use super::GpuBackend;
+use crate::fingerprint::fnv1a;
+use crate::render::plan::MAX_LIGHTS;
+use crate::render::View;
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+/// The scene's static buffers and the hash of the packed content they hold.
+pub(super) struct SceneBuffers {
+    key: u64,
+    spheres: wgpu::Buffer,
+    planes: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+}
+
+/// Per-frame GPU resources.
+pub(super) struct FrameResources {
+    pub bind0: wgpu::BindGroup,
+    /// Per light, one bind group per dispatch of its samples.
+    pub passes: Vec<Vec<wgpu::BindGroup>>,
+    pub hits: wgpu::Buffer,
+    pub visibility: wgpu::Buffer,
+    pub radiance: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
+    pub queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Whether the scene has meshes (selects the pipeline variant).
+    pub meshes: bool,
+}
+
+/// Hash of the packed static data: equal hashes mean the resident buffers can be reused.
+fn static_key(p: &Packed) -> u64 {
+    let mut bytes: Vec<u8> = Vec::new();
+    for (len, data) in [
+        (p.spheres.len(), bytemuck::cast_slice::<_, u8>(&p.spheres)),
+        (p.planes.len(), bytemuck::cast_slice(&p.planes)),
+        (p.nodes.len(), bytemuck::cast_slice(&p.nodes)),
+        (p.triangles.len(), bytemuck::cast_slice(&p.triangles)),
+    ] {
+        bytes.extend_from_slice(&(len as u64).to_le_bytes());
+        bytes.extend_from_slice(&fnv1a(data).to_le_bytes());
+    }
+    fnv1a(&bytes)
+}
+
+impl GpuBackend {
+    pub(super) fn storage<T: Pod>(&self, label: &str, data: &[T], zeroed: T) -> wgpu::Buffer {
+        // WGSL runtime-sized arrays need a non-empty binding.
+        let one = [zeroed];
+        let data: &[T] = if data.is_empty() { &one } else { data };
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(data),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    }
+
+    pub(super) fn output(&self, label: &str, size: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// The resident static buffers for `packed`, uploading them only when its content changed.
+    fn scene_buffers(&mut self, packed: &Packed) -> &SceneBuffers {
+        let key = static_key(packed);
+        if self.scene.as_ref().is_none_or(|s| s.key != key) {
+            self.static_uploads += 1;
+            self.scene = Some(SceneBuffers {
+                key,
+                spheres: self.storage("spheres", &packed.spheres, Zeroable::zeroed()),
+                planes: self.storage("planes", &packed.planes, Zeroable::zeroed()),
+                nodes: self.storage("bvh nodes", &packed.nodes, Zeroable::zeroed()),
+                triangles: self.storage("triangles", &packed.triangles, Zeroable::zeroed()),
+            });
+        }
+        self.scene.as_ref().expect("just set")
+    }
+
+    /// Per-frame resources over the resident static buffers. `extra_floats` widens the visibility
+    /// buffer for the test hooks that write into it.
+    pub(super) fn resources(&mut self, packed: &Packed, view: View, extra_floats: u64) -> FrameResources {
+        self.scene_buffers(packed);
+        let s = self.scene.as_ref().expect("resident");
+        let params = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(&packed.params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let lights = self.storage("lights", &packed.lights, Zeroable::zeroed());
+        let shared = self.storage("shared points", &packed.shared, [0f32; 2]);
+        let pixels = view.pixels() as u64;
+        let hits = self.output("hits", pixels * HIT_BYTES);
+        let visibility = self.output(
+            "visibility",
+            (pixels * packed.lights.len().max(1) as u64).max(extra_floats) * 4,
+        );
+        let radiance = self.output("radiance", pixels * 4);
+        let counters = self.output("ray counters", (MAX_LIGHTS * 2 * 4) as u64);
+        let buffers = [
+            &params,
+            &s.spheres,
+            &s.planes,
+            &lights,
+            &shared,
+            &hits,
+            &visibility,
+            &radiance,
+            &counters,
+            &s.nodes,
+            &s.triangles,
+        ];
+        let entries: Vec<_> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind0 = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.layout0,
+            entries: &entries,
+        });
+        let chunk = self.samples_per_dispatch(packed);
+        let one = [GpuLight::zeroed()];
+        let lights = if packed.lights.is_empty() {
+            &one[..]
+        } else {
+            &packed.lights[..]
+        };
+        let passes = lights
+            .iter()
+            .enumerate()
+            .map(|(light, l)| {
+                (0..l.samples.max(1).div_ceil(chunk))
+                    .map(|c| self.pass_info(light as u32, c * chunk, chunk))
+                    .collect()
+            })
+            .collect();
+        let queries = self.timestamps.then(|| {
+            let count = 2 * (packed.lights.len() as u32 + 1);
+            let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count,
+            });
+            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size: count as u64 * 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
+        FrameResources {
+            bind0,
+            passes,
+            hits,
+            visibility,
+            radiance,
+            counters,
+            queries,
+            meshes: !packed.nodes.is_empty(),
+        }
+    }
+
+    fn pass_info(&self, light: u32, first_sample: u32, sample_count: u32) -> wgpu::BindGroup {
+        let info = PassInfo {
+            light,
+            first_sample,
+            sample_count,
+            _pad: 0,
+        };
+        let buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pass info"),
+            contents: bytemuck::bytes_of(&info),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pass"),
+            layout: &self.layout1,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            }],
+        })
+    }
+
+    /// Shadow samples per dispatch: all of a light's samples in one, unless the adapter caps loop
+    /// iterations (see [`super::loop_cap`]), where a chunk keeps every loop under the cap: 32
+    /// samples when a BVH walk of a few hundred steps runs per sample, 1024 for analytic scenes.
+    fn samples_per_dispatch(&self, packed: &Packed) -> u32 {
+        match (self.loop_cap, packed.nodes.is_empty()) {
+            (None, _) => u32::MAX,
+            (Some(_), true) => 1024,
+            (Some(_), false) => 32,
+        }
+    }
+}
