@@ -17,19 +17,6 @@ width = 0.6
 [[meshes]]
 path = "square.obj"
 albedo = 0.7
-
-[[planes]]
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-albedo = 0.8
-
-[[lights]]
-type = "disk"
-center = [0.0, 0.0, 2.0]
-normal = [0.0, 0.0, -1.0]
-radius = 0.05
-power = 60.0
-samples = 16
 "#;
 
 const EXPERIMENT: &str = r#"
@@ -82,13 +69,20 @@ fn cached_ground_truths(dir: &Path) -> usize {
     std::fs::read_dir(dir.join("out/cache")).map_or(0, |d| d.count())
 }
 
-#[test]
-fn editing_an_obj_invalidates_the_journal_and_the_ground_truth_cache() {
+/// The scene (a square occluder from square.obj), the experiment and the OBJ, in a new folder.
+fn experiment_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("scene.toml"), SCENE).unwrap();
+    std::fs::write(d.join("scene.toml"), SCENE.to_string() + &common::plane_and_light(0.05)).unwrap();
     std::fs::write(d.join("keys.toml"), EXPERIMENT).unwrap();
     std::fs::write(d.join("square.obj"), square(0.5)).unwrap();
+    dir
+}
+
+#[test]
+fn editing_an_obj_invalidates_the_journal_and_the_ground_truth_cache() {
+    let dir = experiment_dir();
+    let d = dir.path();
     // The group at the figure ray count (16) is always re-rendered; the one at 4 resumes.
     assert_eq!(resumed(d, "cpu"), 0);
     assert_eq!(resumed(d, "cpu"), 1);
@@ -109,11 +103,8 @@ fn one_backend_never_resumes_another_backends_rows() {
     if common::gpu().is_none() {
         return;
     }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = experiment_dir();
     let d = dir.path();
-    std::fs::write(d.join("scene.toml"), SCENE).unwrap();
-    std::fs::write(d.join("keys.toml"), EXPERIMENT).unwrap();
-    std::fs::write(d.join("square.obj"), square(0.5)).unwrap();
     assert_eq!(resumed(d, "gpu"), 0);
     assert_eq!(resumed(d, "cpu"), 0, "the CPU backend resumed rows the GPU wrote");
     let runs = std::fs::read_to_string(d.join("out/runs.csv")).unwrap();

@@ -24,19 +24,6 @@ width = WIDTH
 center = [SX, SY, 0.5]
 radius = 0.25
 albedo = 0.8
-
-[[planes]]
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-albedo = 0.8
-
-[[lights]]
-type = "disk"
-center = [0.0, 0.0, 2.0]
-normal = [0.0, 0.0, -1.0]
-radius = 0.02
-power = 60.0
-samples = 16
 "#;
 
 const EXPERIMENT: &str = r#"
@@ -71,7 +58,8 @@ fn experiment(dir: &Path, sphere: (f64, f64), centre: (f64, f64), width: f64, ra
         .replace("SY", &sphere.1.to_string())
         .replace("CX", &centre.0.to_string())
         .replace("CY", &centre.1.to_string())
-        .replace("WIDTH", &width.to_string());
+        .replace("WIDTH", &width.to_string())
+        + &common::plane_and_light(0.02);
     std::fs::write(dir.join("scene.toml"), scene).unwrap();
     std::fs::write(
         dir.join("masks.toml"),

@@ -70,3 +70,24 @@ pub fn sweep(args: &[&std::ffi::OsStr]) -> (i32, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// Scene TOML for the receiver every test scene shares: the ground plane z = 0 and a one-sided
+/// disk light of `radius` metres 2 m above the origin, facing down.
+pub fn plane_and_light(radius: f64) -> String {
+    format!(
+        r#"
+[[planes]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+albedo = 0.8
+
+[[lights]]
+type = "disk"
+center = [0.0, 0.0, 2.0]
+normal = [0.0, 0.0, -1.0]
+radius = {radius}
+power = 60.0
+samples = 16
+"#
+    )
+}
