@@ -8,6 +8,17 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
+/// A hash of the running executable: any change to the renderer's or the metrics' code
+/// invalidates cached ground truths and journaled runs, whichever file the change is in.
+pub fn build_id() -> u64 {
+    static ID: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *ID.get_or_init(|| {
+        std::env::current_exe()
+            .and_then(std::fs::read)
+            .map_or(0, |bytes| fnv1a(&bytes))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

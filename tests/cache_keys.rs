@@ -113,3 +113,24 @@ fn one_backend_never_resumes_another_backends_rows() {
     assert_eq!(resumed(d, "gpu"), 1);
     assert_eq!(resumed(d, "cpu"), 1);
 }
+
+/// Another seed list gives another bias/variance split: a group journaled with seeds [1, 2] is
+/// not taken for [1, 2, 3] (its first run's key is the same), nor is the shorter one afterwards.
+#[test]
+fn another_seed_list_renders_the_group_again() {
+    let dir = experiment_dir();
+    let d = dir.path();
+    assert_eq!(resumed(d, "cpu"), 0);
+    let three = EXPERIMENT.replace("seeds = [1, 2]", "seeds = [1, 2, 3]");
+    std::fs::write(d.join("keys.toml"), three).unwrap();
+    assert_eq!(resumed(d, "cpu"), 0, "seeds [1, 2, 3] resumed the [1, 2] group");
+    let summary = std::fs::read_to_string(d.join("out/summary.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(summary.as_bytes());
+    let seeds = rows.headers().unwrap().iter().position(|h| h == "seeds").unwrap();
+    for row in rows.records() {
+        assert_eq!(&row.unwrap()[seeds], "3");
+    }
+    assert_eq!(resumed(d, "cpu"), 1);
+    std::fs::write(d.join("keys.toml"), EXPERIMENT).unwrap();
+    assert_eq!(resumed(d, "cpu"), 1, "both seed lists stay journaled");
+}

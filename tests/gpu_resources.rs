@@ -96,6 +96,42 @@ fn the_loop_cap_probe_finds_what_the_split_works_around() {
     }
 }
 
+/// An analytic scene with many spheres: each shadow sample loops over all of them, so the
+/// samples per dispatch must shrink with the sphere count (a fixed 1024 exceeds llvmpipe's cap
+/// past about 60 spheres and drops rays without a word).
+#[test]
+fn many_spheres_keep_every_shadow_ray_under_the_loop_cap() {
+    let Some(mut gpu) = common::gpu() else { return };
+    let mut s = scene("experiments/scenes/sphere.toml");
+    // Below the ground plane: every shadow ray tests them, none is blocked by them.
+    for i in 0..120 {
+        s.spheres.push(penumbra::scene::Sphere {
+            center: glam::DVec3::new(0.1 * i as f64 - 6.0, 0.0, -3.0),
+            radius: 0.04,
+            albedo: 0.5,
+        });
+    }
+    if let Light::Disk(d) = &mut s.lights[0] {
+        d.samples = 1024;
+    }
+    let view = View {
+        camera: &s.cameras["measure"],
+        width: 12,
+        height: 12,
+    };
+    let cpu = CpuBackend::default().render(&s, view, sampling(4)).unwrap();
+    let gpu_image = gpu.render(&s, view, sampling(4)).unwrap();
+    assert_eq!(gpu_image.rays.shadow_total(), cpu.rays.shadow_total());
+    let cap = gpu.loop_cap();
+    if cap.is_some() {
+        // The same frame as one undivided dispatch per light loses rays: the test has teeth.
+        gpu.set_loop_cap(None);
+        let whole = gpu.render(&s, view, sampling(4));
+        gpu.set_loop_cap(cap);
+        assert!(whole.unwrap().rays.shadow_total() < cpu.rays.shadow_total());
+    }
+}
+
 #[test]
 fn scheme_ids_come_from_one_list_and_unknown_ids_give_nan() {
     let prelude = scheme_prelude();

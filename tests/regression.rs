@@ -161,3 +161,63 @@ fn the_convergence_checks_reject_a_scheme_that_stops_converging() {
     failures(&checks);
     assert!(checks.iter().all(|x| !x.ok), "{checks:#?}");
 }
+
+/// Summaries of the CI sweep with `scheme`'s exact 10-90 width scaled by `factor`: as if the
+/// scheme's profile were off the exact one by 1/factor - 1.
+fn exact_width_scaled(scheme: DiskScheme, factor: f64) -> Vec<Summary> {
+    let mut summaries = ci().summaries.clone();
+    for s in summaries.iter_mut().filter(|s| s.run.scheme == scheme) {
+        s.exact_width_10_90 *= factor;
+    }
+    summaries
+}
+
+#[test]
+fn the_unbiased_width_check_rejects_a_profile_off_the_exact_width() {
+    let c = ci();
+    let tol = c.thresholds.unbiased.width_10_90_tolerance;
+    for factor in [1.0 + 2.0 * tol, 1.0 / (1.0 + 2.0 * tol)] {
+        let summaries = exact_width_scaled(DiskScheme::Uniform, factor);
+        let checks = c.thresholds.check_unbiased(&summaries, DiskScheme::Uniform, radius());
+        let width: Vec<&Check> = checks.iter().filter(|x| x.what.contains("10-90 width")).collect();
+        failures(&checks);
+        assert!(!width.is_empty() && width.iter().all(|x| !x.ok), "{width:#?}");
+    }
+}
+
+#[test]
+fn the_paper_width_check_rejects_too_much_widening() {
+    let c = ci();
+    let max = c.thresholds.paper.max_width_10_90_excess;
+    // The exact width shrunk so that the paper's measured width exceeds it by max + 10 %.
+    let paper = |s: &Summary| s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+    let worst = c
+        .summaries
+        .iter()
+        .filter(|s| s.run.scheme == DiskScheme::Paper)
+        .map(paper)
+        .fold(f64::INFINITY, f64::min);
+    let summaries = exact_width_scaled(DiskScheme::Paper, (1.0 + worst) / (1.0 + max + 0.1));
+    let checks = c.thresholds.check_paper_width(&summaries, DiskScheme::Paper, radius());
+    failures(&checks);
+    assert!(!checks.is_empty() && checks.iter().all(|x| !x.ok), "{checks:#?}");
+}
+
+#[test]
+fn a_bound_on_a_scheme_the_sweep_lacks_fails() {
+    let c = ci();
+    let without: Vec<Summary> = c
+        .summaries
+        .iter()
+        .filter(|s| s.run.scheme != DiskScheme::Jittered)
+        .cloned()
+        .collect();
+    for checks in [
+        c.thresholds.check_unbiased(&without, DiskScheme::Jittered, radius()),
+        c.thresholds.check_unbiased(&c.summaries, DiskScheme::Uniform, 0.5),
+        c.thresholds.check_paper_width(&c.summaries, DiskScheme::Paper, 0.5),
+    ] {
+        failures(&checks);
+        assert!(checks.len() == 1 && !checks[0].ok, "{checks:#?}");
+    }
+}

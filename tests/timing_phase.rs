@@ -81,11 +81,14 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
         let (q1, med, q3) = (r.num("frame_ms_q1"), r.num("frame_ms"), r.num("frame_ms_q3"));
         assert!(q1 <= med && med <= q3 && q1 > 10.0, "{q1} {med} {q3}");
     }
-    // Every configuration does the same (fake) work; the drift must not rank any two of them.
+    // Every configuration does the same (fake) work; the drift must not rank any two of them,
+    // with or without the noise floor.
     let all: Vec<_> = out.timings.configs.values().collect();
     for a in &all {
         for b in &all {
-            assert_eq!(faster(a, b), None, "{:?} vs {:?}", a.frame_ms(), b.frame_ms());
+            for floor in [None, Some(noise)] {
+                assert_eq!(faster(a, b, floor), None, "{:?} vs {:?}", a.frame_ms(), b.frame_ms());
+            }
         }
     }
     // A resumed sweep takes the timings from the journal and times nothing.

@@ -92,9 +92,9 @@ impl Journal {
         Ok(())
     }
 
-    /// The records and stats of `group` if it completed in an earlier sweep.
-    pub fn completed(&self, group_key: &str, group: &Group, context: &str) -> Option<(Vec<Record>, GroupStats)> {
-        let &split = self.groups.get(group_key)?;
+    /// The records and stats of `group` if it completed in an earlier sweep with the same seeds.
+    pub fn completed(&self, group: &Group, context: &str) -> Option<(Vec<Record>, GroupStats)> {
+        let &split = self.groups.get(&group.key(context))?;
         let records: Option<Vec<Record>> = group
             .runs
             .iter()
@@ -103,17 +103,18 @@ impl Journal {
         Some((
             records?,
             GroupStats {
-                key: group_key.to_string(),
+                key: group.head().key(context),
                 run: *group.head(),
                 split,
             },
         ))
     }
 
-    /// Appends a completed group and flushes it to disk (a group already journaled, such as one
-    /// rendered again for the figures, is not written twice).
-    pub fn append(&mut self, records: &[Record], stats: &GroupStats) -> anyhow::Result<()> {
-        if self.groups.contains_key(&stats.key) {
+    /// Appends a completed group under its key `group_key` ([`Group::key`]) and flushes it to
+    /// disk (a group already journaled, such as one rendered again for the figures, is not
+    /// written twice).
+    pub fn append(&mut self, group_key: &str, records: &[Record], stats: &GroupStats) -> anyhow::Result<()> {
+        if self.groups.contains_key(group_key) {
             return Ok(());
         }
         append_rows(
@@ -123,14 +124,14 @@ impl Journal {
         )?;
         let s = &stats.split;
         let row = vec![
-            stats.key.clone(),
+            group_key.to_string(),
             s.seeds.to_string(),
             num(s.bias2),
             num(s.bias2_ci),
             num(s.variance),
         ];
         append_rows(&self.dir.join("groups.csv"), &GROUP_COLUMNS, std::iter::once(row))?;
-        self.groups.insert(stats.key.clone(), *s);
+        self.groups.insert(group_key.to_string(), *s);
         Ok(())
     }
 }

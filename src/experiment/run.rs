@@ -2,7 +2,7 @@
 //! plain data, one record per row of runs.csv in tidy form.
 
 use super::spec::Spec;
-use crate::fingerprint::fnv1a;
+use crate::fingerprint::{build_id, fnv1a};
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 
@@ -34,6 +34,13 @@ impl Group {
     /// The group's runs share everything but the seed; this is the first.
     pub fn head(&self) -> &Run {
         &self.runs[0]
+    }
+
+    /// Journal key of the group's statistics: a hash of every run's key, so that another seed
+    /// list (whose bias/variance split differs) is never taken for this one.
+    pub fn key(&self, context: &str) -> String {
+        let keys: Vec<String> = self.runs.iter().map(|r| r.key(context)).collect();
+        format!("{:016x}", fnv1a(keys.join(",").as_bytes()))
     }
 }
 
@@ -82,13 +89,14 @@ pub fn context_key(spec: &Spec, adapter: &AdapterInfo) -> String {
         .map(|m| format!("{:016x}", m.file_fnv1a))
         .collect();
     format!(
-        "scene={:016x};meshes=[{}];measure={:?};gt={};plane={};device={:?}",
+        "scene={:016x};meshes=[{}];measure={:?};gt={};plane={};device={:?};build={:016x}",
         fnv1a(spec.scene_text.as_bytes()),
         meshes.join(","),
         (&spec.measure.camera, spec.measure.width, spec.measure.height),
         spec.ground_truth.samples,
         spec.measure.plane,
         (&adapter.backend, &adapter.name, &adapter.driver, &adapter.api),
+        build_id(),
     )
 }
 

@@ -116,17 +116,17 @@ pub fn run_sweep(
         bar.set_message(format!("runs; reference for {lights} light(s) of radius {radius} m"));
         let reference = Reference::build(spec, backend, lights, radius, cache, &context)?;
         for warning in reference.warnings() {
-            bar.println(format!("warning: {warning}"));
+            // `println` on a hidden bar (stderr not a terminal, as in CI logs) prints nothing.
+            bar.suspend(|| eprintln!("warning: {warning}"));
         }
         for group in groups
             .iter()
             .filter(|g| g.head().light_radius == radius && g.head().lights == lights)
         {
             let head = *group.head();
-            let gkey = head.key(&context);
             let needed_for_figures = head.samples == fig_n;
             if !needed_for_figures {
-                if let Some((records, stats)) = journal.completed(&gkey, group, &context) {
+                if let Some((records, stats)) = journal.completed(group, &context) {
                     out.records.extend(records);
                     out.groups.push(stats);
                     out.resumed += 1;
@@ -145,7 +145,7 @@ pub fn run_sweep(
             let failed = records.iter().filter(|r| r.get("status") != "ok").count();
             out.failures += failed;
             if failed == 0 {
-                journal.append(&records, &stats)?;
+                journal.append(&group.key(&context), &records, &stats)?;
             }
             out.records.extend(records);
             out.groups.push(stats);
@@ -298,10 +298,12 @@ fn run_group(
                 images.push(image);
             }
             Err(e) => {
-                bar.println(format!(
-                    "run failed ({} {} n={} r={} seed={}): {e:#}",
-                    run.scheme, run.pattern, run.samples, run.light_radius, run.seed
-                ));
+                bar.suspend(|| {
+                    eprintln!(
+                        "run failed ({} {} n={} r={} seed={}): {e:#}",
+                        run.scheme, run.pattern, run.samples, run.light_radius, run.seed
+                    )
+                });
                 records.push(failed_record(spec, backend, run, context, &format!("{e:#}")));
             }
         }

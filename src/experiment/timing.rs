@@ -44,14 +44,29 @@ impl ConfigTiming {
     }
 }
 
-/// Whether two timings can be ranked: their interquartile ranges are disjoint. `Some(true)` when
-/// `a` is faster, `Some(false)` when slower, `None` when equal within timing noise (or untimed).
-pub fn faster(a: &ConfigTiming, b: &ConfigTiming) -> Option<bool> {
+/// Whether two timings can be ranked: their interquartile ranges are disjoint, and their medians
+/// differ by more than the noise probe's interquartile range (relative to the larger median),
+/// when there is a probe. With five frames each, disjoint ranges alone rank one pair of identical
+/// configurations in five; with the probe's fifteen frames as the floor, one in fifteen (the
+/// simulation in this module's tests).
+/// `Some(true)` when `a` is faster, `Some(false)` when slower, `None` when equal within timing
+/// noise (or untimed).
+pub fn faster(a: &ConfigTiming, b: &ConfigTiming, noise: Option<&ConfigTiming>) -> Option<bool> {
     let ((a1, am, a3), (b1, bm, b3)) = (a.frame_ms(), b.frame_ms());
     if am.is_nan() || bm.is_nan() {
         return None;
     }
-    if a3 < b1 {
+    let floor = noise.map_or(0.0, |n| {
+        let (q1, m, q3) = n.frame_ms();
+        if m > 0.0 {
+            (q3 - q1) / m * am.max(bm)
+        } else {
+            0.0
+        }
+    });
+    if (am - bm).abs() <= floor {
+        None
+    } else if a3 < b1 {
         Some(true)
     } else if b3 < a1 {
         Some(false)
@@ -175,13 +190,52 @@ mod tests {
         let a = timing(&[10.0, 11.0, 12.0, 13.0, 14.0]);
         let b = timing(&[15.0, 16.0, 17.0, 18.0, 19.0]);
         let overlapping = timing(&[12.5, 13.0, 14.0, 15.0, 30.0]);
-        assert_eq!(faster(&a, &b), Some(true));
-        assert_eq!(faster(&b, &a), Some(false));
-        assert_eq!(faster(&a, &overlapping), None);
-        assert_eq!(faster(&a, &timing(&[])), None);
+        assert_eq!(faster(&a, &b, None), Some(true));
+        assert_eq!(faster(&b, &a, None), Some(false));
+        assert_eq!(faster(&a, &overlapping, None), None);
+        assert_eq!(faster(&a, &timing(&[]), None), None);
+        // Medians 5 ms apart: ranked under a 20 % noise floor, not under a 40 % one.
+        let probe = |rel: f64| timing(&[-1.0, -0.5, 0.0, 0.5, 1.0].map(|k| 100.0 * (1.0 + k * rel)));
+        assert_eq!(faster(&a, &b, Some(&probe(0.2))), Some(true));
+        assert_eq!(faster(&a, &b, Some(&probe(0.4))), None);
         let (q1, med, q3) = a.frame_ms();
         assert!((q1 - 11.0).abs() < 1e-9 && (med - 12.0).abs() < 1e-9 && (q3 - 13.0).abs() < 1e-9);
         assert!(a.primary_median().is_nan());
+    }
+
+    /// Identical configurations (five frames each from one seeded noise distribution) against a
+    /// probe of fifteen: the noise floor cuts the false rankings that disjoint ranges alone make.
+    #[test]
+    fn identical_configurations_are_rarely_ranked() {
+        let mut draw = {
+            let stream = crate::sampling::Stream::new(11, 0, None);
+            let mut i = 0u32;
+            move || {
+                // Roughly normal (sum of four uniforms) around 50 ms, sd ~ 2.9 ms.
+                let u: f64 = (0..4)
+                    .map(|_| {
+                        i += 1;
+                        stream.unit(i)
+                    })
+                    .sum();
+                50.0 + 5.0 * (u - 2.0)
+            }
+        };
+        let mut frames = |n: usize| timing(&(0..n).map(|_| draw()).collect::<Vec<_>>());
+        let trials = 2000;
+        let (mut alone, mut gated) = (0, 0);
+        for _ in 0..trials {
+            let (a, b, probe) = (frames(5), frames(5), frames(15));
+            alone += faster(&a, &b, None).is_some() as usize;
+            gated += faster(&a, &b, Some(&probe)).is_some() as usize;
+        }
+        let (alone, gated) = (alone as f64 / trials as f64, gated as f64 / trials as f64);
+        eprintln!("identical pairs ranked: {alone} by disjoint ranges alone, {gated} with the floor");
+        assert!(alone > 0.1, "disjoint ranges alone ranked {alone}");
+        assert!(
+            gated < 0.08 && gated < alone / 2.0,
+            "with the noise floor {gated} were ranked"
+        );
     }
 
     #[test]

@@ -11,7 +11,9 @@
 //! rises linearly from 0 to 1 as the annulus passes over it, so inner = r0 - (1/2 - SHARE) w and
 //! outer = r0 + (1/2 - SHARE) w for annulus width w, wherever r0 falls relative to the pixels: the
 //! exact image's extent is r_p - r_u + 0.9 w. Annuli with fewer than [`MIN_PIXELS`] pixels (the
-//! corners of the patch) are skipped.
+//! corners of the patch) are skipped. A crossing that the patch clips (the outermost annulus
+//! still shadowed, or the innermost lit where the patch does not reach the axis) is not a
+//! measurement: the extent is NaN there, "beyond the patch", never the patch's edge.
 
 /// Share of an annulus's pixels that must show (partial) shadow or light.
 pub const SHARE: f64 = 0.05;
@@ -56,7 +58,7 @@ impl Annuli {
         (n, (counts[hi] - counts[lo]) as f64 / n.max(1) as f64)
     }
 
-    /// Inner and outer extent (m); NaN where no annulus qualifies.
+    /// Inner and outer extent (m); NaN where no annulus qualifies or the patch clips the crossing.
     pub fn extent(&self) -> (f64, f64) {
         let (Some(&first), Some(&last)) = (self.radius.first(), self.radius.last()) else {
             return (f64::NAN, f64::NAN);
@@ -64,14 +66,17 @@ impl Annuli {
         let step = self.width / STEPS as f64;
         let count = ((last - first) / step).ceil() as usize + 1;
         let centres = (0..count).map(|k| first + k as f64 * step);
-        let inner = self.crossing(centres.clone(), &self.lit);
-        let outer = self.crossing(centres.rev(), &self.shadowed);
+        // An innermost annulus that covers the axis may already be lit: there is no umbra.
+        let from_axis = first <= 0.5 * self.width;
+        let inner = self.crossing(centres.clone(), &self.lit, from_axis);
+        let outer = self.crossing(centres.rev(), &self.shadowed, false);
         (inner, outer)
     }
 
     /// The first centre in `centres` whose share reaches [`SHARE`], interpolated from the
-    /// previous qualifying-size annulus.
-    fn crossing(&self, centres: impl Iterator<Item = f64>, counts: &[usize]) -> f64 {
+    /// previous qualifying-size annulus. Reached at the first annulus, the crossing lies at or
+    /// before the patch's edge: NaN unless `open_start` says nothing lies before it.
+    fn crossing(&self, centres: impl Iterator<Item = f64>, counts: &[usize], open_start: bool) -> f64 {
         let mut previous: Option<(f64, f64)> = None;
         for c in centres {
             let (n, s) = self.share(c, counts);
@@ -81,7 +86,8 @@ impl Annuli {
             if s >= SHARE {
                 return match previous {
                     Some((c0, s0)) => c0 + (c - c0) * (SHARE - s0) / (s - s0),
-                    None => c,
+                    None if open_start => c,
+                    None => f64::NAN,
                 };
             }
             previous = Some((c, s));
@@ -131,6 +137,18 @@ mod tests {
             (inner - 1.55).abs() < 0.011 && (outer - 8.45).abs() < 0.011,
             "{inner} {outer}"
         );
+    }
+
+    #[test]
+    fn crossings_the_patch_clips_are_not_measured() {
+        // Partial shadow from r = 2 to past the patch's edge at r = 10.
+        let (inner, outer) = annuli(|r| ((r - 2.0) / 12.0).clamp(0.0, 1.0)).extent();
+        assert!((inner - 1.55).abs() < 0.011, "{inner}");
+        assert!(outer.is_nan(), "the penumbra runs past the patch, yet outer = {outer}");
+        // A ring patch (r in [3, 10)) lit throughout: the umbra, if any, lies inside r = 3.
+        let ring: Vec<(f64, f64)> = (300..1000).map(|k| ((k as f64 + 0.5) / 100.0, 1.0)).collect();
+        let (inner, _) = Annuli::new(ring, 1.0).extent();
+        assert!(inner.is_nan(), "the ring's inner edge read as an extent: {inner}");
     }
 
     #[test]

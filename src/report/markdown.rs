@@ -123,7 +123,7 @@ fn noise_floor(outcome: &Outcome) -> String {
     };
     let (q1, med, q3) = t.frame_ms();
     format!(
-        "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint; otherwise they are equal within timing noise.\n\n",
+        "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint and their medians differ by more than this noise floor's interquartile range; otherwise they are equal within timing noise.\n\n",
         t.frame_seconds.len() / crate::experiment::timing::NOISE_VISITS as usize,
         t.clock,
         run.scheme,
@@ -138,7 +138,7 @@ fn noise_floor(outcome: &Outcome) -> String {
 
 /// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
 /// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked
-/// against uniform's time only where the interquartile ranges are disjoint.
+/// against uniform's time only where [`faster`] can tell them apart.
 fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, lights: u32) -> String {
     let mut s = format!(
         "\n## What accuracy costs ({lights} light(s))\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [first, third quartile] of the timed frames. `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and how it ranks against uniform@{n}'s.\n\n"
@@ -164,7 +164,7 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, l
             .and_then(|u| rows.iter().find(|x| x.mean("rmse") <= u.mean("rmse")).map(|x| (x, u)))
             .map_or("not reached".to_string(), |(x, u)| {
                 let rank = match (&x.timing, &u.timing) {
-                    (Some(a), Some(b)) => match faster(a, b) {
+                    (Some(a), Some(b)) => match faster(a, b, outcome.timings.noise.as_ref().map(|n| &n.1)) {
                         Some(true) => "faster than uniform",
                         Some(false) => "slower than uniform",
                         None => "equal within timing noise",

@@ -165,6 +165,9 @@ impl Thresholds {
                 ),
             ));
         }
+        if out.is_empty() {
+            out.push(not_swept(scheme, radius, t.min_samples));
+        }
         out
     }
 
@@ -172,7 +175,7 @@ impl Thresholds {
     /// 16 rays and more.
     pub fn check_paper_width(&self, summaries: &[Summary], scheme: DiskScheme, radius: f64) -> Vec<Check> {
         let t = &self.paper;
-        at_counts(summaries, scheme, radius, 16)
+        let out: Vec<Check> = at_counts(summaries, scheme, radius, 16)
             .map(|s| {
                 let excess = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
                 check(
@@ -183,7 +186,11 @@ impl Thresholds {
                     ),
                 )
             })
-            .collect()
+            .collect();
+        if out.is_empty() {
+            return vec![not_swept(scheme, radius, 16)];
+        }
+        out
     }
 
     /// `scheme`'s RMSE falls from 4 to 64 rays at least as fast as the bound asks of uniform
@@ -234,6 +241,15 @@ impl Thresholds {
         ));
         out
     }
+}
+
+/// A bound with nothing to check fails: a thresholds file that names a scheme the sweep lacks
+/// protects nothing.
+fn not_swept(scheme: DiskScheme, radius: f64, min: u32) -> Check {
+    check(
+        false,
+        format!("{scheme}: not swept per-pixel with one light of radius {radius} m at {min} rays or more"),
+    )
 }
 
 /// Per-pixel summaries of `scheme` at `radius` with one light, from `min` rays up.

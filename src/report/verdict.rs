@@ -28,6 +28,11 @@ impl Compare {
         ))
     }
 
+    /// Whether both means have intervals, so that a difference can be called either way.
+    pub fn comparable(&self) -> bool {
+        self.intervals().is_some()
+    }
+
     /// Whether both intervals exist and are disjoint with a above b.
     pub fn a_above(&self) -> bool {
         self.intervals().is_some_and(|(a, b)| a.0 > b.1)
@@ -127,6 +132,8 @@ impl Verdict {
                 "The paper's penumbra is narrower (95 % intervals disjoint)."
             } else if self.seeds < 2 {
                 "Without intervals no difference can be called."
+            } else if !self.extent.comparable() {
+                "No difference can be called: an extent is missing (no penumbra, or beyond the measured patch)."
             } else {
                 "The difference is within the seed-to-seed noise."
             }
@@ -145,6 +152,10 @@ impl Verdict {
             or_na(w, mm),
             if departs {
                 "The paper's extra width is a departure from the exact profile: a bias, not a truer penumbra."
+            } else if self.seeds < 2 {
+                "Without intervals no difference can be called."
+            } else if !self.width_10_90.comparable() || !w.is_finite() {
+                "No difference can be called: a 10-90 % width is missing (no penumbra, or beyond the measured patch)."
             } else {
                 "Neither profile departs from the exact one by more than the other beyond noise."
             }

@@ -199,13 +199,40 @@ impl GpuBackend {
     }
 
     /// Shadow samples per dispatch: all of a light's samples in one, unless the adapter caps loop
-    /// iterations (see [`super::loop_cap`]), where a chunk keeps every loop under the cap: 32
-    /// samples when a BVH walk of a few hundred steps runs per sample, 1024 for analytic scenes.
+    /// iterations (see [`super::loop_cap`]), where a chunk keeps one invocation's loop iterations
+    /// under the cap: [`shadow_sample_iterations`] per sample, and the primary ray's loop.
     fn samples_per_dispatch(&self, packed: &Packed) -> u32 {
-        match (self.loop_cap, packed.nodes.is_empty()) {
-            (None, _) => u32::MAX,
-            (Some(_), true) => 1024,
-            (Some(_), false) => 32,
+        match self.loop_cap {
+            None => u32::MAX,
+            Some(cap) => chunk_under_cap(cap, packed),
         }
     }
+}
+
+/// Loop iterations one shadow sample may run besides its occluder loops: the disk-point
+/// generators in sampling.wgsl (isqrt's two digit loops, at most 16 each; the strata search,
+/// at most sqrt(n) ≤ 64 for n ≤ 4096; Sobol's bit loop, at most 32), with room to spare.
+const SAMPLE_POINT_ITERATIONS: u32 = 192;
+/// Loop iterations budgeted for one any-hit BVH walk (node pops plus leaf triangles). obvhs's
+/// SAH trees over the shipped meshes stay in the low hundreds; grazing rays pay more.
+const BVH_WALK_ITERATIONS: u32 = 1536;
+
+/// Upper bound on the loop iterations of one shadow sample in render.wgsl: the sample loop's own
+/// step, the point generator, one test per sphere and per plane, and a BVH walk when the scene
+/// has meshes.
+pub(super) fn shadow_sample_iterations(packed: &Packed) -> u32 {
+    let walk = if packed.nodes.is_empty() {
+        0
+    } else {
+        BVH_WALK_ITERATIONS
+    };
+    1 + SAMPLE_POINT_ITERATIONS + packed.spheres.len() as u32 + packed.planes.len() as u32 + walk
+}
+
+/// Samples per dispatch on an adapter that stops loops after `cap` iterations: the largest count
+/// whose loops, with the primary ray's (one per sphere and plane), fit under the cap. Never zero:
+/// a scene too large for one sample per dispatch renders what the adapter allows.
+pub(super) fn chunk_under_cap(cap: u32, packed: &Packed) -> u32 {
+    let primary = (packed.spheres.len() + packed.planes.len()) as u32;
+    (cap.saturating_sub(primary) / shadow_sample_iterations(packed)).max(1)
 }
