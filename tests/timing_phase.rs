@@ -113,3 +113,34 @@ fn timing_asks_for_at_least_five_repeats() {
         "{e}"
     );
 }
+
+/// The frame-rate experiment times each configuration in one call after a sizing frame, so the
+/// timed frames share their resources (not one set of buffers per frame).
+#[test]
+fn frame_rates_are_timed_over_shared_resources() {
+    use penumbra::experiment::fps::{run_fps, FpsSpec};
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = common::repo("experiments/scenes");
+    let text = std::fs::read_to_string(common::repo("experiments/fps.toml"))
+        .unwrap()
+        .replace("frames = 100", "frames = 7")
+        .replace("resolutions = [[800, 600], [1920, 1080]]", "resolutions = [[16, 12]]")
+        .replace("scene = \"scenes/", &format!("scene = \"{}/", scenes.display()));
+    let path = dir.path().join("fps.toml");
+    std::fs::write(&path, text).unwrap();
+    let spec = FpsSpec::load(&path).unwrap();
+    let mut backend = Drifting {
+        cpu: CpuBackend::default(),
+        calls: vec![],
+    };
+    let rows = run_fps(&spec, &mut backend).unwrap();
+    assert_eq!(rows.len(), 4, "two scenes, one and two lights, one resolution");
+    // Per configuration: warm-up and one sizing frame, then the other six in one call.
+    let per_config: Vec<(u32, u32)> = backend.calls.iter().map(|c| (c.2, c.3)).collect();
+    assert_eq!(per_config, [(1, 1), (1, 6)].repeat(4));
+    assert!(
+        rows.iter().all(|r| r.frames == 7),
+        "{:?}",
+        rows.iter().map(|r| r.frames).collect::<Vec<_>>()
+    );
+}

@@ -200,6 +200,13 @@ impl FpsRow {
     }
 }
 
+/// Timed frames for a configuration whose frames take `per_frame` seconds: as many as fit in
+/// `max_seconds`, at least 3, at most `frames`.
+fn frames_within(spec: &FpsSpec, per_frame: f64) -> u32 {
+    let fit = (spec.max_seconds / per_frame.max(1e-9)).floor().min(u32::MAX as f64) as u32;
+    fit.clamp(3.min(spec.frames), spec.frames)
+}
+
 /// Times every configuration; one row each.
 pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend) -> anyhow::Result<Vec<FpsRow>> {
     let mut rows = Vec::new();
@@ -223,17 +230,15 @@ pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend) -> anyhow::Result<Vec<
                 let frame = backend
                     .render(&scene, view, spec.sampling)
                     .with_context(|| format!("rendering {}", s.name))?;
+                // One call times every frame over the same resources; a first frame sizes the
+                // run to the time budget.
                 let start = Instant::now();
-                let mut seconds = Vec::new();
-                let mut clock = Clock::WallClock;
-                backend.time(&scene, view, spec.sampling, spec.warmup, 0)?;
-                while seconds.len() < spec.frames as usize
-                    && (seconds.len() < 3 || start.elapsed().as_secs_f64() < spec.max_seconds)
-                {
-                    let t = backend.time(&scene, view, spec.sampling, 0, 1)?;
-                    clock = t.clock;
-                    seconds.extend(t.seconds);
-                }
+                let first = backend.time(&scene, view, spec.sampling, spec.warmup, 1)?;
+                let per_frame = start.elapsed().as_secs_f64() / (spec.warmup + 1) as f64;
+                let more = frames_within(spec, per_frame).saturating_sub(1);
+                let rest = backend.time(&scene, view, spec.sampling, 1, more)?;
+                let clock = rest.clock;
+                let seconds: Vec<f64> = first.seconds.into_iter().chain(rest.seconds).collect();
                 rows.push(FpsRow {
                     scene: s.name.clone(),
                     lights,
