@@ -23,6 +23,15 @@ fn sampling(seed: u32) -> Sampling {
     }
 }
 
+/// Without the split a capped adapter cuts loops short, and the renderer says so instead of
+/// returning a frame with rays missing.
+fn cut_short(whole: anyhow::Result<penumbra::render::Frame>) {
+    match whole {
+        Err(e) => assert!(e.to_string().contains("ended a loop early"), "{e:#}"),
+        Ok(f) => panic!("the undivided frame came back as whole, {} rays", f.rays.shadow_total()),
+    }
+}
+
 #[test]
 fn geometry_is_uploaded_once_per_scene_and_again_when_it_changes() {
     let Some(mut gpu) = common::gpu() else { return };
@@ -87,12 +96,7 @@ fn the_loop_cap_probe_finds_what_the_split_works_around() {
         gpu.set_loop_cap(None);
         let whole = gpu.render(&s, view, sampling(1));
         gpu.set_loop_cap(cap);
-        let whole = whole.unwrap();
-        assert!(
-            whole.rays.shadow_total() < cpu.rays.shadow_total(),
-            "without the split the capped adapter traced all {} rays",
-            cpu.rays.shadow_total()
-        );
+        cut_short(whole);
     }
 }
 
@@ -128,7 +132,76 @@ fn many_spheres_keep_every_shadow_ray_under_the_loop_cap() {
         gpu.set_loop_cap(None);
         let whole = gpu.render(&s, view, sampling(4));
         gpu.set_loop_cap(cap);
-        assert!(whole.unwrap().rays.shadow_total() < cpu.rays.shadow_total());
+        cut_short(whole);
+    }
+}
+
+/// A mesh whose walks outrun the split's budget: 2000 needles between random points of the space
+/// between receiver and light, whose boxes overlap so much that a shadow ray enters hundreds of
+/// leaves. The shader reports
+/// loops cut short, the renderer halves its split until the frame is whole, and the GPU traces
+/// exactly the CPU's rays.
+#[test]
+fn walks_longer_than_their_budget_are_caught_and_split_again() {
+    let Some(mut gpu) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let stream = penumbra::sampling::Stream::new(21, 0, None);
+    let mut next = 0u32;
+    let mut point = || {
+        let mut u = || {
+            next += 1;
+            stream.unit(next)
+        };
+        [2.0 * u() - 1.0, 2.0 * u() - 1.0, 0.6 + 0.9 * u()]
+    };
+    let mut obj = String::new();
+    for k in 0..2000 {
+        let (a, b) = (point(), point());
+        obj += &format!("v {} {} {}\nv {} {} {}\n", a[0], a[1], a[2], b[0], b[1], b[2]);
+        obj += &format!(
+            "v {} {} {}\nf {} {} {}\n",
+            b[0] + 1e-4,
+            b[1],
+            b[2],
+            3 * k + 1,
+            3 * k + 2,
+            3 * k + 3
+        );
+    }
+    std::fs::write(dir.path().join("needles.obj"), obj).unwrap();
+    let camera = r#"
+[cameras.measure]
+projection = "orthographic"
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+width = 0.6
+
+[[meshes]]
+path = "needles.obj"
+albedo = 0.7
+"#;
+    let path = dir.path().join("needles.toml");
+    std::fs::write(&path, camera.to_string() + &common::plane_and_light(0.05)).unwrap();
+    let mut s = Scene::load(&path).unwrap();
+    if let Light::Disk(d) = &mut s.lights[0] {
+        d.samples = 64;
+    }
+    let view = View {
+        camera: &s.cameras["measure"],
+        width: 8,
+        height: 8,
+    };
+    let cpu = CpuBackend::default().render(&s, view, sampling(5)).unwrap();
+    let frame = gpu.render(&s, view, sampling(5)).unwrap();
+    assert_eq!(frame.rays.shadow_total(), cpu.rays.shadow_total());
+    let timed = gpu.time(&s, view, sampling(5), 0, 1).unwrap();
+    assert_eq!(timed.seconds.len(), 1);
+    if gpu.loop_cap().is_some() {
+        assert!(
+            gpu.chunk_divisor() > 1,
+            "the walks fit the budget: the test lost its teeth"
+        );
     }
 }
 

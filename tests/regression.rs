@@ -65,7 +65,9 @@ fn radius() -> f64 {
 fn ci_experiment_stays_within_thresholds() {
     let c = ci();
     let checks = c.thresholds.check_all(&c.references, &c.summaries, radius());
-    assert!(checks.len() >= 4 + 4 * 2 * 2 + 2 + 2, "{} checks", checks.len());
+    // Ground truth 4; per scheme a width check at 16 and 64 rays and at least one bias check;
+    // paper 2; convergence 2.
+    assert!(checks.len() >= 4 + 4 * (2 + 1) + 2 + 2, "{} checks", checks.len());
     let failed = failures(&checks);
     assert!(failed.is_empty(), "thresholds crossed: {failed:#?}");
 }
@@ -220,4 +222,23 @@ fn a_bound_on_a_scheme_the_sweep_lacks_fails() {
         failures(&checks);
         assert!(checks.len() == 1 && !checks[0].ok, "{checks:#?}");
     }
+}
+
+#[test]
+fn an_unbiasedness_bound_too_loose_to_see_a_bias_fails() {
+    let c = ci();
+    let mut strict = c.thresholds.clone();
+    strict.unbiased.detectable_bias2 = 1e-9;
+    let checks = strict.check_unbiased(&c.summaries, DiskScheme::Uniform, radius());
+    failures(&checks);
+    assert!(
+        checks
+            .iter()
+            .any(|x| !x.ok && x.what.contains("no swept count resolves")),
+        "{checks:#?}"
+    );
+    assert!(
+        !checks.iter().any(|x| x.what.contains("per-pixel squared bias")),
+        "{checks:#?}"
+    );
 }

@@ -101,6 +101,19 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
         o.records.iter().map(|r| r.get("frame_ms").to_string()).collect()
     };
     assert_eq!(frame_ms(&again), frame_ms(&out));
+    // One configuration more: every configuration is timed again in one interleaved phase, so
+    // the new one is never ranked against frames timed in another process.
+    let text = std::fs::read_to_string(&exp).unwrap();
+    std::fs::write(
+        &exp,
+        text.replace(r#"["uniform", "paper"]"#, r#"["uniform", "paper", "jittered"]"#),
+    )
+    .unwrap();
+    let wider = Spec::load(&exp).unwrap();
+    backend.calls.clear();
+    let third = run_sweep(&wider, &mut backend, &journal, &cache, false).unwrap();
+    assert_eq!(third.timings.configs.len(), configs + 4);
+    assert_eq!(backend.calls.len(), 5 * (configs + 4 + NOISE_VISITS as usize));
 }
 
 #[test]

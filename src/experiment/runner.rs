@@ -193,7 +193,14 @@ fn time_sweep(
         }
     }
     let noise_key = probe.map(|g| timing::noise_key(&g.head().key(context)));
-    let journaled_noise = noise_key.as_ref().and_then(|k| journal.timing(k, &settings)).cloned();
+    let mut journaled_noise = noise_key.as_ref().and_then(|k| journal.timing(k, &settings)).cloned();
+    // Times are compared only within one interleaved phase: if anything must be timed, all is
+    // timed again, so no ranking sets frames from two processes (and two machine loads) apart.
+    if !todo.is_empty() || (probe.is_some() && journaled_noise.is_none()) {
+        todo = rendered.clone();
+        result.configs.clear();
+        journaled_noise = None;
+    }
     let noise_todo = if journaled_noise.is_none() { probe } else { None };
     if !todo.is_empty() || noise_todo.is_some() {
         let visits =

@@ -16,12 +16,13 @@ pub fn t975(dof: usize) -> f64 {
     }
 }
 
-/// Mean and the half-width of its 95 % confidence interval, mean +- t s / sqrt(k); NaN values
-/// are skipped, and the half-width is NaN with fewer than two values.
-pub fn mean_ci(values: &[f64]) -> (f64, f64) {
-    let v: Vec<f64> = values.iter().copied().filter(|x| !x.is_nan()).collect();
+/// Mean and the half-width of its 95 % confidence interval, mean +- t s / sqrt(k); the
+/// half-width is NaN with fewer than two values. One NaN value (a seed whose metric is not
+/// measurable, e.g. an extent beyond the patch) makes both NaN: a mean over fewer seeds than the
+/// row claims would be another statistic.
+pub fn mean_ci(v: &[f64]) -> (f64, f64) {
     let k = v.len();
-    if k == 0 {
+    if k == 0 || v.iter().any(|x| x.is_nan()) {
         return (f64::NAN, f64::NAN);
     }
     let mean = v.iter().sum::<f64>() / k as f64;
@@ -70,7 +71,8 @@ mod tests {
         // s = sqrt(5/3), t(3) = 3.182: h = 3.182 * sqrt(5/12).
         assert!((h - 3.182 * (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert!(mean_ci(&[1.0]).1.is_nan());
-        assert_eq!(mean_ci(&[f64::NAN, 2.0, 4.0]).0, 3.0);
+        let (m, h) = mean_ci(&[f64::NAN, 2.0, 4.0]);
+        assert!(m.is_nan() && h.is_nan());
     }
 
     #[test]

@@ -69,6 +69,12 @@ impl OnAxis {
         self.light_radius + self.light_height * (beta - phi).tan()
     }
 
+    /// Where partial shadow begins: r_u, or the axis when there is no umbra (r_u < 0 means the
+    /// whole light is seen past the sphere's silhouette from every receiver point).
+    pub fn inner_radius(&self) -> f64 {
+        self.umbra_radius().max(0.0)
+    }
+
     /// Penumbra (outer) radius r_p.
     pub fn penumbra_radius(&self) -> f64 {
         let (phi, beta) = self.angles();

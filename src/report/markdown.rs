@@ -5,7 +5,7 @@ use super::numbers::or_na;
 use super::summary::{find, Summary};
 use super::verdict::Verdict;
 use crate::experiment::runner::{figure_samples, Outcome};
-use crate::experiment::timing::faster;
+use crate::experiment::timing::{faster, ConfigTiming};
 use crate::experiment::Spec;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
@@ -73,7 +73,11 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.lights,
             r.light_radius,
-            opt(o.map(|o| o.umbra_radius()), |x| format!("{x:.5}")),
+            opt(o.map(|o| o.umbra_radius()), |x| if x < 0.0 {
+                format!("{x:.5} (no umbra)")
+            } else {
+                format!("{x:.5}")
+            }),
             opt(o.map(|o| o.penumbra_radius()), |x| format!("{x:.5}")),
             opt(r.gt_max_abs_all(), |x| format!("{x:.2e}")),
             opt(r.gt_vs_exact().map(|e| e.rmse), |x| format!("{x:.2e}")),
@@ -136,6 +140,19 @@ fn noise_floor(outcome: &Outcome) -> String {
     )
 }
 
+/// How a configuration's frame time ranks against uniform sampling's, by [`faster`] with the
+/// noise probe's floor.
+fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, noise: Option<&ConfigTiming>) -> &'static str {
+    match (x, uniform) {
+        (Some(a), Some(b)) => match faster(a, b, noise) {
+            Some(true) => "faster than uniform",
+            Some(false) => "slower than uniform",
+            None => "equal within timing noise",
+        },
+        _ => "untimed",
+    }
+}
+
 /// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
 /// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked
 /// against uniform's time only where [`faster`] can tell them apart.
@@ -160,19 +177,17 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, l
             })
             .collect();
         rows.sort_by_key(|x| x.run.samples);
-        let matched = uniform
-            .and_then(|u| rows.iter().find(|x| x.mean("rmse") <= u.mean("rmse")).map(|x| (x, u)))
-            .map_or("not reached".to_string(), |(x, u)| {
-                let rank = match (&x.timing, &u.timing) {
-                    (Some(a), Some(b)) => match faster(a, b, outcome.timings.noise.as_ref().map(|n| &n.1)) {
-                        Some(true) => "faster than uniform",
-                        Some(false) => "slower than uniform",
-                        None => "equal within timing noise",
-                    },
-                    _ => "untimed",
-                };
-                format!("{} rays, {}, {rank}", x.run.samples, ms_iqr(x.frame_ms()))
-            });
+        let noise = outcome.timings.noise.as_ref().map(|n| &n.1);
+        let matched = match uniform.filter(|u| u.mean("rmse").is_finite()) {
+            None => "n/a".to_string(),
+            Some(u) => rows
+                .iter()
+                .find(|x| x.mean("rmse") <= u.mean("rmse"))
+                .map_or("not reached".to_string(), |x| {
+                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), noise);
+                    format!("{} rays, {}, {rank}", x.run.samples, ms_iqr(x.frame_ms()))
+                }),
+        };
         s += &format!(
             "| {} | {} | {} | {} | {} | {} | {} |\n",
             scheme,
@@ -185,4 +200,32 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, l
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn timing(ms: &[f64]) -> ConfigTiming {
+        ConfigTiming {
+            frame_seconds: ms.iter().map(|x| x * 1e-3).collect(),
+            primary_seconds: vec![],
+            clock: "wall-clock".into(),
+        }
+    }
+
+    #[test]
+    fn times_rank_only_beyond_the_noise_floor() {
+        // Disjoint interquartile ranges, medians 4 % apart.
+        let (a, b) = (
+            timing(&[99.0, 99.5, 100.0, 100.5, 101.0]),
+            timing(&[103.0, 103.5, 104.0, 104.5, 105.0]),
+        );
+        let quiet = timing(&[99.0, 99.5, 100.0, 100.5, 101.0]);
+        let loud = timing(&[80.0, 90.0, 100.0, 110.0, 120.0]);
+        assert_eq!(time_rank(Some(&a), Some(&b), Some(&quiet)), "faster than uniform");
+        assert_eq!(time_rank(Some(&b), Some(&a), Some(&quiet)), "slower than uniform");
+        assert_eq!(time_rank(Some(&a), Some(&b), Some(&loud)), "equal within timing noise");
+        assert_eq!(time_rank(None, Some(&b), Some(&quiet)), "untimed");
+    }
 }

@@ -21,11 +21,20 @@ pub fn with_ci(mean: f64, ci: f64, f: impl Fn(f64) -> String) -> String {
 }
 
 /// A squared bias with its 95 % interval: "0 within noise (-6.5e-5 ± 1.2e-4)" where the interval
-/// holds 0, else "7.5e-4 ± 1.1e-4"; "n/a" with fewer than two seeds.
+/// holds 0, else "7.5e-4 ± 1.1e-4"; with two seeds the value and why it has no interval; "n/a"
+/// with fewer.
 pub fn bias2(split: &BiasVariance) -> String {
     let e = |x: f64| format!("{x:.2e}");
     if !split.bias2.is_finite() {
         return "n/a".into();
+    }
+    if !split.bias2_ci.is_finite() {
+        // Two seeds: a value, but no interval to read it against; the unbiased estimator can
+        // fall below zero, which would otherwise read as a wrong number.
+        return format!(
+            "{} (no interval below 3 seeds; the unbiased estimator can be negative)",
+            e(split.bias2)
+        );
     }
     let text = with_ci(split.bias2, split.bias2_ci, e);
     if split.zero_within_noise() {
@@ -61,7 +70,10 @@ mod tests {
     fn squared_bias_reads_with_its_interval() {
         assert_eq!(bias2(&split(-6.47e-5, 1.2e-4)), "0 within noise (-6.47e-5 ± 1.20e-4)");
         assert_eq!(bias2(&split(7.5e-4, 1.1e-4)), "7.50e-4 ± 1.10e-4");
-        assert_eq!(bias2(&split(3e-5, f64::NAN)), "3.00e-5 ± n/a");
+        assert_eq!(
+            bias2(&split(-4.61e-5, f64::NAN)),
+            "-4.61e-5 (no interval below 3 seeds; the unbiased estimator can be negative)"
+        );
         assert_eq!(bias2(&split(f64::NAN, f64::NAN)), "n/a");
     }
 }

@@ -40,7 +40,7 @@ pub struct Summary {
     pub exact_width_10_90: f64,
     /// Exact extent width (from the exact image, read with the same annulus as the runs).
     pub exact_extent_width: f64,
-    /// Closed-form penumbra width r_p - r_u (on-axis scenes).
+    /// Closed-form penumbra width r_p - max(r_u, 0) (on-axis scenes; no umbra: from the axis).
     pub closed_form_width: f64,
     /// Bias/variance split.
     pub stats: GroupStats,
@@ -103,7 +103,7 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip, figure: (u32, f64, u32))
                 values,
                 exact_width_10_90: first("exact_width_10_90"),
                 exact_extent_width: first("exact_extent_width"),
-                closed_form_width: first("exact_penumbra_radius") - first("exact_umbra_radius"),
+                closed_form_width: first("exact_penumbra_radius") - first("exact_umbra_radius").max(0.0),
                 stats: g.clone(),
                 timing: outcome.timings.configs.get(&g.key).cloned(),
                 rays_per_s: ["rays_per_s", "primary_rays_per_s", "shadow_rays_per_s"].map(first),

@@ -48,6 +48,9 @@ pub struct UnbiasedBounds {
     pub max_bias2_sigmas: f64,
     /// ...plus this floor (the ground truth's own noise enters the squared bias).
     pub bias2_floor: f64,
+    /// The squared bias the check must be able to see: counts whose bound exceeds it are too
+    /// noisy to test and are skipped, and a scheme with no count below it fails.
+    pub detectable_bias2: f64,
     /// Ray counts from which the checks apply.
     pub min_samples: u32,
     /// Relative tolerance of the 10-90 % width against exact.
@@ -105,7 +108,7 @@ impl Thresholds {
         };
         let (inner, outer) = p.extent();
         let tol = t.extent_tolerance_pixels * r.receivers.bin_width;
-        let (ru, rp) = (o.umbra_radius(), o.penumbra_radius());
+        let (ru, rp) = (o.inner_radius(), o.penumbra_radius());
         vec![
             check(
                 max <= t.max_abs_error,
@@ -140,22 +143,28 @@ impl Thresholds {
 
     /// `scheme` (per-pixel) is unbiased at every swept count from `min_samples`: its per-pixel
     /// squared bias over seeds is 0 within `max_bias2_sigmas` jackknife standard errors plus the
-    /// floor (a squared statistic: errors of either sign add up instead of cancelling), and its
-    /// 10-90 % width is within the tolerance of exact.
+    /// floor (a squared statistic: errors of either sign add up instead of cancelling), wherever
+    /// that bound is below `detectable_bias2` (and somewhere it must be), and its 10-90 % width
+    /// is within the tolerance of exact.
     pub fn check_unbiased(&self, summaries: &[Summary], scheme: DiskScheme, radius: f64) -> Vec<Check> {
         let t = &self.unbiased;
         let mut out = Vec::new();
+        let mut bias_checked = false;
         for s in at_counts(summaries, scheme, radius, t.min_samples) {
             let b = &s.stats.split;
             let se = b.bias2_ci / t975(b.seeds.saturating_sub(1));
             let bound = t.max_bias2_sigmas * se + t.bias2_floor;
-            out.push(check(
-                b.bias2 <= bound,
-                format!(
-                    "{scheme} n={}: per-pixel squared bias {:.2e} <= {:.1} x {se:.2e} + {:.0e}",
-                    s.run.samples, b.bias2, t.max_bias2_sigmas, t.bias2_floor
-                ),
-            ));
+            // NaN bounds (too few seeds) are not skipped: they fail below.
+            if bound.is_nan() || bound <= t.detectable_bias2 {
+                bias_checked = true;
+                out.push(check(
+                    b.bias2 <= bound,
+                    format!(
+                        "{scheme} n={}: per-pixel squared bias {:.2e} <= {:.1} x {se:.2e} + {:.0e}",
+                        s.run.samples, b.bias2, t.max_bias2_sigmas, t.bias2_floor
+                    ),
+                ));
+            }
             let rel = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
             out.push(check(
                 rel.abs() <= t.width_10_90_tolerance,
@@ -167,6 +176,14 @@ impl Thresholds {
         }
         if out.is_empty() {
             out.push(not_swept(scheme, radius, t.min_samples));
+        } else if !bias_checked {
+            out.push(check(
+                false,
+                format!(
+                    "{scheme}: no swept count resolves a squared bias of {:.0e} (more seeds or rays needed)",
+                    t.detectable_bias2
+                ),
+            ));
         }
         out
     }

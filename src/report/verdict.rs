@@ -121,7 +121,7 @@ impl Verdict {
         }
         let (e, w) = self.exact;
         s += &format!(
-            "- *Wider?* The visible penumbra (how far partial shadow reaches, read with a sliding one-pixel annulus) is {} with the paper's pattern and {} with uniform sampling; the exact image reads {} (closed form r_p - r_u = {}; the annulus adds 0.9 pixel). {}\n",
+            "- *Wider?* The visible penumbra (how far partial shadow reaches, read with a sliding one-pixel annulus) is {} with the paper's pattern and {} with uniform sampling; the exact image reads {} (closed form r_p - max(r_u, 0) = {}; the annulus adds 0.9 pixel at an umbra edge). {}\n",
             pm(self.extent.a),
             pm(self.extent.b),
             or_na(e, mm),
@@ -150,8 +150,10 @@ impl Verdict {
             pm(wb),
             dev(wb.0),
             or_na(w, mm),
-            if departs {
+            if departs && wa.0 > w {
                 "The paper's extra width is a departure from the exact profile: a bias, not a truer penumbra."
+            } else if departs {
+                "The paper's profile is narrower than the exact one by more than uniform's departs, beyond noise: a bias."
             } else if self.seeds < 2 {
                 "Without intervals no difference can be called."
             } else if !self.width_10_90.comparable() || !w.is_finite() {
@@ -184,5 +186,83 @@ impl Verdict {
             or_na(self.split.1.variance, e2),
         );
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn split() -> BiasVariance {
+        BiasVariance {
+            seeds: 4,
+            bias2: 1e-4,
+            bias2_ci: 2e-4,
+            variance: 1e-3,
+        }
+    }
+
+    /// A verdict at 4 seeds with the exact 10-90 width 10 mm; extents and 10-90 widths given as
+    /// (paper, uniform) (mean, CI) pairs.
+    fn verdict(extent: [(f64, f64); 2], width: [(f64, f64); 2]) -> Verdict {
+        let none = Compare {
+            a: (f64::NAN, f64::NAN),
+            b: (f64::NAN, f64::NAN),
+        };
+        Verdict {
+            samples: 16,
+            light_radius: 0.02,
+            pattern: Pattern::PerPixel,
+            seeds: 4,
+            extent: Compare {
+                a: extent[0],
+                b: extent[1],
+            },
+            width_10_90: Compare {
+                a: width[0],
+                b: width[1],
+            },
+            rmse: none,
+            rmse_exact: none,
+            flip: none,
+            split: (split(), split()),
+            exact: (0.015, 0.010),
+            closed_form_width: 0.0149,
+        }
+    }
+
+    const AT_EXACT: [(f64, f64); 2] = [(0.010, 1e-4), (0.010, 1e-4)];
+
+    #[test]
+    fn a_difference_is_called_only_between_disjoint_intervals() {
+        let wider = verdict([(0.0150, 1e-4), (0.0145, 1e-4)], AT_EXACT).markdown();
+        assert!(
+            wider.contains("The paper's penumbra is wider (95 % intervals disjoint)."),
+            "{wider}"
+        );
+        let narrower = verdict([(0.0140, 1e-4), (0.0145, 1e-4)], AT_EXACT).markdown();
+        assert!(narrower.contains("is narrower (95 % intervals disjoint)"), "{narrower}");
+        let overlap = verdict([(0.0146, 1e-4), (0.0145, 1e-4)], AT_EXACT).markdown();
+        assert!(overlap.contains("within the seed-to-seed noise"), "{overlap}");
+        let missing = verdict([(f64::NAN, f64::NAN), (0.0145, 1e-4)], AT_EXACT).markdown();
+        assert!(missing.contains("an extent is missing"), "{missing}");
+        assert!(!missing.contains("NaN") && !missing.contains("within the seed-to-seed noise"));
+    }
+
+    #[test]
+    fn a_bias_is_called_only_beyond_both_intervals_and_in_its_direction() {
+        let extent = [(0.0146, 1e-4), (0.0145, 1e-4)];
+        // Paper 6 % wide, uniform at exact, intervals 0.1 mm: a widening bias.
+        let wide = verdict(extent, [(0.0106, 1e-4), (0.0100, 1e-4)]).markdown();
+        assert!(wide.contains("extra width is a departure"), "{wide}");
+        // The same departure inside the intervals: nothing is called.
+        let noisy = verdict(extent, [(0.0106, 4e-4), (0.0100, 4e-4)]).markdown();
+        assert!(noisy.contains("Neither profile departs"), "{noisy}");
+        // Narrower than exact: a bias, but not an extra width.
+        let narrow = verdict(extent, [(0.0094, 1e-4), (0.0100, 1e-4)]).markdown();
+        assert!(narrow.contains("narrower than the exact one"), "{narrow}");
+        assert!(!narrow.contains("extra width"), "{narrow}");
+        let missing = verdict(extent, [(0.0106, f64::NAN), (0.0100, 1e-4)]).markdown();
+        assert!(missing.contains("a 10-90 % width is missing"), "{missing}");
     }
 }

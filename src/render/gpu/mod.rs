@@ -33,6 +33,12 @@ const SHADER: &str = concat!(
     include_str!("shaders/render.wgsl"),
 );
 
+/// u32 words of the counters buffer: per light, shadow rays as (low, high) words; then the
+/// count of invocations whose loops were cut short.
+pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 1;
+/// Word of the counters buffer that counts invocations cut short (`cut_short` in bvh.wgsl).
+const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
+
 /// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`] and prepended
 /// to the shaders, so Rust and WGSL share one list.
 pub fn scheme_prelude() -> String {
@@ -116,7 +122,13 @@ impl GpuBackend {
         let loop_cap = loop_cap::detect(&device, &queue).context("probing the adapter's loop limits")?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render.wgsl"),
-            source: wgpu::ShaderSource::Wgsl((scheme_prelude() + SHADER).into()),
+            source: wgpu::ShaderSource::Wgsl(
+                format!(
+                    "{}const CUT_SHORT_SLOT: u32 = {CUT_SHORT_SLOT}u;\n{SHADER}",
+                    scheme_prelude()
+                )
+                .into(),
+            ),
         });
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
@@ -225,6 +237,12 @@ impl GpuBackend {
     /// How many times static scene data (geometry, BVH) has been uploaded.
     pub fn static_uploads(&self) -> u64 {
         self.static_uploads
+    }
+
+    /// How many times the capped chunk over the resident scene has been halved because frames
+    /// came back cut short (1: never).
+    pub fn chunk_divisor(&self) -> u32 {
+        self.scene.as_ref().map_or(1, |s| s.chunk_divisor)
     }
 
     fn check_limits(&self, scene: &crate::scene::Scene, view: View) -> anyhow::Result<()> {
@@ -343,6 +361,29 @@ impl GpuBackend {
         Ok(bytes)
     }
 
+    /// Whether the frame just rendered over `r` is whole: no invocation reported a loop cut short.
+    /// If some did, the capped chunk over this scene is halved for the next attempt (`Ok(false)`);
+    /// where it is one sample already, or the adapter has no cap, no smaller split can help (a BVH
+    /// deeper than the traversal stack) and the frame is an error, never a silent answer.
+    fn whole(&mut self, r: &FrameResources, packed: &layout::Packed) -> anyhow::Result<bool> {
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.counters, COUNTER_WORDS as u64 * 4)?);
+        let cut = words[CUT_SHORT_SLOT];
+        if cut == 0 {
+            return Ok(true);
+        }
+        let chunk = self.samples_per_dispatch(packed);
+        match (&mut self.scene, self.loop_cap) {
+            (Some(scene), Some(_)) if chunk > 1 => {
+                scene.chunk_divisor *= 2;
+                Ok(false)
+            }
+            _ => bail!(
+                "{cut} GPU invocations ended a loop early (at {chunk} shadow sample(s) per dispatch, loop cap {:?}): a mesh walk longer than the adapter allows or a BVH deeper than the traversal stack; use the CPU backend for this scene",
+                self.loop_cap
+            ),
+        }
+    }
+
     /// (whole frame, primary pass) seconds from the timestamps around each pass.
     fn frame_seconds(&self, r: &FrameResources) -> anyhow::Result<Option<(f64, f64)>> {
         let Some((set, resolve)) = &r.queries else {
@@ -374,11 +415,16 @@ impl Backend for GpuBackend {
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view, 0);
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        self.encode(&mut encoder, &r, view, lights);
-        self.submit(encoder, scope)?;
+        let r = loop {
+            let r = self.resources(&packed, view, 0);
+            let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, &r, view, lights);
+            self.submit(encoder, scope)?;
+            if self.whole(&r, &packed)? {
+                break r;
+            }
+        };
         let pixels = view.pixels();
         let hits: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.hits, pixels as u64 * HIT_BYTES)?);
         let vis: Vec<f32> = if lights > 0 {
@@ -417,16 +463,35 @@ impl Backend for GpuBackend {
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = self.resources(&packed, view, 0);
+        loop {
+            let r = self.resources(&packed, view, 0);
+            let timing = self.time_frames(&r, view, lights, warmup, repeats)?;
+            if self.whole(&r, &packed)? {
+                return Ok(timing);
+            }
+        }
+    }
+}
+
+impl GpuBackend {
+    /// `warmup` untimed and `repeats` timed frames over the same resources.
+    fn time_frames(
+        &self,
+        r: &FrameResources,
+        view: View,
+        lights: usize,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<Timing> {
         let (mut seconds, mut primary_seconds) = (Vec::new(), Vec::new());
         for i in 0..warmup + repeats {
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, &r, view, lights);
+            self.encode(&mut encoder, r, view, lights);
             let start = Instant::now();
             self.submit(encoder, scope)?;
             let wall = start.elapsed().as_secs_f64();
-            let passes = self.frame_seconds(&r)?;
+            let passes = self.frame_seconds(r)?;
             if i >= warmup {
                 seconds.push(passes.map_or(wall, |p| p.0));
                 primary_seconds.extend(passes.map(|p| p.1));

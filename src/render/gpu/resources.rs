@@ -6,8 +6,8 @@
 
 use super::layout::{GpuLight, Packed, PassInfo, HIT_BYTES};
 use super::GpuBackend;
+use super::COUNTER_WORDS;
 use crate::fingerprint::fnv1a;
-use crate::render::plan::MAX_LIGHTS;
 use crate::render::View;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -15,6 +15,9 @@ use wgpu::util::DeviceExt;
 /// The scene's static buffers and the hash of the packed content they hold.
 pub(super) struct SceneBuffers {
     key: u64,
+    /// The capped chunk is divided by this: doubled each time a frame over this scene reports
+    /// loops cut short (a BVH walk longer than its budget), so the split adapts per scene.
+    pub chunk_divisor: u32,
     spheres: wgpu::Buffer,
     planes: wgpu::Buffer,
     nodes: wgpu::Buffer,
@@ -78,6 +81,7 @@ impl GpuBackend {
             self.static_uploads += 1;
             self.scene = Some(SceneBuffers {
                 key,
+                chunk_divisor: 1,
                 spheres: self.storage("spheres", &packed.spheres, Zeroable::zeroed()),
                 planes: self.storage("planes", &packed.planes, Zeroable::zeroed()),
                 nodes: self.storage("bvh nodes", &packed.nodes, Zeroable::zeroed()),
@@ -106,7 +110,7 @@ impl GpuBackend {
             (pixels * packed.lights.len().max(1) as u64).max(extra_floats) * 4,
         );
         let radiance = self.output("radiance", pixels * 4);
-        let counters = self.output("ray counters", (MAX_LIGHTS * 2 * 4) as u64);
+        let counters = self.output("ray counters", COUNTER_WORDS as u64 * 4);
         let buffers = [
             &params,
             &s.spheres,
@@ -200,11 +204,13 @@ impl GpuBackend {
 
     /// Shadow samples per dispatch: all of a light's samples in one, unless the adapter caps loop
     /// iterations (see [`super::loop_cap`]), where a chunk keeps one invocation's loop iterations
-    /// under the cap: [`shadow_sample_iterations`] per sample, and the primary ray's loop.
-    fn samples_per_dispatch(&self, packed: &Packed) -> u32 {
+    /// under the cap: [`shadow_sample_iterations`] per sample, and the primary ray's loop,
+    /// divided further where frames over this scene were cut short.
+    pub(super) fn samples_per_dispatch(&self, packed: &Packed) -> u32 {
+        let divisor = self.scene.as_ref().map_or(1, |s| s.chunk_divisor);
         match self.loop_cap {
             None => u32::MAX,
-            Some(cap) => chunk_under_cap(cap, packed),
+            Some(cap) => (chunk_under_cap(cap, packed) / divisor).max(1),
         }
     }
 }

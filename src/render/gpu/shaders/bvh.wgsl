@@ -34,6 +34,11 @@ const BIG: f32 = 3.4e38;
 // array is cleared on each call, which tripled the cost of analytic-only shadow rays on lavapipe.
 var<private> stack: array<u32, STACK_SIZE>;
 
+// Set when a loop ended before its own exit condition held (an adapter's loop-iteration cap) or
+// a walk dropped children because its stack was full: the invocation's answer is not to be
+// trusted, and the kernel reports it in `counters[CUT_SHORT_SLOT]`.
+var<private> cut_short: bool = false;
+
 @group(0) @binding(9) var<storage, read> nodes: array<Node>;
 @group(0) @binding(10) var<storage, read> tris: array<Tri>;
 
@@ -86,13 +91,17 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
         let n = nodes[stack[sp]];
         let entered = slab(o, inv_d, best.t, n) != BIG;
         if (entered && n.prim_count > 0u) {
-            for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
+            var i = n.first_index;
+            for (; i < n.first_index + n.prim_count; i++) {
                 let t = tri_t(o, d, tris[i]);
                 if (t > 0.0 && t < best.t && tris[i].index != skip) {
                     best = MeshHit(t, i);
                 }
             }
-        } else if (entered && sp + 2u <= STACK_SIZE) {
+            cut_short = cut_short || i < n.first_index + n.prim_count;
+        } else if (entered && sp + 2u > STACK_SIZE) {
+            cut_short = true;
+        } else if (entered) {
             // Visit the nearer child first.
             let a = slab(o, inv_d, best.t, nodes[n.first_index]);
             let b = slab(o, inv_d, best.t, nodes[n.first_index + 1u]);
@@ -102,6 +111,7 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
             sp += 2u;
         }
     }
+    cut_short = cut_short || sp > 0u;
     return best;
 }
 
@@ -121,15 +131,20 @@ fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
         let n = nodes[stack[sp]];
         let entered = slab(o, inv_d, tmax, n) != BIG;
         if (entered && n.prim_count > 0u) {
-            for (var i = n.first_index; i < n.first_index + n.prim_count; i++) {
+            var i = n.first_index;
+            for (; i < n.first_index + n.prim_count; i++) {
                 let t = tri_t(o, d, tris[i]);
                 found = found || (t > 0.0 && t < tmax && tris[i].index != skip);
             }
-        } else if (entered && sp + 2u <= STACK_SIZE) {
+            cut_short = cut_short || i < n.first_index + n.prim_count;
+        } else if (entered && sp + 2u > STACK_SIZE) {
+            cut_short = true;
+        } else if (entered) {
             stack[sp] = n.first_index;
             stack[sp + 1u] = n.first_index + 1u;
             sp += 2u;
         }
     }
+    cut_short = cut_short || (sp > 0u && !found);
     return found;
 }

@@ -101,18 +101,21 @@ fn plane_t(origin: vec3<f32>, dir: vec3<f32>, pl: Plane) -> f32 {
 fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
     let len = length(d);
     let dir = d / len;
-    for (var i = 0u; i < params.sphere_count; i++) {
+    var i = 0u;
+    for (; i < params.sphere_count; i++) {
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
         if (i != skip && r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
             return true;
         }
     }
-    for (var i = 0u; i < params.plane_count; i++) {
-        let t = plane_t(origin, dir, planes[i]);
-        if (params.sphere_count + i != skip && t > 0.0 && t < len) {
+    var j = 0u;
+    for (; j < params.plane_count; j++) {
+        let t = plane_t(origin, dir, planes[j]);
+        if (params.sphere_count + j != skip && t > 0.0 && t < len) {
             return true;
         }
     }
+    cut_short = cut_short || i < params.sphere_count || j < params.plane_count;
     return bvh_any(origin, dir, len, skip_tri);
 }
 
@@ -185,6 +188,9 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     hits[pixel] = hit;
+    if (cut_short) {
+        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
+    }
 }
 
 fn add_rays(light: u32, n: u32) {
@@ -235,7 +241,8 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
             var visible = 0u;
             var sum = 0.0;
             let last = min(first + pass_info.sample_count, light.samples);
-            for (var k = first; k < last; k++) {
+            var k = first;
+            for (; k < last; k++) {
                 var s: vec2<f32>;
                 if (params.shared_pattern != 0u) {
                     s = shared_points[light.shared_offset + k];
@@ -253,6 +260,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                     }
                 }
             }
+            cut_short = cut_short || k < last;
             vis = f32(visible) / f32(light.samples);
             irradiance = light.power / (PI * f32(light.samples)) * sum;
         }
@@ -261,6 +269,9 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     visibility[out] += vis;
     radiance[pixel] += hit.albedo / PI * irradiance;
     add_rays(li, rays);
+    if (cut_short) {
+        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
+    }
 }
 
 // Test hook: the unit-disk points a scheme gives pixel `seed`'s stream, for the CPU/GPU
