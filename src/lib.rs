@@ -17,6 +17,7 @@
 pub mod accel;
 pub mod config;
 pub mod experiment;
+pub mod files;
 pub mod fingerprint;
 pub mod geometry;
 pub mod mesh;

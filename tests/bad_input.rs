@@ -15,7 +15,7 @@ fn rejects(edit: impl Fn(String) -> String) -> String {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("runs.csv"), "earlier results\n").unwrap();
     let (code, stderr) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
-    assert_ne!(code, 0, "accepted bad input; stderr:\n{stderr}");
+    assert_eq!(code, 2, "bad input must exit with status 2; stderr:\n{stderr}");
     assert_eq!(
         std::fs::read_to_string(out.join("runs.csv")).unwrap(),
         "earlier results\n"
@@ -76,7 +76,7 @@ fn bad_scene_value_is_located_in_the_scene_file() {
         .replace("radius = 0.25", "radius = 0.0");
     std::fs::write(&scene, text).unwrap();
     let (code, e) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), dir.path().join("r").as_os_str()]);
-    assert_ne!(code, 0);
+    assert_eq!(code, 2);
     assert!(e.contains("sphere.toml:") && e.contains("spheres[0].radius"), "{e}");
     assert!(!Path::new(&dir.path().join("r/runs.csv")).exists());
 }
@@ -84,7 +84,7 @@ fn bad_scene_value_is_located_in_the_scene_file() {
 #[test]
 fn missing_experiment_file() {
     let (code, e) = common::sweep(&[OsStr::new("/nonexistent/exp.toml")]);
-    assert_ne!(code, 0);
+    assert_eq!(code, 2);
     assert!(e.contains("/nonexistent/exp.toml") && e.contains("cannot read"), "{e}");
 }
 
@@ -112,7 +112,7 @@ fn no_gpu_adapter() {
     let gpu = run("gpu", "g");
     let err = String::from_utf8_lossy(&gpu.stderr);
     assert!(
-        !gpu.status.success() && err.contains("no GPU adapter") && err.contains("mesa-vulkan-drivers"),
+        gpu.status.code() == Some(1) && err.contains("no GPU adapter") && err.contains("mesa-vulkan-drivers"),
         "{err}"
     );
     assert!(!dir.path().join("g/runs.csv").exists());
@@ -147,7 +147,7 @@ fn frame_rate_experiment_errors_are_located() {
         OsStr::new("--out"),
         dir.path().join("r").as_os_str(),
     ]);
-    assert_ne!(code, 0);
+    assert_eq!(code, 2);
     assert!(
         e.contains("fps.toml:") && e.contains("scenes[0].lights") && e.contains("1..=1"),
         "{e}"

@@ -144,3 +144,42 @@ fn traced_rays_match_an_independent_count() {
         check("gpu", &mut *g);
     }
 }
+
+/// The GPU dispatches exactly the plan's passes: one primary dispatch, and per light one
+/// dispatch per sample chunk (every light here fits one chunk on any adapter: at most 32
+/// samples, and a capped adapter's chunk holds hundreds on a mesh-free scene). Counted for the
+/// full scene, for it without lights, and over timed frames.
+#[test]
+fn the_gpu_dispatches_the_plans_passes_and_nothing_else() {
+    let Some(mut gpu) = common::gpu() else { return };
+    let (mut s, cam) = scene();
+    let view = View {
+        camera: &cam,
+        width: 16,
+        height: 12,
+    };
+    let sampling = Sampling {
+        scheme: DiskScheme::Uniform,
+        pattern: Pattern::PerPixel,
+        seed: 3,
+    };
+    let mut count = |s: &Scene, frames: u32| {
+        let before = gpu.dispatches();
+        if frames == 1 {
+            gpu.render(s, view, sampling).unwrap();
+        } else {
+            gpu.time(s, view, sampling, 1, frames - 1).unwrap();
+        }
+        gpu.dispatches() - before
+    };
+    assert_eq!(count(&s, 1), 1 + 3, "primary and three lights");
+    assert_eq!(
+        count(&s, 4),
+        4 * (1 + 3),
+        "warm-up and timed frames run the same passes"
+    );
+    s.lights.truncate(1);
+    assert_eq!(count(&s, 1), 1 + 1, "primary and the point light");
+    s.lights.clear();
+    assert_eq!(count(&s, 1), 1, "no light, no shadow pass");
+}

@@ -2,33 +2,70 @@
 
 use anyhow::Context;
 use clap::Parser;
-use penumbra::experiment::fps::{is_fps, run_fps, FpsSpec};
-use penumbra::experiment::{pictures::render_pictures, run_sweep, spec::BackendChoice, Spec};
-use penumbra::render::open_backend;
+use penumbra::config::ConfigError;
+use penumbra::experiment::filter::{self, Filter};
+use penumbra::experiment::fps::{is_fps, run_fps, timed_scene, FpsSpec};
+use penumbra::experiment::run::expand;
+use penumbra::experiment::runner::sweep_plan;
+use penumbra::experiment::{pictures::render_pictures, run_sweep, Spec};
+use penumbra::render::{open_backend, BackendChoice, RenderPlan, View};
 use penumbra::report::fps::write_fps;
 use penumbra::report::markdown::verdict_radius;
 use penumbra::report::write::{write_all, Results};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use tracing::info;
+use tracing_subscriber::EnvFilter;
+
+/// Exit statuses, stated in `--help`.
+const AFTER_HELP: &str = "Exit status: 0 when every run rendered and the results are written; 2 for bad \
+input (the experiment or scene file, an OBJ, a command-line value), before any work; 3 when some runs \
+failed (their rows say why; the results are written); 1 for any other error (no GPU where one was \
+required, a device lost, a file that could not be written). Logging: -v and -q raise and lower the \
+level; RUST_LOG (e.g. RUST_LOG=penumbra=debug) overrides both.";
 
 /// Sweep sampling scheme x pattern x shadow-ray count x light radius x seed, measure every run
 /// against a ground truth checked against the exact answer, and write CSV, plots and a report.
 #[derive(Parser)]
-#[command(version)]
+#[command(version, after_help = AFTER_HELP)]
 struct Args {
     /// Experiment file, e.g. experiments/sphere.toml.
     experiment: PathBuf,
-    /// Results folder (default: results/NAME, NAME from the experiment file).
+    /// Results folder (default: results/NAME, NAME from the experiment file; with --filter,
+    /// results/NAME--FILTERS, so a subset never replaces the whole sweep's results).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Discard the journal of an interrupted sweep and redo every run.
     #[arg(long)]
     fresh: bool,
-    /// Override the experiment's backend: auto, gpu or cpu.
+    /// Override the experiment's backend.
+    #[arg(long, value_enum)]
+    backend: Option<BackendChoice>,
+    /// Print the expanded runs and the render plan, then exit without rendering.
     #[arg(long)]
-    backend: Option<String>,
+    dry_run: bool,
+    /// Run only the runs whose AXIS has VALUE (axes: scheme, pattern, samples, light_radius,
+    /// lights, seed); repeat to keep several values or restrict several axes.
+    #[arg(long, value_name = "AXIS=VALUE")]
+    filter: Vec<Filter>,
+    /// More log output (repeatable).
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    verbose: u8,
+    /// Less log output (repeatable).
+    #[arg(short, long, action = clap::ArgAction::Count, conflicts_with = "verbose")]
+    quiet: u8,
 }
+
+/// Bad input: exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct BadInput(String);
+
+/// Some runs failed: exit status 3.
+#[derive(Debug, thiserror::Error)]
+#[error("{0} runs failed; see the `error` column of {1}")]
+struct RunsFailed(usize, String);
 
 fn peak_rss() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -36,18 +73,43 @@ fn peak_rss() -> Option<u64> {
     line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
 }
 
+/// Loads an experiment file; its errors are bad input.
+fn load<T>(load: impl FnOnce() -> Result<T, ConfigError>) -> anyhow::Result<T> {
+    load().map_err(|e| BadInput(e.to_string()).into())
+}
+
 /// A frame-rate experiment (`kind = "fps"`): times configurations, no sweep.
 fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
-    let spec = FpsSpec::load(&args.experiment)?;
+    let spec = load(|| FpsSpec::load(&args.experiment))?;
+    if !args.filter.is_empty() {
+        return Err(BadInput("--filter applies to sweeps, not to frame-rate experiments".into()).into());
+    }
+    if args.dry_run {
+        for s in &spec.scenes {
+            for &lights in &s.lights {
+                let scene = timed_scene(&spec, s, lights);
+                for &[width, height] in &spec.resolutions {
+                    let view = View {
+                        camera: &scene.cameras[&s.camera],
+                        width,
+                        height,
+                    };
+                    println!("{} with {lights} light(s) at {width}x{height}:", s.name);
+                    print!("{}", RenderPlan::new(&scene, view)?);
+                }
+            }
+        }
+        return Ok(());
+    }
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
-    let mut backend = open_backend(backend_choice(args, BackendChoice::Auto)?)?;
+    let mut backend = open_backend(args.backend.unwrap_or(BackendChoice::Auto))?;
     let adapter = backend.adapter().clone();
     let rows = run_fps(&spec, backend.as_mut())?;
     write_fps(&spec, &rows, &adapter, started.elapsed().as_secs_f64(), &out)?;
-    eprintln!(
+    info!(
         "{} configurations timed; wrote {}",
         rows.len(),
         out.join("report.md").display()
@@ -55,14 +117,26 @@ fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn backend_choice(args: &Args, default: BackendChoice) -> anyhow::Result<BackendChoice> {
-    Ok(match args.backend.as_deref() {
-        None => default,
-        Some("auto") => BackendChoice::Auto,
-        Some("gpu") => BackendChoice::Gpu,
-        Some("cpu") => BackendChoice::Cpu,
-        Some(other) => anyhow::bail!("--backend must be auto, gpu or cpu, got `{other}`"),
-    })
+/// The sweep's runs, one line per configuration with its seeds, then the render plan.
+fn print_dry_run(spec: &Spec) -> anyhow::Result<()> {
+    let groups = expand(spec);
+    let runs: usize = groups.iter().map(|g| g.runs.len()).sum();
+    println!("{}: {runs} runs in {} configurations", spec.name, groups.len());
+    for g in &groups {
+        let r = g.head();
+        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
+        println!(
+            "  scheme={} pattern={} samples={} light_radius={} lights={} seeds=[{}]",
+            r.scheme,
+            r.pattern,
+            r.samples,
+            r.light_radius,
+            r.lights,
+            seeds.join(", ")
+        );
+    }
+    print!("render plan of a run:\n{}", sweep_plan(spec)?);
+    Ok(())
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -70,21 +144,24 @@ fn run(args: Args) -> anyhow::Result<()> {
     if is_fps(&args.experiment) {
         return run_fps_experiment(&args, started);
     }
-    let spec = Spec::load(&args.experiment)?;
-    let choice = backend_choice(&args, spec.backend)?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
-    let mut backend = open_backend(choice)?;
+    let spec = load(|| Spec::load(&args.experiment))?;
+    let spec = spec.filtered(&args.filter).map_err(BadInput)?;
+    if args.dry_run {
+        return print_dry_run(&spec);
+    }
+    let out = args.out.clone().unwrap_or_else(|| {
+        let name = match args.filter.as_slice() {
+            [] => spec.name.clone(),
+            f => format!("{}--{}", spec.name, filter::label(f)),
+        };
+        PathBuf::from("results").join(name)
+    });
+    let mut backend = open_backend(args.backend.unwrap_or(spec.backend))?;
     let adapter = backend.adapter().clone();
-    eprintln!(
+    info!(
         "{}: {} runs on {} ({}, {})",
         spec.name,
-        penumbra::experiment::run::expand(&spec)
-            .iter()
-            .map(|g| g.runs.len())
-            .sum::<usize>(),
+        expand(&spec).iter().map(|g| g.runs.len()).sum::<usize>(),
         adapter.name,
         adapter.backend,
         adapter.api
@@ -96,7 +173,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         &out.join("cache"),
         args.fresh,
     )?;
-    eprint!("render plan of a run:\n{}", outcome.plan);
+    info!("render plan of a run:\n{}", outcome.plan);
     let pictures =
         render_pictures(&spec, backend.as_mut(), verdict_radius(&spec)).context("rendering the figures' pictures")?;
     let seconds = started.elapsed().as_secs_f64();
@@ -109,7 +186,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         peak_rss: peak_rss(),
     };
     write_all(&results, &out)?;
-    eprintln!(
+    info!(
         "{} runs ({} failed, {} groups resumed) in {seconds:.1} s; peak RSS {:.0} MiB; wrote {}",
         outcome.records.len(),
         outcome.failures,
@@ -118,13 +195,29 @@ fn run(args: Args) -> anyhow::Result<()> {
         out.join("report.md").display()
     );
     if outcome.failures > 0 {
-        anyhow::bail!(
-            "{} runs failed; see the `error` column of {}",
-            outcome.failures,
-            out.join("runs.csv").display()
-        );
+        return Err(RunsFailed(outcome.failures, out.join("runs.csv").display().to_string()).into());
     }
     Ok(())
+}
+
+/// Logs to stderr at info (warn with -q, error with -qq; debug with -v, trace with -vv) for
+/// penumbra, warn for its dependencies; RUST_LOG overrides.
+fn init_logging(args: &Args) {
+    let level = match args.verbose as i8 - args.quiet as i8 {
+        i8::MIN..=-2 => "error",
+        -1 => "warn",
+        0 => "info",
+        1 => "debug",
+        _ => "trace",
+    };
+    let filter = EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| EnvFilter::new(format!("warn,penumbra={level},sweep={level}")));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .without_time()
+        .with_target(false)
+        .init();
 }
 
 fn main() -> ExitCode {
@@ -133,11 +226,19 @@ fn main() -> ExitCode {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
-    match run(Args::parse()) {
+    let args = Args::parse();
+    init_logging(&args);
+    match run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::from(2)
+            if e.is::<BadInput>() {
+                ExitCode::from(2)
+            } else if e.is::<RunsFailed>() {
+                ExitCode::from(3)
+            } else {
+                ExitCode::from(1)
+            }
         }
     }
 }

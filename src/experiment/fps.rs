@@ -207,26 +207,33 @@ fn frames_within(spec: &FpsSpec, per_frame: f64) -> u32 {
     fit.clamp(3.min(spec.frames), spec.frames)
 }
 
+/// The scene `s` as timed with `lights` lights on: each disk light at the experiment's radius
+/// and ray count.
+pub fn timed_scene(spec: &FpsSpec, s: &FpsScene, lights: u32) -> Scene {
+    let mut scene = s.scene.clone();
+    scene.lights.truncate(lights as usize);
+    for l in &mut scene.lights {
+        if let Light::Disk(d) = l {
+            d.radius = spec.light_radius;
+            d.samples = spec.samples;
+        }
+    }
+    scene
+}
+
 /// Times every configuration; one row each.
 pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend) -> anyhow::Result<Vec<FpsRow>> {
     let mut rows = Vec::new();
     for s in &spec.scenes {
         for (&lights, &paper_fps) in s.lights.iter().zip(&s.paper_fps) {
-            let mut scene = s.scene.clone();
-            scene.lights.truncate(lights as usize);
-            for l in &mut scene.lights {
-                if let Light::Disk(d) = l {
-                    d.radius = spec.light_radius;
-                    d.samples = spec.samples;
-                }
-            }
+            let scene = timed_scene(spec, s, lights);
             for &[width, height] in &spec.resolutions {
                 let view = View {
                     camera: &scene.cameras[&s.camera],
                     width,
                     height,
                 };
-                eprintln!("timing {} with {lights} light(s) at {width}x{height}", s.name);
+                tracing::info!("timing {} with {lights} light(s) at {width}x{height}", s.name);
                 let frame = backend
                     .render(&scene, view, spec.sampling)
                     .with_context(|| format!("rendering {}", s.name))?;

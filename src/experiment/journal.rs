@@ -4,8 +4,7 @@
 //! ground truth, axis or device gives different keys and the group is rendered again. Timed
 //! frames are journaled apart, under the timing settings' key, when the timing phase finishes.
 
-use super::run::{num, Group, Record, RUN_COLUMNS};
-use super::runner::GroupStats;
+use super::run::{num, Group, GroupStats, Record, RUN_COLUMNS};
 use super::timing::ConfigTiming;
 use crate::metrics::BiasVariance;
 use std::collections::HashMap;

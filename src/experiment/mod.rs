@@ -1,6 +1,7 @@
 //! Experiments: the file ([`spec`]), its expansion into runs ([`run`]), the per-radius
 //! references ([`reference`]), the sweep ([`runner`]) and its resumable journal ([`journal`]).
 
+pub mod filter;
 pub mod fps;
 pub mod journal;
 pub mod measure;

@@ -260,5 +260,5 @@ fn save_cached(path: &Path, (vis, hit): &(Vec<f32>, Vec<u32>)) -> anyhow::Result
     let mut bytes = MAGIC.to_vec();
     bytes.extend_from_slice(bytemuck::cast_slice(vis));
     bytes.extend_from_slice(bytemuck::cast_slice(hit));
-    crate::report::files::write_atomic(path, &bytes)
+    crate::files::write_atomic(path, &bytes)
 }

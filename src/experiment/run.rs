@@ -3,6 +3,7 @@
 
 use super::spec::Spec;
 use crate::fingerprint::{build_id, fnv1a};
+use crate::metrics::BiasVariance;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 
@@ -42,6 +43,17 @@ impl Group {
         let keys: Vec<String> = self.runs.iter().map(|r| r.key(context)).collect();
         format!("{:016x}", fnv1a(keys.join(",").as_bytes()))
     }
+}
+
+/// The per-pixel bias/variance split of one group (the runs of a configuration over its seeds).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupStats {
+    /// Key of the group's first run.
+    pub key: String,
+    /// The group's axes (seed of the first run).
+    pub run: Run,
+    /// Squared bias with its interval, and variance, over the ground truth's penumbra.
+    pub split: BiasVariance,
 }
 
 /// The sweep in canonical order: lights on, light radius, then scheme, pattern, samples; seeds

@@ -5,6 +5,7 @@
 use super::journal::Journal;
 use super::measure::{failed_record, measure_run};
 use super::reference::Reference;
+pub use super::run::GroupStats;
 use super::run::{context_key, expand, num, Group, Record, Run};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
@@ -13,17 +14,6 @@ use crate::render::{Backend, RenderPlan, View};
 use crate::sampling::{DiskScheme, Pattern};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
-
-/// The per-pixel bias/variance split of one group (the runs of a configuration over its seeds).
-#[derive(Clone, Debug, PartialEq)]
-pub struct GroupStats {
-    /// Key of the group's first run.
-    pub key: String,
-    /// The group's axes (seed of the first run).
-    pub run: Run,
-    /// Squared bias with its interval, and variance, over the ground truth's penumbra.
-    pub split: BiasVariance,
-}
 
 /// What a finished sweep hands to the report.
 pub struct Outcome {
@@ -59,6 +49,19 @@ pub fn figure_samples(spec: &Spec) -> u32 {
         .expect("validated non-empty")
 }
 
+/// The render plan of the sweep's fullest run (most lights, first radius, the figures' ray
+/// count): logged with every sweep and printed by `--dry-run`.
+pub fn sweep_plan(spec: &Spec) -> anyhow::Result<RenderPlan> {
+    let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
+    let s = spec.scene_with(lights, spec.axes.light_radii[0], figure_samples(spec));
+    let view = View {
+        camera: &s.cameras[&spec.measure.camera],
+        width: spec.measure.width,
+        height: spec.measure.height,
+    };
+    RenderPlan::new(&s, view)
+}
+
 /// The light radius the verdict is read at: the paper's 2 cm if swept, else the nearest.
 pub fn verdict_radius(spec: &Spec) -> f64 {
     *spec
@@ -89,20 +92,13 @@ pub fn run_sweep(
     let mut journal = Journal::open(journal_dir, fresh)?;
     let fig_n = figure_samples(spec);
     let bar = progress(groups.iter().map(|g| g.runs.len() as u64).sum());
-    let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    let s = spec.scene_with(lights, spec.axes.light_radii[0], fig_n);
-    let view = View {
-        camera: &s.cameras[&spec.measure.camera],
-        width: spec.measure.width,
-        height: spec.measure.height,
-    };
     let mut out = Outcome {
         records: Vec::new(),
         groups: Vec::new(),
         references: Vec::new(),
         profiles: BTreeMap::new(),
         keep: BTreeMap::new(),
-        plan: RenderPlan::new(&s, view)?,
+        plan: sweep_plan(spec)?,
         timings: Timings::default(),
         failures: 0,
         resumed: 0,
@@ -117,7 +113,7 @@ pub fn run_sweep(
         let reference = Reference::build(spec, backend, lights, radius, cache, &context)?;
         for warning in reference.warnings() {
             // `println` on a hidden bar (stderr not a terminal, as in CI logs) prints nothing.
-            bar.suspend(|| eprintln!("warning: {warning}"));
+            bar.suspend(|| tracing::warn!("{warning}"));
         }
         for group in groups
             .iter()
@@ -306,9 +302,13 @@ fn run_group(
             }
             Err(e) => {
                 bar.suspend(|| {
-                    eprintln!(
+                    tracing::error!(
                         "run failed ({} {} n={} r={} seed={}): {e:#}",
-                        run.scheme, run.pattern, run.samples, run.light_radius, run.seed
+                        run.scheme,
+                        run.pattern,
+                        run.samples,
+                        run.light_radius,
+                        run.seed
                     )
                 });
                 records.push(failed_record(spec, backend, run, context, &format!("{e:#}")));

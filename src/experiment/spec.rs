@@ -3,23 +3,12 @@
 
 use crate::config::{ConfigError, Source};
 use crate::key_path;
+pub use crate::render::BackendChoice;
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
-
-/// Which renderer runs the sweep.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum BackendChoice {
-    /// The GPU when an adapter exists, else the CPU with a warning.
-    Auto,
-    /// The GPU or an error.
-    Gpu,
-    /// The f64 CPU reference.
-    Cpu,
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -148,17 +148,29 @@ pub trait Backend {
     ) -> anyhow::Result<Timing>;
 }
 
+/// Which renderer runs an experiment: the experiment file's `backend` key, or `--backend`.
+#[derive(Clone, Copy, Debug, serde::Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackendChoice {
+    /// The GPU when an adapter exists, else the CPU with a warning.
+    Auto,
+    /// The GPU or an error.
+    Gpu,
+    /// The f64 CPU reference.
+    Cpu,
+}
+
 /// Opens the backend an experiment asks for; `Auto` falls back to the CPU with a warning that
 /// names what to install.
-pub fn open_backend(choice: crate::experiment::spec::BackendChoice) -> anyhow::Result<Box<dyn Backend>> {
-    use crate::experiment::spec::BackendChoice;
+pub fn open_backend(choice: BackendChoice) -> anyhow::Result<Box<dyn Backend>> {
     match choice {
         BackendChoice::Cpu => Ok(Box::new(cpu::CpuBackend::default())),
         BackendChoice::Gpu => Ok(Box::new(gpu::GpuBackend::new()?)),
         BackendChoice::Auto => match gpu::GpuBackend::new() {
             Ok(g) => Ok(Box::new(g)),
             Err(e) => {
-                eprintln!("warning: {e:#}\nwarning: falling back to the f64 CPU backend (slow; results record it)");
+                tracing::warn!("{e:#}");
+                tracing::warn!("falling back to the f64 CPU backend (slow; results record it)");
                 Ok(Box::new(cpu::CpuBackend::default()))
             }
         },

@@ -1,9 +1,9 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
 //! numbers, report.md and the manifest.
 
-use super::files::{write_atomic, write_csv};
 use super::plots::{line_plot, Axes, Reference, Series};
 use crate::experiment::fps::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
+use crate::files::{write_atomic, write_csv};
 use crate::render::AdapterInfo;
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! Float images to files: EXR keeps the measured values, PNG shows them (visibility in grey,
 //! signed errors on a blue-white-red scale). Receiver-less pixels are drawn dark blue.
 
-use super::files::write_atomic;
+use crate::files::write_atomic;
 use crate::render::NO_RECEIVER;
 use anyhow::anyhow;
 use std::io::Cursor;

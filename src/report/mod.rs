@@ -1,6 +1,5 @@
 //! Outputs: CSV tables, plots, images and the markdown report, all written atomically.
 
-pub mod files;
 pub mod fps;
 pub mod images;
 pub mod markdown;

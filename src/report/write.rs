@@ -1,7 +1,6 @@
 //! Writes a finished sweep: tables, plots, images, report and manifest, each file atomically,
 //! the manifest last.
 
-use super::files::{write_atomic, write_csv};
 use super::images::{diverging, grey, write_exr, Rgb};
 use super::markdown::{report, verdict_radius};
 use super::pictures::{picture_flip, write_fig2_picture};
@@ -12,6 +11,7 @@ use crate::experiment::run::{num, RUN_COLUMNS};
 use crate::experiment::runner::{figure_samples, Outcome};
 use crate::experiment::timing::ConfigTiming;
 use crate::experiment::Spec;
+use crate::files::{write_atomic, write_csv};
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;

@@ -274,8 +274,8 @@ impl Scene {
             let transform = DMat4::from_scale_rotation_translation(DVec3::splat(m.scale), rotation, translate);
             let (kept, skipped) = clean(raw, &transform);
             if skipped.degenerate + skipped.non_finite > 0 {
-                eprintln!(
-                    "warning: {}: skipped {} degenerate and {} non-finite triangles (they can never be hit)",
+                tracing::warn!(
+                    "{}: skipped {} degenerate and {} non-finite triangles (they can never be hit)",
                     path.display(),
                     skipped.degenerate,
                     skipped.non_finite

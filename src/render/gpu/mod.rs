@@ -11,7 +11,7 @@ mod layout;
 pub mod loop_cap;
 mod resources;
 
-use super::plan::{RenderPlan, MAX_LIGHTS};
+use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
 use crate::sampling::DiskScheme;
 use anyhow::{anyhow, bail, Context};
@@ -78,6 +78,8 @@ pub struct GpuBackend {
     scene: Option<SceneBuffers>,
     /// Times static scene data was uploaded.
     static_uploads: u64,
+    /// Compute dispatches recorded so far (all passes, all frames).
+    dispatches: std::cell::Cell<u64>,
 }
 
 impl GpuBackend {
@@ -116,9 +118,7 @@ impl GpuBackend {
         let lost = Arc::new(AtomicBool::new(false));
         let flag = lost.clone();
         device.set_device_lost_callback(move |_, _| flag.store(true, Ordering::SeqCst));
-        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
-            eprintln!("penumbra: uncaptured GPU error: {e}")
-        }));
+        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| tracing::error!("uncaptured GPU error: {e}")));
         let loop_cap = loop_cap::detect(&device, &queue).context("probing the adapter's loop limits")?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("render.wgsl"),
@@ -220,6 +220,7 @@ impl GpuBackend {
             loop_cap,
             scene: None,
             static_uploads: 0,
+            dispatches: Default::default(),
         })
     }
 
@@ -237,6 +238,12 @@ impl GpuBackend {
     /// How many times static scene data (geometry, BVH) has been uploaded.
     pub fn static_uploads(&self) -> u64 {
         self.static_uploads
+    }
+
+    /// Compute dispatches recorded so far, every pass of every frame: what a test counts against
+    /// the plan.
+    pub fn dispatches(&self) -> u64 {
+        self.dispatches.get()
     }
 
     /// How many times the capped chunk over the resident scene has been halved because frames
@@ -283,34 +290,35 @@ impl GpuBackend {
         Ok(())
     }
 
-    /// Records the plan's passes into `encoder`: primary, then one shadow pass per light.
-    fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, lights: usize) {
+    /// Records the plan's passes into `encoder`, in the plan's order: the primary pass, and for
+    /// each shadow pass one dispatch per sample chunk of its light. Nothing outside the plan is
+    /// dispatched.
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, plan: &RenderPlan) {
         encoder.clear_buffer(&r.counters, 0, None);
         encoder.clear_buffer(&r.visibility, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
-        for pass in 0..=lights {
+        for (index, pass) in plan.passes.iter().enumerate() {
             let timestamp_writes = r.queries.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
                 query_set: set,
-                beginning_of_pass_write_index: Some(2 * pass as u32),
-                end_of_pass_write_index: Some(2 * pass as u32 + 1),
+                beginning_of_pass_write_index: Some(2 * index as u32),
+                end_of_pass_write_index: Some(2 * index as u32 + 1),
             });
             let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: None,
                 timestamp_writes,
             });
-            let pipelines = if pass == 0 { &self.primary } else { &self.shadow };
+            // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
+            let (pipelines, chunks) = match pass {
+                Pass::Primary { .. } => (&self.primary, &r.passes[0][..1]),
+                Pass::Shadow { light, .. } => (&self.shadow, &r.passes[*light][..]),
+            };
             cp.set_pipeline(&pipelines[r.meshes as usize]);
             cp.set_bind_group(0, &r.bind0, &[]);
-            // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
-            let chunks = if pass == 0 {
-                &r.passes[0][..1]
-            } else {
-                &r.passes[pass - 1][..]
-            };
             for chunk in chunks {
                 cp.set_bind_group(1, chunk, &[]);
                 cp.dispatch_workgroups(groups.0, groups.1, 1);
             }
+            self.dispatches.set(self.dispatches.get() + chunks.len() as u64);
         }
     }
 
@@ -411,7 +419,7 @@ impl Backend for GpuBackend {
     }
 
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
-        RenderPlan::new(scene, view)?;
+        let plan = RenderPlan::new(scene, view)?;
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
@@ -419,7 +427,7 @@ impl Backend for GpuBackend {
             let r = self.resources(&packed, view, 0);
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, &r, view, lights);
+            self.encode(&mut encoder, &r, view, &plan);
             self.submit(encoder, scope)?;
             if self.whole(&r, &packed)? {
                 break r;
@@ -459,13 +467,12 @@ impl Backend for GpuBackend {
         warmup: u32,
         repeats: u32,
     ) -> anyhow::Result<Timing> {
-        RenderPlan::new(scene, view)?;
+        let plan = RenderPlan::new(scene, view)?;
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
-        let lights = scene.lights.len();
         loop {
             let r = self.resources(&packed, view, 0);
-            let timing = self.time_frames(&r, view, lights, warmup, repeats)?;
+            let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;
             if self.whole(&r, &packed)? {
                 return Ok(timing);
             }
@@ -479,7 +486,7 @@ impl GpuBackend {
         &self,
         r: &FrameResources,
         view: View,
-        lights: usize,
+        plan: &RenderPlan,
         warmup: u32,
         repeats: u32,
     ) -> anyhow::Result<Timing> {
@@ -487,7 +494,7 @@ impl GpuBackend {
         for i in 0..warmup + repeats {
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, r, view, lights);
+            self.encode(&mut encoder, r, view, plan);
             let start = Instant::now();
             self.submit(encoder, scope)?;
             let wall = start.elapsed().as_secs_f64();
