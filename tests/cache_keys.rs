@@ -6,19 +6,6 @@ mod common;
 use std::ffi::OsStr;
 use std::path::Path;
 
-const SCENE: &str = r#"
-[cameras.measure]
-projection = "orthographic"
-position = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-width = 0.6
-
-[[meshes]]
-path = "square.obj"
-albedo = 0.7
-"#;
-
 const EXPERIMENT: &str = r#"
 name = "keys"
 scene = "scene.toml"
@@ -73,7 +60,7 @@ fn cached_ground_truths(dir: &Path) -> usize {
 fn experiment_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("scene.toml"), SCENE.to_string() + &common::plane_and_light(0.05)).unwrap();
+    std::fs::write(d.join("scene.toml"), common::mesh_over_plane("square.obj", 0.05)).unwrap();
     std::fs::write(d.join("keys.toml"), EXPERIMENT).unwrap();
     std::fs::write(d.join("square.obj"), square(0.5)).unwrap();
     dir

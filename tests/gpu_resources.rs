@@ -169,20 +169,8 @@ fn walks_longer_than_their_budget_are_caught_and_split_again() {
         );
     }
     std::fs::write(dir.path().join("needles.obj"), obj).unwrap();
-    let camera = r#"
-[cameras.measure]
-projection = "orthographic"
-position = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-width = 0.6
-
-[[meshes]]
-path = "needles.obj"
-albedo = 0.7
-"#;
     let path = dir.path().join("needles.toml");
-    std::fs::write(&path, camera.to_string() + &common::plane_and_light(0.05)).unwrap();
+    std::fs::write(&path, common::mesh_over_plane("needles.obj", 0.05)).unwrap();
     let mut s = Scene::load(&path).unwrap();
     if let Light::Disk(d) = &mut s.lights[0] {
         d.samples = 64;

@@ -12,6 +12,7 @@ use penumbra::render::{open_backend, BackendChoice, RenderPlan, View};
 use penumbra::report::fps::write_fps;
 use penumbra::report::markdown::verdict_radius;
 use penumbra::report::write::{write_all, Results};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -215,6 +216,7 @@ fn init_logging(args: &Args) {
     tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
         .without_time()
         .with_target(false)
         .init();

@@ -38,6 +38,16 @@ impl ConfigTiming {
         (a * 1e3, b * 1e3, c * 1e3)
     }
 
+    /// Wall-clock frames of the given milliseconds: hand-made timings for tests.
+    #[cfg(test)]
+    pub(crate) fn wall_clock_ms(ms: &[f64]) -> ConfigTiming {
+        ConfigTiming {
+            frame_seconds: ms.iter().map(|x| x * 1e-3).collect(),
+            primary_seconds: vec![],
+            clock: "wall-clock".into(),
+        }
+    }
+
     /// Median seconds of the primary pass; NaN where the clock cannot split passes.
     pub fn primary_median(&self) -> f64 {
         median(&self.primary_seconds)
@@ -178,11 +188,7 @@ mod tests {
     use super::*;
 
     fn timing(ms: &[f64]) -> ConfigTiming {
-        ConfigTiming {
-            frame_seconds: ms.iter().map(|x| x * 1e-3).collect(),
-            primary_seconds: vec![],
-            clock: "wall-clock".into(),
-        }
+        ConfigTiming::wall_clock_ms(ms)
     }
 
     #[test]

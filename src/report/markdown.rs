@@ -207,11 +207,7 @@ mod tests {
     use super::*;
 
     fn timing(ms: &[f64]) -> ConfigTiming {
-        ConfigTiming {
-            frame_seconds: ms.iter().map(|x| x * 1e-3).collect(),
-            primary_seconds: vec![],
-            clock: "wall-clock".into(),
-        }
+        ConfigTiming::wall_clock_ms(ms)
     }
 
     #[test]

@@ -91,3 +91,22 @@ samples = 16
 "#
     )
 }
+
+/// Scene TOML of one OBJ mesh (`obj`, relative to the scene file) under the shared receiver and
+/// light, seen by an orthographic measuring camera 0.6 m wide looking straight down.
+pub fn mesh_over_plane(obj: &str, light_radius: f64) -> String {
+    format!(
+        r#"
+[cameras.measure]
+projection = "orthographic"
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+width = 0.6
+
+[[meshes]]
+path = "{obj}"
+albedo = 0.7
+"#
+    ) + &plane_and_light(light_radius)
+}
