@@ -58,7 +58,7 @@ fn keep<T: PartialEq + Copy>(
     Ok(())
 }
 
-/// The axes of `spec` restricted by `filters`.
+/// `axes` restricted by `filters`.
 pub fn restrict(axes: &Axes, filters: &[Filter]) -> Result<Axes, String> {
     let mut named: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
     for f in filters {
@@ -85,10 +85,9 @@ pub fn label(filters: &[Filter]) -> String {
 
 impl Spec {
     /// This experiment with its sweep restricted by `filters`.
-    pub fn filtered(&self, filters: &[Filter]) -> Result<Spec, String> {
-        let mut s = self.clone();
-        s.axes = restrict(&self.axes, filters)?;
-        Ok(s)
+    pub fn filtered(mut self, filters: &[Filter]) -> Result<Spec, String> {
+        self.axes = restrict(&self.axes, filters)?;
+        Ok(self)
     }
 }
 

@@ -5,8 +5,7 @@
 use super::journal::Journal;
 use super::measure::{failed_record, measure_run};
 use super::reference::Reference;
-pub use super::run::GroupStats;
-use super::run::{context_key, expand, num, Group, Record, Run};
+use super::run::{context_key, expand, num, Group, GroupStats, Record, Run};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
 use crate::metrics::{BiasVariance, RadialProfile};

@@ -3,7 +3,7 @@
 
 use crate::config::{ConfigError, Source};
 use crate::key_path;
-pub use crate::render::BackendChoice;
+use crate::render::BackendChoice;
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};

@@ -3,7 +3,8 @@
 //! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
 use crate::experiment::run::num;
-use crate::experiment::runner::{GroupStats, Outcome};
+use crate::experiment::run::GroupStats;
+use crate::experiment::runner::Outcome;
 use crate::experiment::timing::ConfigTiming;
 use crate::experiment::{Record, Run};
 use crate::metrics::stats::mean_ci;

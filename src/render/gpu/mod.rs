@@ -246,7 +246,7 @@ impl GpuBackend {
         self.dispatches.get()
     }
 
-    /// How many times the capped chunk over the resident scene has been halved because frames
+    /// What the capped chunk over the resident scene is divided by: doubled each time a frame
     /// came back cut short (1: never).
     pub fn chunk_divisor(&self) -> u32 {
         self.scene.as_ref().map_or(1, |s| s.chunk_divisor)
@@ -369,13 +369,20 @@ impl GpuBackend {
         Ok(bytes)
     }
 
-    /// Whether the frame just rendered over `r` is whole: no invocation reported a loop cut short.
-    /// If some did, the capped chunk over this scene is halved for the next attempt (`Ok(false)`);
-    /// where it is one sample already, or the adapter has no cap, no smaller split can help (a BVH
-    /// deeper than the traversal stack) and the frame is an error, never a silent answer.
-    fn whole(&mut self, r: &FrameResources, packed: &layout::Packed) -> anyhow::Result<bool> {
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.counters, COUNTER_WORDS as u64 * 4)?);
-        let cut = words[CUT_SHORT_SLOT];
+    /// The counters buffer of the frame just rendered over `r` ([`COUNTER_WORDS`] words).
+    fn counters(&self, r: &FrameResources) -> anyhow::Result<Vec<u32>> {
+        Ok(bytemuck::pod_collect_to_vec(
+            &self.read(&r.counters, COUNTER_WORDS as u64 * 4)?,
+        ))
+    }
+
+    /// Whether a frame whose counters are `counters` is whole: no invocation reported a loop cut
+    /// short. If some did, the capped chunk over this scene is halved for the next attempt
+    /// (`Ok(false)`); where it is one sample already, or the adapter has no cap, no smaller split
+    /// can help (a BVH deeper than the traversal stack) and the frame is an error, never a silent
+    /// answer.
+    fn whole(&mut self, counters: &[u32], packed: &layout::Packed) -> anyhow::Result<bool> {
+        let cut = counters[CUT_SHORT_SLOT];
         if cut == 0 {
             return Ok(true);
         }
@@ -423,14 +430,15 @@ impl Backend for GpuBackend {
         self.check_limits(scene, view)?;
         let packed = pack(scene, view, sampling);
         let lights = scene.lights.len();
-        let r = loop {
+        let (r, counters) = loop {
             let r = self.resources(&packed, view, 0);
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, &r, view, &plan);
             self.submit(encoder, scope)?;
-            if self.whole(&r, &packed)? {
-                break r;
+            let counters = self.counters(&r)?;
+            if self.whole(&counters, &packed)? {
+                break (r, counters);
             }
         };
         let pixels = view.pixels();
@@ -441,7 +449,6 @@ impl Backend for GpuBackend {
             vec![]
         };
         let radiance: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.radiance, pixels as u64 * 4)?);
-        let counters: Vec<u32> = bytemuck::pod_collect_to_vec(&self.read(&r.counters, (MAX_LIGHTS * 8) as u64)?);
         let mut rays = RayCounts {
             primary: pixels as u64,
             shadow: [0; MAX_LIGHTS],
@@ -473,7 +480,7 @@ impl Backend for GpuBackend {
         loop {
             let r = self.resources(&packed, view, 0);
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;
-            if self.whole(&r, &packed)? {
+            if self.whole(&self.counters(&r)?, &packed)? {
                 return Ok(timing);
             }
         }

@@ -237,7 +237,8 @@ pub(super) fn shadow_sample_iterations(packed: &Packed) -> u32 {
 
 /// Samples per dispatch on an adapter that stops loops after `cap` iterations: the largest count
 /// whose loops, with the primary ray's (one per sphere and plane), fit under the cap. Never zero:
-/// a scene too large for one sample per dispatch renders what the adapter allows.
+/// a scene too large even for one sample per dispatch is caught when its frames come back cut
+/// short.
 pub(super) fn chunk_under_cap(cap: u32, packed: &Packed) -> u32 {
     let primary = (packed.spheres.len() + packed.planes.len()) as u32;
     (cap.saturating_sub(primary) / shadow_sample_iterations(packed)).max(1)
