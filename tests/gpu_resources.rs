@@ -6,7 +6,7 @@
 mod common;
 
 use penumbra::render::cpu::CpuBackend;
-use penumbra::render::gpu::scheme_prelude;
+use penumbra::render::gpu::{scheme_prelude, GpuBackend};
 use penumbra::render::{Backend, Sampling, View};
 use penumbra::sampling::{strata, DiskScheme, Pattern, Stream};
 use penumbra::scene::{Light, Scene};
@@ -23,12 +23,22 @@ fn sampling(seed: u32) -> Sampling {
     }
 }
 
-/// Without the split a capped adapter cuts loops short, and the renderer says so instead of
-/// returning a frame with rays missing.
-fn cut_short(whole: anyhow::Result<penumbra::render::Frame>) {
-    match whole {
-        Err(e) => assert!(e.to_string().contains("ended a loop early"), "{e:#}"),
-        Ok(f) => panic!("the undivided frame came back as whole, {} rays", f.rays.shadow_total()),
+/// The split frame traces exactly the CPU's shadow rays; and where the adapter caps loops, the
+/// same frame as one undivided dispatch per light is cut short, which the renderer reports
+/// instead of returning a frame with rays missing (the check has teeth).
+fn split_traces_the_cpus_rays(gpu: &mut GpuBackend, s: &Scene, view: View, sampling: Sampling) {
+    let cpu = CpuBackend::default().render(s, view, sampling).unwrap();
+    let split = gpu.render(s, view, sampling).unwrap();
+    assert_eq!(split.rays.shadow_total(), cpu.rays.shadow_total());
+    let cap = gpu.loop_cap();
+    if cap.is_some() {
+        gpu.set_loop_cap(None);
+        let whole = gpu.render(s, view, sampling);
+        gpu.set_loop_cap(cap);
+        match whole {
+            Err(e) => assert!(e.to_string().contains("ended a loop early"), "{e:#}"),
+            Ok(f) => panic!("the undivided frame came back as whole, {} rays", f.rays.shadow_total()),
+        }
     }
 }
 
@@ -66,7 +76,7 @@ fn geometry_is_uploaded_once_per_scene_and_again_when_it_changes() {
     );
 }
 
-/// Where the probe finds a cap, one undivided 1024-ray dispatch over a mesh loses rays (the
+/// Where the probe finds a cap, one undivided 1024-ray dispatch over a mesh is cut short (the
 /// reason for the split); with the split the GPU traces exactly the CPU's rays.
 #[test]
 fn the_loop_cap_probe_finds_what_the_split_works_around() {
@@ -89,15 +99,7 @@ fn the_loop_cap_probe_finds_what_the_split_works_around() {
         width: 16,
         height: 16,
     };
-    let cpu = CpuBackend::default().render(&s, view, sampling(1)).unwrap();
-    let split = gpu.render(&s, view, sampling(1)).unwrap();
-    assert_eq!(split.rays.shadow_total(), cpu.rays.shadow_total());
-    if cap.is_some() {
-        gpu.set_loop_cap(None);
-        let whole = gpu.render(&s, view, sampling(1));
-        gpu.set_loop_cap(cap);
-        cut_short(whole);
-    }
+    split_traces_the_cpus_rays(&mut gpu, &s, view, sampling(1));
 }
 
 /// An analytic scene with many spheres: each shadow sample loops over all of them, so the
@@ -123,24 +125,13 @@ fn many_spheres_keep_every_shadow_ray_under_the_loop_cap() {
         width: 12,
         height: 12,
     };
-    let cpu = CpuBackend::default().render(&s, view, sampling(4)).unwrap();
-    let gpu_image = gpu.render(&s, view, sampling(4)).unwrap();
-    assert_eq!(gpu_image.rays.shadow_total(), cpu.rays.shadow_total());
-    let cap = gpu.loop_cap();
-    if cap.is_some() {
-        // The same frame as one undivided dispatch per light loses rays: the test has teeth.
-        gpu.set_loop_cap(None);
-        let whole = gpu.render(&s, view, sampling(4));
-        gpu.set_loop_cap(cap);
-        cut_short(whole);
-    }
+    split_traces_the_cpus_rays(&mut gpu, &s, view, sampling(4));
 }
 
 /// A mesh whose walks outrun the split's budget: 2000 needles between random points of the space
 /// between receiver and light, whose boxes overlap so much that a shadow ray enters hundreds of
-/// leaves. The shader reports
-/// loops cut short, the renderer halves its split until the frame is whole, and the GPU traces
-/// exactly the CPU's rays.
+/// leaves. The shader reports loops cut short, the renderer halves its split until the frame is
+/// whole, and the GPU traces exactly the CPU's rays.
 #[test]
 fn walks_longer_than_their_budget_are_caught_and_split_again() {
     let Some(mut gpu) = common::gpu() else { return };
