@@ -5,7 +5,6 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use glam::DVec3;
 use penumbra::accel::{Bvh, Preset};
-use penumbra::mesh::Triangles;
 use penumbra::sampling::Stream;
 use penumbra::scene::Scene;
 use std::hint::black_box;
@@ -28,11 +27,7 @@ fn rays(bvh: &Bvh, n: u32) -> Vec<(DVec3, DVec3)> {
 
 fn build(c: &mut Criterion) {
     let scene = body();
-    let bvh = scene.bvh.as_ref().expect("mesh");
-    let triangles = Triangles {
-        positions: bvh.world.clone(),
-        mesh_of: bvh.mesh_of.clone(),
-    };
+    let triangles = scene.triangles.clone();
     let mut g = c.benchmark_group("bvh_build");
     g.sample_size(10);
     g.throughput(Throughput::Elements(triangles.positions.len() as u64));
@@ -43,8 +38,8 @@ fn build(c: &mut Criterion) {
 
 fn traverse(c: &mut Criterion) {
     let scene = body();
-    let bvh = scene.bvh.as_ref().expect("mesh");
-    let rays = rays(bvh, 4096);
+    let bvh = Bvh::build(&scene.triangles, scene.accel_settings.bvh_preset);
+    let rays = rays(&bvh, 4096);
     let mut g = c.benchmark_group("bvh_traverse");
     g.throughput(Throughput::Elements(rays.len() as u64));
     g.bench_function("closest", |b| {

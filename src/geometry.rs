@@ -1,32 +1,34 @@
-//! Ray-shape intersection and self-intersection-safe ray origins, in f64 for the CPU backend.
-//! The WGSL copies in `render/gpu/shaders/geometry.wgsl` follow the same formulas in f32.
+//! Self-intersection-safe ray origins and the GPU's local coordinate frame. The WGSL copy in
+//! `render/gpu/shaders/geometry.wgsl` follows the same formula in f32.
 
-use crate::scene::{Plane, Sphere};
 use glam::DVec3;
 
-/// Both roots of a ray-sphere intersection for a unit `dir`, or `None` on a miss.
-///
-/// Uses the formulation of Haines et al., "Precision Improvements for Ray/Sphere Intersection"
-/// (Ray Tracing Gems, ch. 7): the discriminant is computed from the closest-approach vector
-/// rather than b^2 - c, which loses every digit for small spheres far from the ray origin.
-pub fn sphere_roots(origin: DVec3, dir: DVec3, s: &Sphere) -> Option<(f64, f64)> {
-    let f = origin - s.center;
-    let b = -f.dot(dir);
-    let l = f + b * dir;
-    let disc = s.radius * s.radius - l.length_squared();
-    if disc < 0.0 {
-        return None;
-    }
-    let c = f.length_squared() - s.radius * s.radius;
-    let q = b + disc.sqrt().copysign(b);
-    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q) };
-    Some((t0.min(t1), t0.max(t1)))
+/// A frame of f32 coordinates for the GPU: world = origin + scale * local. `scale` is a power of
+/// two, so dividing by it is exact; the render re-bases on the camera's look-at point so f32
+/// keeps its relative precision wherever the scene is placed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalFrame {
+    /// World position of the local origin.
+    pub origin: DVec3,
+    /// World length of one local unit.
+    pub scale: f64,
 }
 
-/// Distance along a unit `dir` to a plane, if the ray is not parallel to it.
-pub fn plane_t(origin: DVec3, dir: DVec3, p: &Plane) -> Option<f64> {
-    let denom = dir.dot(p.normal);
-    (denom != 0.0).then(|| (p.point - origin).dot(p.normal) / denom)
+impl LocalFrame {
+    /// A world point in local coordinates, still in f64.
+    pub fn point_f64(&self, p: DVec3) -> DVec3 {
+        (p - self.origin) / self.scale
+    }
+
+    /// A world point in local f32 coordinates.
+    pub fn point(&self, p: DVec3) -> [f32; 3] {
+        self.point_f64(p).as_vec3().to_array()
+    }
+
+    /// A world length in local units.
+    pub fn length(&self, x: f64) -> f32 {
+        (x / self.scale) as f32
+    }
 }
 
 /// Moves a surface point off the surface along its geometric normal by an amount that scales
@@ -49,44 +51,17 @@ pub fn offset_origin(p: DVec3, n: DVec3) -> DVec3 {
     DVec3::new(nudge(p.x, n.x), nudge(p.y, n.y), nudge(p.z, n.z))
 }
 
-/// Snaps a computed hit point back onto the sphere, removing the error of `origin + t dir`
-/// that grows with the ray's length (pbrt-v4 re-projects the same way).
-pub fn reproject_sphere(p: DVec3, s: &Sphere) -> DVec3 {
-    s.center + (p - s.center).normalize() * s.radius
-}
-
-/// Snaps a computed hit point back onto the plane.
-pub fn reproject_plane(p: DVec3, pl: &Plane) -> DVec3 {
-    p - pl.normal * (p - pl.point).dot(pl.normal)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn sphere_roots_survive_tiny_spheres_far_away() {
-        let s = Sphere {
-            center: DVec3::new(0.0, 0.0, 1e6),
-            radius: 1e-3,
-            albedo: 1.0,
-        };
-        let (t0, t1) = sphere_roots(DVec3::ZERO, DVec3::Z, &s).unwrap();
-        assert!((t0 - (1e6 - 1e-3)).abs() < 1e-9 && (t1 - (1e6 + 1e-3)).abs() < 1e-9);
-        assert!(sphere_roots(DVec3::new(2e-3, 0.0, 0.0), DVec3::Z, &s).is_none());
-    }
-
-    #[test]
     fn offset_leaves_the_surface_on_the_normal_side_at_any_scale() {
         for scale in [1e-6, 1e-3, 1.0, 1e3, 1e5, 1e8] {
-            let pl = Plane {
-                point: DVec3::new(scale, -scale, scale),
-                normal: DVec3::Z,
-                albedo: 1.0,
-            };
-            let p = offset_origin(pl.point, pl.normal);
-            assert!((p - pl.point).dot(pl.normal) > 0.0, "scale {scale}");
-            assert!((p - pl.point).length() < 1e-9 * scale.max(1.0), "scale {scale}");
+            let (point, normal) = (DVec3::new(scale, -scale, scale), DVec3::Z);
+            let p = offset_origin(point, normal);
+            assert!((p - point).dot(normal) > 0.0, "scale {scale}");
+            assert!((p - point).length() < 1e-9 * scale.max(1.0), "scale {scale}");
         }
     }
 }

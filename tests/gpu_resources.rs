@@ -49,7 +49,7 @@ fn geometry_is_uploaded_once_per_scene_and_again_when_it_changes() {
         scene("experiments/scenes/sphere.toml"),
         scene("experiments/scenes/sphere.toml"),
     );
-    b.spheres[0].radius = 0.3;
+    b.spheres_mut().next().unwrap().radius = 0.3;
     fn view(s: &Scene) -> View<'_> {
         View {
             camera: &s.cameras["measure"],
@@ -111,11 +111,11 @@ fn many_spheres_keep_every_shadow_ray_under_the_loop_cap() {
     let mut s = scene("experiments/scenes/sphere.toml");
     // Below the ground plane: every shadow ray tests them, none is blocked by them.
     for i in 0..120 {
-        s.spheres.push(penumbra::scene::Sphere {
+        s.shapes.push(penumbra::scene::Shape::Sphere(penumbra::scene::Sphere {
             center: glam::DVec3::new(0.1 * i as f64 - 6.0, 0.0, -3.0),
             radius: 0.04,
             albedo: 0.5,
-        });
+        }));
     }
     if let Light::Disk(d) = &mut s.lights[0] {
         d.samples = 1024;

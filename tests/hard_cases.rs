@@ -9,7 +9,7 @@ use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{Backend, Frame, Sampling, View, NO_RECEIVER};
 use penumbra::sampling::{DiskScheme, Pattern};
 use penumbra::scene::camera::{Camera, Projection};
-use penumbra::scene::{DiskLight, Light, Scene};
+use penumbra::scene::{DiskLight, Light, Scene, Shape, Sphere};
 
 fn sphere_scene() -> Scene {
     Scene::load(&common::repo("experiments/scenes/sphere.toml")).unwrap()
@@ -63,13 +63,14 @@ fn exact_of(scene: &Scene, camera: &Camera, size: u32, frame: &Frame) -> Vec<Opt
     let Light::Disk(l) = &scene.lights[0] else {
         unreachable!()
     };
-    let pl = &scene.planes[0];
+    let (plane_id, pl) = scene.plane(0).unwrap();
+    let spheres: Vec<Sphere> = scene.spheres().copied().collect();
     (0..size * size)
         .map(|i| {
-            (frame.hit[i as usize] == scene.plane_id(0)).then(|| {
+            (frame.hit[i as usize] == plane_id).then(|| {
                 let r = camera.ray(i % size, i / size, size, size);
-                let t = penumbra::geometry::plane_t(r.origin, r.direction, pl).unwrap();
-                visible_fraction(r.origin + r.direction * t, pl.normal, l, &scene.spheres, &[])
+                let t = pl.t(r.origin, r.direction).unwrap();
+                visible_fraction(r.origin + r.direction * t, pl.normal, l, &spheres, &[])
             })
         })
         .collect()
@@ -176,7 +177,8 @@ fn light_facing_away_gives_no_light_and_no_rays() {
 #[test]
 fn contact_shadow_of_a_sphere_resting_on_the_plane() {
     let mut s = sphere_scene();
-    s.spheres[0].center.z = s.spheres[0].radius;
+    let sphere = s.spheres_mut().next().unwrap();
+    sphere.center.z = sphere.radius;
     disk(&mut s).samples = 1024;
     // A patch around the contact point, seen from above at a slant so the sphere hides little.
     let cam = Camera {
@@ -207,7 +209,7 @@ fn receivers_exactly_on_the_umbra_and_penumbra_radii() {
     };
     for (r, expected) in [(o.umbra_radius(), 0.0), (o.penumbra_radius(), 1.0)] {
         let p = o.point_at(r);
-        let v = visible_fraction(p, DVec3::Z, &l, &s.spheres, &[]);
+        let v = visible_fraction(p, DVec3::Z, &l, &s.spheres().copied().collect::<Vec<_>>(), &[]);
         assert!((v - expected).abs() < 1e-9, "exact V at r = {r}: {v}");
         let cam = probe(p);
         on_backends(|name, b| {
@@ -226,7 +228,7 @@ fn receivers_exactly_on_the_umbra_and_penumbra_radii() {
 fn grazing_light_and_grazing_camera_rays() {
     // A vertical light centred on the receiver's horizon: exactly half of it is above.
     let mut s = sphere_scene();
-    s.spheres.clear();
+    s.shapes.retain(|x| !matches!(x, Shape::Sphere(_)));
     *disk(&mut s) = DiskLight {
         center: DVec3::new(3.0, 0.0, 0.0),
         normal: DVec3::NEG_X,
@@ -246,7 +248,7 @@ fn grazing_light_and_grazing_camera_rays() {
     });
     // Camera rays at grazing incidence on an unoccluded plane: no self-shadowing anywhere.
     let mut g = sphere_scene();
-    g.spheres.clear();
+    g.shapes.retain(|x| !matches!(x, Shape::Sphere(_)));
     let low = Camera {
         position: DVec3::new(-5.0, 0.0, 1e-3),
         look_at: DVec3::new(10.0, 0.0, 0.0),

@@ -15,9 +15,8 @@ fn body() -> Scene {
 
 /// Seeded rays from a sphere around the figure towards random points of its bounding box.
 fn rays(scene: &Scene, n: u32) -> Vec<(DVec3, DVec3, f64)> {
-    let bvh = scene.bvh.as_ref().unwrap();
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for p in bvh.world.iter().flatten() {
+    for p in scene.triangles.positions.iter().flatten() {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
@@ -35,13 +34,19 @@ fn rays(scene: &Scene, n: u32) -> Vec<(DVec3, DVec3, f64)> {
 #[test]
 fn body_scene_loads_about_32k_triangles() {
     let s = body();
-    let bvh = s.bvh.as_ref().unwrap();
-    assert_eq!(s.meshes.len(), 1);
+    assert_eq!(s.accel.as_ref().map(|a| a.name()), Some("bvh"));
+    assert_eq!(s.meshes().count(), 1);
     // 13,378 + 2,650 quads = 32,056 triangles, less any degenerate ones (reported).
-    let m = &s.meshes[0];
+    let m = s.meshes().next().unwrap();
     assert_eq!(m.triangles + m.skipped.degenerate + m.skipped.non_finite, 32_056);
-    assert_eq!(bvh.world.len(), m.triangles);
-    let min_z = bvh.world.iter().flatten().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    assert_eq!(s.triangles.positions.len(), m.triangles);
+    let min_z = s
+        .triangles
+        .positions
+        .iter()
+        .flatten()
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
     assert!(min_z.abs() < 1e-3, "the soles rest on the ground: min z = {min_z}");
 }
 
@@ -50,9 +55,12 @@ fn body_scene_loads_about_32k_triangles() {
 #[test]
 fn cpu_traversal_matches_brute_force() {
     let s = body();
-    let bvh = s.bvh.as_ref().unwrap();
+    let bvh = s.accel.as_ref().unwrap();
     for (o, d, _) in rays(&s, 1500) {
-        let (a, b) = (bvh.closest(o, d, f64::INFINITY, u32::MAX), bvh.brute_force(o, d));
+        let (a, b) = (
+            bvh.closest(o, d, f64::INFINITY, u32::MAX),
+            penumbra::accel::brute_force(&s.triangles, o, d),
+        );
         assert_eq!(a.map(|h| h.triangle), b.map(|h| h.triangle), "o={o} d={d}");
         if let (Some(a), Some(b)) = (a, b) {
             assert!((a.t - b.t).abs() < 1e-12);
@@ -69,7 +77,7 @@ fn cpu_traversal_matches_brute_force() {
 fn gpu_traversal_matches_cpu() {
     let Some(mut gpu) = common::gpu() else { return };
     let s = body();
-    let bvh = s.bvh.as_ref().unwrap();
+    let bvh = s.accel.as_ref().unwrap();
     let rays = rays(&s, 20_000);
     let g = gpu.probe(&s, &rays).unwrap();
     let mut disagree = 0;
@@ -148,9 +156,9 @@ fn degenerate_triangles_are_skipped_and_never_hit() {
     )
     .unwrap();
     let s = Scene::load(&dir.path().join("s.toml")).unwrap();
-    let m = &s.meshes[0];
+    let m = s.meshes().next().unwrap();
     assert_eq!((m.triangles, m.skipped.degenerate, m.skipped.non_finite), (2, 2, 2));
-    let bvh = s.bvh.as_ref().unwrap();
+    let bvh = s.accel.as_ref().unwrap();
     // A ray along the line the degenerate triangles lie on, and one through the valid ones.
     let along = bvh.closest(
         DVec3::new(-1.0, -1.0, 0.0),

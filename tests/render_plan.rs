@@ -4,12 +4,14 @@
 mod common;
 
 use glam::DVec3;
+use penumbra::accel::AccelSettings;
+use penumbra::mesh::Triangles;
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::plan::Pass;
 use penumbra::render::{Backend, RenderPlan, Sampling, View};
 use penumbra::sampling::{DiskScheme, Pattern};
 use penumbra::scene::camera::{Camera, Projection};
-use penumbra::scene::{DiskLight, Light, Plane, Scene, Sphere};
+use penumbra::scene::{DiskLight, Light, Mesh, Plane, Scene, Shape, Sphere};
 
 /// A ground plane seen in perspective up to the horizon, a point light and a disk light above
 /// it, and a disk light below it facing up (every receiver is behind that one).
@@ -65,7 +67,7 @@ fn plan_follows_the_scene() {
         plan.passes[0],
         Pass::Primary {
             rays: 1200,
-            shapes: vec!["plane"]
+            shapes: vec!["plane".to_string()]
         }
     );
     assert!(matches!(
@@ -87,19 +89,51 @@ fn plan_follows_the_scene() {
     ));
     assert_eq!(plan.max_rays(), 1200 * (1 + 1 + 8 + 32));
     s.lights.clear();
-    s.spheres.push(Sphere {
-        center: DVec3::Z,
-        radius: 0.5,
-        albedo: 0.5,
-    });
+    s.shapes.insert(
+        0,
+        Shape::Sphere(Sphere {
+            center: DVec3::Z,
+            radius: 0.5,
+            albedo: 0.5,
+        }),
+    );
     let plan = RenderPlan::new(&s, view).unwrap();
     assert_eq!(
         plan.passes,
         vec![Pass::Primary {
             rays: 1200,
-            shapes: vec!["sphere", "plane"]
+            shapes: vec!["sphere".to_string(), "plane".to_string()]
         }]
     );
+    let plan = RenderPlan::new(&with_quad(s), view).unwrap();
+    assert_eq!(
+        plan.passes,
+        vec![Pass::Primary {
+            rays: 1200,
+            shapes: ["sphere", "plane", "mesh (BVH)"].map(String::from).to_vec()
+        }]
+    );
+}
+
+/// `scene` with a mesh: a 0.4 m square of two triangles, 1 m above the ground, indexed by the
+/// default acceleration structure.
+fn with_quad(scene: Scene) -> Scene {
+    let c = |x: f64, y: f64| DVec3::new(x, y, 1.0);
+    let triangles = Triangles {
+        positions: vec![
+            [c(-0.2, -0.2), c(0.2, -0.2), c(0.2, 0.2)],
+            [c(-0.2, -0.2), c(0.2, 0.2), c(-0.2, 0.2)],
+        ],
+        object_of: vec![0, 0],
+    };
+    let mesh = Mesh {
+        source: "quad".into(),
+        file_fnv1a: 0,
+        albedo: 0.5,
+        triangles: 2,
+        skipped: Default::default(),
+    };
+    scene.with_meshes(vec![mesh], triangles, AccelSettings::default())
 }
 
 /// Receivers (pixels whose ray goes down to the plane) each trace 1 ray to the point light and
@@ -145,14 +179,13 @@ fn traced_rays_match_an_independent_count() {
     }
 }
 
-/// The GPU dispatches exactly the plan's passes: one primary dispatch, and per light one
-/// dispatch per sample chunk (every light here fits one chunk on any adapter: at most 32
-/// samples, and a capped adapter's chunk holds hundreds on a mesh-free scene). Counted for the
-/// full scene, for it without lights, and over timed frames.
+/// Each backend runs exactly the plan's passes: one primary dispatch, and per light one dispatch
+/// per sample chunk (every light here fits one chunk on any adapter: at most 32 samples, and a
+/// capped adapter's chunk holds dozens even with a mesh). Counted against 1 + lights for the
+/// full scene, with a mesh, without lights, and over timed frames.
 #[test]
-fn the_gpu_dispatches_the_plans_passes_and_nothing_else() {
-    let Some(mut gpu) = common::gpu() else { return };
-    let (mut s, cam) = scene();
+fn each_backend_runs_the_plans_passes_and_nothing_else() {
+    let (scene, cam) = scene();
     let view = View {
         camera: &cam,
         width: 16,
@@ -163,23 +196,31 @@ fn the_gpu_dispatches_the_plans_passes_and_nothing_else() {
         pattern: Pattern::PerPixel,
         seed: 3,
     };
-    let mut count = |s: &Scene, frames: u32| {
-        let before = gpu.dispatches();
-        if frames == 1 {
-            gpu.render(s, view, sampling).unwrap();
-        } else {
-            gpu.time(s, view, sampling, 1, frames - 1).unwrap();
-        }
-        gpu.dispatches() - before
+    let check = |name: &str, b: &mut dyn Backend| {
+        let mut count = |s: &Scene, frames: u32| {
+            let before = b.dispatches();
+            if frames == 1 {
+                b.render(s, view, sampling).unwrap();
+            } else {
+                b.time(s, view, sampling, 1, frames - 1).unwrap();
+            }
+            b.dispatches() - before
+        };
+        let mut s = scene.clone();
+        assert_eq!(count(&s, 1), 1 + 3, "{name}: primary and three lights");
+        assert_eq!(count(&with_quad(s.clone()), 1), 1 + 3, "{name}: a mesh adds no pass");
+        assert_eq!(
+            count(&s, 4),
+            4 * (1 + 3),
+            "{name}: warm-up and timed frames run the same passes"
+        );
+        s.lights.truncate(1);
+        assert_eq!(count(&s, 1), 1 + 1, "{name}: primary and the point light");
+        s.lights.clear();
+        assert_eq!(count(&s, 1), 1, "{name}: no light, no shadow pass");
     };
-    assert_eq!(count(&s, 1), 1 + 3, "primary and three lights");
-    assert_eq!(
-        count(&s, 4),
-        4 * (1 + 3),
-        "warm-up and timed frames run the same passes"
-    );
-    s.lights.truncate(1);
-    assert_eq!(count(&s, 1), 1 + 1, "primary and the point light");
-    s.lights.clear();
-    assert_eq!(count(&s, 1), 1, "no light, no shadow pass");
+    check("cpu", &mut CpuBackend::default());
+    if let Some(mut g) = common::gpu() {
+        check("gpu", &mut *g);
+    }
 }

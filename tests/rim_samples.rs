@@ -26,7 +26,7 @@ fn rim_targets_are_traced_and_agree_with_the_exact_test() {
         normal: DVec3::Z,
         albedo: 0.5,
     };
-    let scene = Scene::analytic(vec![sphere.clone()], vec![plane], vec![Light::Disk(light.clone())]);
+    let scene = Scene::analytic(vec![sphere], vec![plane], vec![Light::Disk(light.clone())]);
     // 64 points exactly on the unit circle (cos^2 + sin^2 rounds to 1 within an ulp).
     let rim: Vec<DVec2> = (0..64)
         .map(|k| DVec2::from_angle(k as f64 * std::f64::consts::TAU / 64.0))
@@ -39,7 +39,7 @@ fn rim_targets_are_traced_and_agree_with_the_exact_test() {
             p,
             n: DVec3::Z,
             albedo: 0.5,
-            object: scene.plane_id(0),
+            object: scene.plane(0).unwrap().0,
             triangle: NO_HIT,
         };
         let s = shade_light(&scene, &receiver, &scene.lights[0], Targets::Shared(&rim));

@@ -85,6 +85,9 @@ impl Backend for Flaky {
     fn adapter(&self) -> &AdapterInfo {
         self.0.adapter()
     }
+    fn dispatches(&self) -> u64 {
+        self.0.dispatches()
+    }
     fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
         anyhow::ensure!(s.seed != 2, "simulated device loss");
         self.0.render(scene, view, s)

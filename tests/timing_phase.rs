@@ -22,6 +22,9 @@ impl Backend for Drifting {
     fn adapter(&self) -> &AdapterInfo {
         self.cpu.adapter()
     }
+    fn dispatches(&self) -> u64 {
+        self.cpu.dispatches()
+    }
     fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
         self.cpu.render(scene, view, s)
     }

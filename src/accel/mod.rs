@@ -1,7 +1,180 @@
-//! Acceleration structures for ray queries against triangle meshes. [`bvh`] wraps obvhs' BVH2
-//! (PLOC build) for the CPU and lays it out for the WGSL traversal in
-//! `render/gpu/shaders/bvh.wgsl`.
+//! Acceleration structures: the one seam for "does this segment hit a triangle, and which one
+//! first" over the triangles of every mesh in a scene (pbrt-v4's `Intersect`/`IntersectP`,
+//! obvhs' traversal closures).
+//!
+//! A structure is a Rust type implementing [`Accelerator`] for the CPU, plus a WGSL module for
+//! the GPU that defines
+//!
+//! ```text
+//! fn accel_closest(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> AccelHit
+//! fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool
+//! ```
+//!
+//! over the storage buffers it declares at `@group(2)` ([`GpuStructure`]), with `AccelHit
+//! { t, triangle }` (`triangle` in input order, `NO_HIT` on a miss; `skip` is a triangle to
+//! ignore) and the flag `cut_short` set where a loop ended early. The GPU backend compiles each
+//! structure's module into its own pipelines, chosen by name. Adding a structure is its module,
+//! its WGSL and one line in [`REGISTRY`].
 
 pub mod bvh;
 
 pub use bvh::{Bvh, Preset};
+
+use crate::geometry::LocalFrame;
+use crate::mesh::Triangles;
+use glam::DVec3;
+use serde::Deserialize;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// A closest hit: distance along the (unit) ray and the triangle's index in input order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriHit {
+    /// Distance.
+    pub t: f64,
+    /// Triangle index (input order).
+    pub triangle: u32,
+}
+
+/// Möller-Trumbore ray-triangle intersection in f64; the distance, or None. Both sides hit.
+pub fn intersect(origin: DVec3, dir: DVec3, tri: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (tri[1] - tri[0], tri[2] - tri[0]);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - tri[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(e2.dot(q) * inv)
+}
+
+/// Closest hit with t > 0 by testing every triangle: the reference every structure is tested
+/// against.
+pub fn brute_force(triangles: &Triangles, origin: DVec3, dir: DVec3) -> Option<TriHit> {
+    triangles
+        .positions
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| {
+            intersect(origin, dir, t)
+                .filter(|t| *t > 0.0)
+                .map(|t| TriHit { t, triangle: i as u32 })
+        })
+        .min_by(|a, b| a.t.total_cmp(&b.t))
+}
+
+/// Ray queries over a fixed set of triangles, in f64 on the CPU.
+pub trait Accelerator: Send + Sync + std::fmt::Debug {
+    /// The name it is registered under (scene files and sweeps choose by it).
+    fn name(&self) -> &'static str;
+
+    /// Closest triangle other than `skip` hit with 0 < t < `tmax` along unit `dir`.
+    fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit>;
+
+    /// Whether any triangle other than `skip` is hit with 0 < t < `tmax`; may stop at the first.
+    fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool;
+
+    /// What the structure cost to build and what it occupies.
+    fn stats(&self) -> BuildStats;
+
+    /// The GPU form in `frame`'s local coordinates, or an error naming the limit it exceeds.
+    fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure>;
+}
+
+/// Build cost and size, for records and reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildStats {
+    /// The build parameters in a few words (a BVH's preset name).
+    pub parameters: String,
+    /// Wall-clock build time, everything included.
+    pub build_time: Duration,
+    /// Bytes the GPU form occupies.
+    pub gpu_bytes: u64,
+    /// Triangles indexed.
+    pub triangles: usize,
+    /// One sentence for the report: kind, size, build time, memory.
+    pub description: String,
+}
+
+/// A structure's GPU buffers: bound read-only at `@group(2)`, binding i for `buffers[i]`.
+pub struct GpuStructure {
+    /// (label, bytes) per buffer, in binding order.
+    pub buffers: Vec<(&'static str, Vec<u8>)>,
+    /// Upper bound on the loop iterations of one any-hit query, for adapters that cap loops.
+    pub walk_iterations: u32,
+}
+
+/// What a scene asks of its acceleration structure: which one, and each one's parameters.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AccelSettings {
+    /// Registry name.
+    pub name: &'static str,
+    /// obvhs build preset (BVH).
+    pub bvh_preset: Preset,
+}
+
+impl Default for AccelSettings {
+    fn default() -> Self {
+        AccelSettings {
+            name: REGISTRY[0].name,
+            bvh_preset: Preset::default(),
+        }
+    }
+}
+
+/// One registered structure.
+pub struct Registered {
+    /// Name in scene files and sweeps.
+    pub name: &'static str,
+    /// Its WGSL module (see the module doc for the interface).
+    pub wgsl: &'static str,
+    /// Storage buffers its WGSL declares at `@group(2)`.
+    pub gpu_buffers: u32,
+    /// Builds it over `triangles`.
+    pub build: fn(&Triangles, &AccelSettings) -> Arc<dyn Accelerator>,
+}
+
+/// Every acceleration structure, the default first.
+pub const REGISTRY: &[Registered] = &[Registered {
+    name: "bvh",
+    wgsl: bvh::WGSL,
+    gpu_buffers: 2,
+    build: |t, s| Arc::new(Bvh::build(t, s.bvh_preset)),
+}];
+
+/// The registered structure called `name`.
+pub fn registered(name: &str) -> Option<&'static Registered> {
+    REGISTRY.iter().find(|r| r.name == name)
+}
+
+/// Registered names, for messages.
+pub fn names() -> Vec<&'static str> {
+    REGISTRY.iter().map(|r| r.name).collect()
+}
+
+/// Builds the structure `settings` names over `triangles`; `None` for no triangles.
+pub fn build(triangles: &Triangles, settings: &AccelSettings) -> Option<Arc<dyn Accelerator>> {
+    let r = registered(settings.name).expect("settings hold a registered name");
+    (!triangles.positions.is_empty()).then(|| (r.build)(triangles, settings))
+}
+
+/// An accelerator name as written in a scene file.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+#[serde(transparent)]
+pub struct AccelName(pub String);
+
+impl Default for AccelName {
+    fn default() -> Self {
+        AccelName(REGISTRY[0].name.to_string())
+    }
+}

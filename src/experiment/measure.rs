@@ -86,12 +86,13 @@ pub fn measure_run(
     }
     r.set("primary_rays", rays.primary.to_string());
     r.set("shadow_rays", rays.shadow_total().to_string());
-    if let Some(b) = &scene.bvh {
-        r.set("bvh_preset", b.preset.name().to_string());
-        r.set("bvh_build_ms", num(b.total_time.as_secs_f64() * 1e3));
+    if let Some(a) = &scene.accel {
+        let stats = a.stats();
+        r.set("bvh_preset", stats.parameters);
+        r.set("bvh_build_ms", num(stats.build_time.as_secs_f64() * 1e3));
         r.set(
             "gpu_bytes_per_triangle",
-            num((b.node_count() * 32 + b.tree.primitive_indices.len() * 48) as f64 / b.world.len() as f64),
+            num(stats.gpu_bytes as f64 / stats.triangles as f64),
         );
     }
     Ok((r, image))

@@ -187,7 +187,7 @@ impl Reference {
 
 /// The exact reference covers disk lights and analytic shapes (no meshes, no point lights).
 pub fn has_exact_answer(scene: &Scene) -> bool {
-    scene.bvh.is_none() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
+    crate::reference::occluders(&scene.shapes).is_some() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
 }
 
 /// How accurate an exact image is, from its quadrature's own estimates.
@@ -202,12 +202,13 @@ pub struct ExactQuality {
 /// Exact shadow image (mean over the scene's disk lights) at every receiver pixel, with its
 /// quadrature's accuracy (rayon; the penumbra dominates the cost).
 pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> (Vec<f32>, ExactQuality) {
-    let pl = &scene.planes[plane];
+    let (_, pl) = scene.plane(plane).expect("the measured plane was validated");
+    let (spheres, planes) = crate::reference::occluders(&scene.shapes).expect("an exact answer exists");
     let points: Vec<(usize, glam::DVec3)> = receivers
         .pixels
         .iter()
         .zip(&receivers.points)
-        .map(|(&(i, _), &p)| (i, crate::geometry::reproject_plane(p, pl)))
+        .map(|(&(i, _), &p)| (i, pl.reproject(p)))
         .collect();
     let disks: Vec<_> = scene
         .lights
@@ -219,7 +220,7 @@ pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Recei
         .map(|&(i, p)| {
             let e = disks
                 .iter()
-                .map(|l| visible_fraction_estimate(p, pl.normal, l, &scene.spheres, &scene.planes))
+                .map(|l| visible_fraction_estimate(p, pl.normal, l, &spheres, &planes))
                 .fold(Estimate::default(), |a, b| a + b);
             let k = disks.len() as f64;
             (

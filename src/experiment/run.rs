@@ -94,12 +94,7 @@ pub fn expand(spec: &Spec) -> Vec<Group> {
 /// renders (another backend or adapter never resumes this one's rows). Timing settings key the
 /// timing journal instead (see `timing`), so changing them re-times without re-rendering.
 pub fn context_key(spec: &Spec, adapter: &AdapterInfo) -> String {
-    let meshes: Vec<String> = spec
-        .scene
-        .meshes
-        .iter()
-        .map(|m| format!("{:016x}", m.file_fnv1a))
-        .collect();
+    let meshes: Vec<String> = spec.scene.meshes().map(|m| format!("{:016x}", m.file_fnv1a)).collect();
     format!(
         "scene={:016x};meshes=[{}];measure={:?};gt={};plane={};device={:?};build={:016x}",
         fnv1a(spec.scene_text.as_bytes()),

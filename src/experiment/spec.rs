@@ -201,10 +201,10 @@ impl Spec {
                 ));
             }
         }
-        if m.plane >= scene.planes.len() {
+        if scene.plane(m.plane).is_none() {
             return Err(err(
                 &key_path!["measure", "plane"],
-                format!("the scene has {} planes", scene.planes.len()),
+                format!("the scene has {} planes", scene.planes().count()),
             ));
         }
         let a = &axes;

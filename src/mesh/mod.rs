@@ -10,8 +10,8 @@ use glam::{DMat4, DVec3};
 pub struct Triangles {
     /// Corner positions (f64, world space).
     pub positions: Vec<[DVec3; 3]>,
-    /// Mesh index per triangle.
-    pub mesh_of: Vec<u32>,
+    /// Owner per triangle: in a [`crate::scene::Scene`], the id of its mesh object.
+    pub object_of: Vec<u32>,
 }
 
 /// Counts of triangles dropped because no ray can hit them.

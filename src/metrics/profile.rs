@@ -30,8 +30,7 @@ impl Receivers {
     /// Receiver pixels of `view`: those whose object id in `hit` is plane `plane`, located by
     /// intersecting their camera rays with that plane in f64.
     pub fn new(scene: &Scene, view: View, plane: usize, hit: &[u32], centre: DVec3, bin_width: f64) -> Self {
-        let pl = &scene.planes[plane];
-        let id = scene.plane_id(plane);
+        let (id, pl) = scene.plane(plane).expect("the measured plane was validated");
         let (mut pixels, mut points) = (Vec::new(), Vec::new());
         for y in 0..view.height {
             for x in 0..view.width {
@@ -40,7 +39,7 @@ impl Receivers {
                     continue;
                 }
                 let ray = view.camera.ray(x, y, view.width, view.height);
-                if let Some(t) = crate::geometry::plane_t(ray.origin, ray.direction, pl) {
+                if let Some(t) = pl.t(ray.origin, ray.direction) {
                     let p = ray.origin + ray.direction * t;
                     pixels.push((i, (p - centre).length()));
                     points.push(p);

@@ -10,4 +10,4 @@ pub mod visibility;
 
 pub use on_axis::OnAxis;
 pub use quadrature::Estimate;
-pub use visibility::{visible_fraction, visible_fraction_estimate};
+pub use visibility::{occluders, visible_fraction, visible_fraction_estimate};

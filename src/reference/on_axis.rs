@@ -30,10 +30,11 @@ impl OnAxis {
         let Some(Light::Disk(l)) = scene.lights.get(light) else {
             return None;
         };
-        let [s] = scene.spheres.as_slice() else {
+        let (spheres, _) = super::occluders(&scene.shapes)?;
+        let [s] = spheres.as_slice() else {
             return None;
         };
-        let pl = scene.planes.get(plane)?;
+        let (_, pl) = scene.plane(plane)?;
         Self::from_parts(l, s, pl)
     }
 

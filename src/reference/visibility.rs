@@ -11,7 +11,7 @@
 //! enter an occluder.
 
 use super::quadrature::{integrate_panels, Estimate};
-use crate::scene::{DiskLight, Plane, Sphere};
+use crate::scene::{DiskLight, Plane, Shape, Sphere};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
@@ -21,6 +21,22 @@ pub const TOLERANCE: f64 = 1e-10;
 /// Initial angular panels: a visible or occluded sliver narrower than 2 pi / (128 x 15) in angle
 /// could be missed; near a tangency its area scales as the cube of that width, ~4e-9 of the disk.
 const PANELS: u32 = 128;
+
+/// The occluders of a scene as the exact answer takes them: its spheres and planes, or None
+/// where it has a mesh with triangles (no closed form covers triangles; such scenes are judged against the
+/// ground truth alone).
+pub fn occluders(shapes: &[Shape]) -> Option<(Vec<Sphere>, Vec<Plane>)> {
+    let (mut spheres, mut planes) = (vec![], vec![]);
+    for s in shapes {
+        match s {
+            Shape::Sphere(s) => spheres.push(*s),
+            Shape::Plane(p) => planes.push(*p),
+            Shape::Mesh(m) if m.triangles > 0 => return None,
+            Shape::Mesh(_) => {}
+        }
+    }
+    Some((spheres, planes))
+}
 
 /// Exact fraction of `light` visible from point `p` with surface normal `n` (the receiver's own
 /// horizon counts as an occluder), with `spheres` and `planes` as occluders. Planes through `p`

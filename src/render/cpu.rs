@@ -1,10 +1,10 @@
 //! The f64 CPU backend: the fallback when no GPU adapter exists and the cross-check of the GPU
-//! in tests. Same plan, same sample streams, double precision, rayon over rows.
+//! in tests. It runs the plan's passes in order, each a parallel loop over pixels (rayon), with
+//! the GPU's sample streams, in double precision.
 
-use super::shading::{shade_light, Receiver, Targets};
+use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
-use crate::geometry::{plane_t, reproject_plane, reproject_sphere, sphere_roots};
-use crate::render::plan::{RenderPlan, MAX_LIGHTS};
+use crate::render::plan::{Pass, RenderPlan};
 use crate::sampling::{shared_points, Pattern, Stream};
 use crate::scene::Scene;
 use glam::DVec3;
@@ -15,6 +15,8 @@ use std::time::Instant;
 /// The CPU reference renderer.
 pub struct CpuBackend {
     info: AdapterInfo,
+    /// Passes run so far, all frames: one parallel loop per pass of the plan.
+    dispatches: u64,
 }
 
 impl Default for CpuBackend {
@@ -27,63 +29,44 @@ impl Default for CpuBackend {
                 api: "cpu".into(),
                 loop_cap: None,
             },
+            dispatches: 0,
         }
     }
 }
 
 /// The closest surface a ray meets, as a receiver of shadow rays: point re-projected onto
-/// analytic surfaces, geometric normal facing the ray.
+/// analytic surfaces, geometric normal facing the ray. Analytic shapes are tested in id order
+/// (the first of equal distances wins), then the accelerator within the distance found.
 pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver> {
-    let mut best: Option<(f64, u32, u32)> = None;
-    let consider = |best: &mut Option<(f64, u32, u32)>, t: f64, id: u32, tri: u32| {
-        if t > 0.0 && best.is_none_or(|(bt, _, _)| t < bt) {
-            *best = Some((t, id, tri));
-        }
-    };
-    for (i, s) in scene.spheres.iter().enumerate() {
-        if let Some((t0, t1)) = sphere_roots(origin, dir, s) {
-            consider(&mut best, if t0 > 0.0 { t0 } else { t1 }, i as u32, NO_HIT);
+    let mut best: Option<(f64, usize)> = None;
+    for (id, shape) in scene.shapes.iter().enumerate() {
+        if let Some(t) = shape.first_t(origin, dir) {
+            if best.is_none_or(|(bt, _)| t < bt) {
+                best = Some((t, id));
+            }
         }
     }
-    for (i, p) in scene.planes.iter().enumerate() {
-        if let Some(t) = plane_t(origin, dir, p) {
-            consider(&mut best, t, scene.plane_id(i), NO_HIT);
+    let tmax = best.map_or(f64::INFINITY, |b| b.0);
+    let mesh_hit = scene.accel.as_ref().and_then(|a| a.closest(origin, dir, tmax, NO_HIT));
+    let (p, n, object, triangle) = match mesh_hit {
+        Some(h) if h.t > 0.0 => {
+            let tri = &scene.triangles.positions[h.triangle as usize];
+            let object = scene.triangles.object_of[h.triangle as usize];
+            let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
+            (origin + dir * h.t, n, object as usize, h.triangle)
         }
-    }
-    if let Some(bvh) = &scene.bvh {
-        let tmax = best.map_or(f64::INFINITY, |b| b.0);
-        if let Some(h) = bvh.closest(origin, dir, tmax, NO_HIT) {
-            consider(
-                &mut best,
-                h.t,
-                scene.mesh_id(bvh.mesh_of[h.triangle as usize] as usize),
-                h.triangle,
-            );
+        _ => {
+            let (t, id) = best?;
+            let surface = scene.shapes[id].surface(origin + dir * t)?;
+            (surface.point, surface.normal, id, NO_HIT)
         }
-    }
-    let (t, object, triangle) = best?;
-    let raw = origin + dir * t;
-    let (p, n, albedo) = if let Some(s) = scene.spheres.get(object as usize) {
-        let p = reproject_sphere(raw, s);
-        (p, (p - s.center) / s.radius, s.albedo)
-    } else if let Some(pl) = scene.planes.get(object as usize - scene.spheres.len()) {
-        (reproject_plane(raw, pl), pl.normal, pl.albedo)
-    } else {
-        let bvh = scene.bvh.as_ref().expect("a mesh hit has a BVH");
-        let tri = &bvh.world[triangle as usize];
-        let mesh = bvh.mesh_of[triangle as usize] as usize;
-        (
-            raw,
-            (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize(),
-            scene.meshes[mesh].albedo,
-        )
     };
     let n = if n.dot(dir) > 0.0 { -n } else { n };
     Some(Receiver {
         p,
         n,
-        albedo,
-        object,
+        albedo: scene.shapes[object].albedo(),
+        object: object as u32,
         triangle,
     })
 }
@@ -93,70 +76,71 @@ impl Backend for CpuBackend {
         &self.info
     }
 
+    fn dispatches(&self) -> u64 {
+        self.dispatches
+    }
+
     fn render(&mut self, scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
-        RenderPlan::new(scene, view)?;
-        let shared: Vec<Option<Vec<_>>> = scene
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                (sampling.pattern == Pattern::Shared)
-                    .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, i as u32))
-            })
-            .collect();
-        let w = view.width as usize;
-        let lights = scene.lights.len();
-        let rows: Vec<_> = (0..view.height)
-            .into_par_iter()
-            .map(|y| {
-                let mut radiance = vec![0f32; w];
-                let mut vis = vec![NO_RECEIVER; w * lights];
-                let mut hit = vec![NO_HIT; w];
-                let mut rays = [0u64; MAX_LIGHTS];
-                for x in 0..view.width {
-                    let ray = view.camera.ray(x, y, view.width, view.height);
-                    let Some(receiver) = closest_hit(scene, ray.origin, ray.direction) else {
-                        continue;
-                    };
-                    let pixel = y * view.width + x;
-                    hit[x as usize] = receiver.object;
-                    let mut irradiance = 0.0;
-                    for (li, light) in scene.lights.iter().enumerate() {
-                        let targets = match &shared[li] {
-                            Some(points) => Targets::Shared(points),
-                            None => {
-                                Targets::PerPixel(sampling.scheme, Stream::new(sampling.seed, li as u32, Some(pixel)))
-                            }
-                        };
-                        let s = shade_light(scene, &receiver, light, targets);
-                        vis[li * w + x as usize] = s.visibility as f32;
-                        irradiance += s.irradiance;
-                        rays[li] += s.rays;
-                    }
-                    radiance[x as usize] = (receiver.albedo * FRAC_1_PI * irradiance) as f32;
-                }
-                (radiance, vis, hit, rays)
-            })
-            .collect();
+        let plan = RenderPlan::new(scene, view)?;
+        let pixels = view.pixels();
         let mut frame = Frame {
             width: view.width,
             height: view.height,
-            radiance: Vec::with_capacity(view.pixels()),
-            visibility: vec![Vec::with_capacity(view.pixels()); lights],
-            hit: Vec::with_capacity(view.pixels()),
-            rays: RayCounts {
-                primary: view.pixels() as u64,
-                shadow: [0; MAX_LIGHTS],
-            },
+            radiance: vec![0.0; pixels],
+            visibility: vec![vec![NO_RECEIVER; pixels]; scene.lights.len()],
+            hit: vec![NO_HIT; pixels],
+            rays: RayCounts::default(),
         };
-        for (radiance, vis, hit, rays) in rows {
-            frame.radiance.extend(radiance);
-            frame.hit.extend(hit);
-            for (li, v) in frame.visibility.iter_mut().enumerate() {
-                v.extend_from_slice(&vis[li * w..(li + 1) * w]);
+        let mut receivers: Vec<Option<Receiver>> = vec![];
+        let mut irradiance = vec![0f64; pixels];
+        for pass in &plan.passes {
+            self.dispatches += 1;
+            match *pass {
+                Pass::Primary { rays, .. } => {
+                    receivers = (0..pixels)
+                        .into_par_iter()
+                        .map(|i| {
+                            let (x, y) = (i as u32 % view.width, i as u32 / view.width);
+                            let ray = view.camera.ray(x, y, view.width, view.height);
+                            closest_hit(scene, ray.origin, ray.direction)
+                        })
+                        .collect();
+                    for (h, r) in frame.hit.iter_mut().zip(&receivers) {
+                        *h = r.map_or(NO_HIT, |r| r.object);
+                    }
+                    frame.rays.primary = rays;
+                }
+                Pass::Shadow { light, .. } => {
+                    let l = &scene.lights[light];
+                    let shared = (sampling.pattern == Pattern::Shared)
+                        .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, light as u32));
+                    let samples: Vec<Option<LightSample>> = receivers
+                        .par_iter()
+                        .enumerate()
+                        .map(|(pixel, r)| {
+                            let targets = match &shared {
+                                Some(points) => Targets::Shared(points),
+                                None => Targets::PerPixel(
+                                    sampling.scheme,
+                                    Stream::new(sampling.seed, light as u32, Some(pixel as u32)),
+                                ),
+                            };
+                            r.as_ref().map(|r| shade_light(scene, r, l, targets))
+                        })
+                        .collect();
+                    for (pixel, s) in samples.iter().enumerate() {
+                        if let Some(s) = s {
+                            frame.visibility[light][pixel] = s.visibility as f32;
+                            irradiance[pixel] += s.irradiance;
+                            frame.rays.shadow[light] += s.rays;
+                        }
+                    }
+                }
             }
-            for (total, r) in frame.rays.shadow.iter_mut().zip(rays) {
-                *total += r;
+        }
+        for ((out, r), e) in frame.radiance.iter_mut().zip(&receivers).zip(&irradiance) {
+            if let Some(r) = r {
+                *out = (r.albedo * FRAC_1_PI * e) as f32;
             }
         }
         Ok(frame)

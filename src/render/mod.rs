@@ -134,6 +134,10 @@ pub trait Backend {
     /// Which device this is.
     fn adapter(&self) -> &AdapterInfo;
 
+    /// Work units issued so far over all frames (GPU: compute dispatches, CPU: pass loops): what
+    /// tests count against the plan, since a pass not in the plan must never run.
+    fn dispatches(&self) -> u64;
+
     /// Renders one frame and reads it back.
     fn render(&mut self, scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame>;
 

@@ -17,8 +17,9 @@ pub enum Pass {
     Primary {
         /// One ray per pixel.
         rays: u64,
-        /// Shape kinds intersected (only those present in the scene).
-        shapes: Vec<&'static str>,
+        /// Shape kinds intersected (only those present in the scene); meshes name the
+        /// acceleration structure that answers for them.
+        shapes: Vec<String>,
     },
     /// Shadow rays from every receiver point towards one light: any-hit with early exit.
     Shadow {
@@ -51,14 +52,13 @@ impl RenderPlan {
         );
         let pixels = view.pixels() as u64;
         let mut shapes = Vec::new();
-        if !scene.spheres.is_empty() {
-            shapes.push("sphere");
+        for kind in ["sphere", "plane"] {
+            if scene.shapes.iter().any(|s| s.kind() == kind) {
+                shapes.push(kind.to_string());
+            }
         }
-        if !scene.planes.is_empty() {
-            shapes.push("plane");
-        }
-        if scene.bvh.is_some() {
-            shapes.push("mesh (BVH)");
+        if let Some(a) = &scene.accel {
+            shapes.push(format!("mesh ({})", a.name().to_uppercase()));
         }
         let mut passes = vec![Pass::Primary { rays: pixels, shapes }];
         for (i, light) in scene.lights.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! Per-receiver shadow-ray logic of the CPU backend, in f64. `shaders/render.wgsl` follows it
 //! line for line in f32; change both together.
 
-use crate::geometry::{offset_origin, plane_t, sphere_roots};
+use crate::geometry::offset_origin;
 use crate::sampling::{DiskScheme, Stream};
 use crate::scene::{DiskLight, Light, Scene};
 use glam::{DVec2, DVec3};
@@ -53,20 +53,16 @@ impl Receiver {
 pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, r: &Receiver) -> bool {
     let len = d.length();
     let dir = d / len;
-    let inside = |t: f64| t > 0.0 && t < len;
-    let sphere_hit = scene.spheres.iter().enumerate().any(|(i, s)| {
-        i as u32 != r.object && sphere_roots(origin, dir, s).is_some_and(|(t0, t1)| inside(t0) || inside(t1))
-    });
-    sphere_hit
+    let analytic = scene
+        .shapes
+        .iter()
+        .enumerate()
+        .any(|(id, s)| id as u32 != r.object && s.blocks(origin, dir, len));
+    analytic
         || scene
-            .planes
-            .iter()
-            .enumerate()
-            .any(|(i, p)| scene.plane_id(i) != r.object && plane_t(origin, dir, p).is_some_and(inside))
-        || scene
-            .bvh
+            .accel
             .as_ref()
-            .is_some_and(|b| b.any_hit(origin, dir, len, r.triangle))
+            .is_some_and(|a| a.any_hit(origin, dir, len, r.triangle))
 }
 
 /// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:

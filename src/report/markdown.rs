@@ -37,11 +37,10 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     s += "Render plan of a run at the figure ray count with every light on (derived from the scene):\n\n```\n";
     s += &outcome.plan.to_string();
     s += "```\n\n";
-    if let Some(b) = &spec.scene.bvh {
+    if let Some(a) = &spec.scene.accel {
         let m: Vec<String> = spec
             .scene
-            .meshes
-            .iter()
+            .meshes()
             .map(|m| {
                 format!(
                     "`{}`: {} triangles ({} degenerate and {} non-finite skipped)",
@@ -49,16 +48,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
                 )
             })
             .collect();
-        s += &format!(
-            "Meshes: {}. BVH2 (obvhs, preset `{}`): {} nodes, depth {}, built in {:.1} ms ({:.1} ms core); {:.1} GPU bytes per triangle (32-byte nodes, 48-byte full-f32 triangles).\n\n",
-            m.join("; "),
-            b.preset.name(),
-            b.node_count(),
-            b.depth,
-            b.total_time.as_secs_f64() * 1e3,
-            b.build_time.as_secs_f64() * 1e3,
-            (b.node_count() * 32 + b.tree.primitive_indices.len() * 48) as f64 / b.world.len() as f64
-        );
+        s += &format!("Meshes: {}. {}.\n\n", m.join("; "), a.stats().description);
     }
     s += "## Ground truth against the exact answer\n\n";
     s += &format!(

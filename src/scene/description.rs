@@ -21,6 +21,9 @@ pub struct SceneFile {
     /// Triangle meshes from OBJ files.
     #[serde(default)]
     pub meshes: Vec<MeshDesc>,
+    /// The acceleration structure over the meshes' triangles (`crate::accel::REGISTRY`).
+    #[serde(default)]
+    pub accelerator: crate::accel::AccelName,
     /// obvhs build preset of the meshes' BVH.
     #[serde(default)]
     pub bvh_preset: crate::accel::Preset,

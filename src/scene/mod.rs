@@ -1,4 +1,5 @@
-//! What is rendered: cameras, analytic spheres and planes, point and disk lights, in metres.
+//! What is rendered: cameras, shapes (spheres, planes, triangle meshes) and point and disk
+//! lights, in metres, with the acceleration structure over the meshes' triangles.
 //!
 //! [`Scene::load`] reads a TOML file ([`description`]) and validates it into this model, so that
 //! everything downstream can assume finite positions, unit normals and positive radii.
@@ -6,10 +7,12 @@
 pub mod camera;
 pub mod description;
 
-use crate::accel::{Bvh, Preset};
+pub mod shape;
+
+use crate::accel::{self, AccelSettings, Accelerator};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
-use crate::mesh::{clean, obj, Skipped, Triangles};
+use crate::mesh::{clean, obj, Triangles};
 use camera::{Camera, Projection};
 use description::{LightDesc, ProjectionDesc, SceneFile};
 use glam::{DMat4, DQuat, DVec3};
@@ -17,27 +20,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-/// An analytic sphere.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sphere {
-    /// Centre.
-    pub center: DVec3,
-    /// Radius (> 0).
-    pub radius: f64,
-    /// Lambertian albedo.
-    pub albedo: f64,
-}
-
-/// An infinite plane {x : normal . (x - point) = 0}.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Plane {
-    /// A point on the plane.
-    pub point: DVec3,
-    /// Unit normal.
-    pub normal: DVec3,
-    /// Lambertian albedo.
-    pub albedo: f64,
-}
+pub use shape::{Mesh, Plane, Shape, Sphere};
 
 /// A one-sided Lambertian disk light, the soft-shadow paper's light source.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,60 +76,38 @@ impl Light {
     }
 }
 
-/// A mesh of the scene (its triangles live in the scene's [`Bvh`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Mesh {
-    /// Where it came from, for messages.
-    pub source: String,
-    /// FNV-1a of the file's bytes: keys cached and resumed results, so an edited file is re-run.
-    pub file_fnv1a: u64,
-    /// Lambertian albedo.
-    pub albedo: f64,
-    /// Triangles kept.
-    pub triangles: usize,
-    /// Triangles dropped as unhittable.
-    pub skipped: Skipped,
-}
-
 /// A validated scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// Cameras by name.
     pub cameras: BTreeMap<String, Camera>,
-    /// Spheres; object ids 0..spheres.len().
-    pub spheres: Vec<Sphere>,
-    /// Planes; object ids follow the spheres'.
-    pub planes: Vec<Plane>,
+    /// Objects; an object's id is its index here.
+    pub shapes: Vec<Shape>,
     /// Lights.
     pub lights: Vec<Light>,
-    /// Meshes; object ids follow the planes'.
-    pub meshes: Vec<Mesh>,
-    /// The BVH over every mesh triangle (None without meshes).
-    pub bvh: Option<Arc<Bvh>>,
-}
-
-impl std::fmt::Debug for Bvh {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "Bvh({} triangles, {} nodes, {})",
-            self.world.len(),
-            self.node_count(),
-            self.preset.name()
-        )
-    }
+    /// Every mesh triangle in world space, with the id of the mesh object it belongs to.
+    pub triangles: Triangles,
+    /// Which acceleration structure indexes `triangles`, and its parameters.
+    pub accel_settings: AccelSettings,
+    /// That structure (None without triangles).
+    pub accel: Option<Arc<dyn Accelerator>>,
 }
 
 impl Scene {
-    /// A scene of analytic shapes and lights only.
+    /// A scene of analytic shapes and lights only: the spheres' ids first, then the planes'.
     pub fn analytic(spheres: Vec<Sphere>, planes: Vec<Plane>, lights: Vec<Light>) -> Scene {
+        let shapes = spheres
+            .into_iter()
+            .map(Shape::Sphere)
+            .chain(planes.into_iter().map(Shape::Plane))
+            .collect();
         Scene {
             cameras: BTreeMap::new(),
-            spheres,
-            planes,
+            shapes,
             lights,
-            meshes: vec![],
-            bvh: None,
+            triangles: Triangles::default(),
+            accel_settings: AccelSettings::default(),
+            accel: None,
         }
     }
 
@@ -156,16 +117,66 @@ impl Scene {
         self
     }
 
-    /// Adds triangle meshes (world space) and builds their BVH with `preset`.
-    pub fn with_triangles(mut self, meshes: Vec<Mesh>, triangles: Triangles, preset: Preset) -> Scene {
-        self.bvh = (!triangles.positions.is_empty()).then(|| Arc::new(Bvh::build(&triangles, preset)));
-        self.meshes = meshes;
+    /// Adds triangle meshes, whose world-space `triangles` name their mesh by its index in
+    /// `meshes`, and indexes every triangle with the structure `settings` names.
+    pub fn with_meshes(mut self, meshes: Vec<Mesh>, mut triangles: Triangles, settings: AccelSettings) -> Scene {
+        let base = self.shapes.len() as u32;
+        triangles.object_of.iter_mut().for_each(|m| *m += base);
+        self.shapes.extend(meshes.into_iter().map(Shape::Mesh));
+        self.triangles.positions.extend(triangles.positions);
+        self.triangles.object_of.extend(triangles.object_of);
+        self.with_accelerator(settings)
+    }
+
+    /// The same scene with its triangles indexed by the structure `settings` names.
+    pub fn with_accelerator(mut self, settings: AccelSettings) -> Scene {
+        self.accel = accel::build(&self.triangles, &settings);
+        self.accel_settings = settings;
         self
     }
 
-    /// Object id of mesh `i` (after spheres and planes).
-    pub fn mesh_id(&self, i: usize) -> u32 {
-        (self.spheres.len() + self.planes.len() + i) as u32
+    /// The spheres, in id order.
+    pub fn spheres(&self) -> impl Iterator<Item = &Sphere> {
+        self.shapes.iter().filter_map(|s| match s {
+            Shape::Sphere(s) => Some(s),
+            _ => None,
+        })
+    }
+
+    /// The planes, in id order.
+    pub fn planes(&self) -> impl Iterator<Item = &Plane> {
+        self.shapes.iter().filter_map(|s| match s {
+            Shape::Plane(p) => Some(p),
+            _ => None,
+        })
+    }
+
+    /// The spheres, mutable (ids unchanged).
+    pub fn spheres_mut(&mut self) -> impl Iterator<Item = &mut Sphere> {
+        self.shapes.iter_mut().filter_map(|s| match s {
+            Shape::Sphere(s) => Some(s),
+            _ => None,
+        })
+    }
+
+    /// The meshes, in id order.
+    pub fn meshes(&self) -> impl Iterator<Item = &Mesh> {
+        self.shapes.iter().filter_map(|s| match s {
+            Shape::Mesh(m) => Some(m),
+            _ => None,
+        })
+    }
+
+    /// Plane `i` (counting planes only) and its object id.
+    pub fn plane(&self, i: usize) -> Option<(u32, &Plane)> {
+        self.shapes
+            .iter()
+            .enumerate()
+            .filter_map(|(id, s)| match s {
+                Shape::Plane(p) => Some((id as u32, p)),
+                _ => None,
+            })
+            .nth(i)
     }
 
     /// Reads and validates a scene file.
@@ -217,6 +228,21 @@ impl Scene {
             cameras.insert(name.clone(), camera);
         }
         let mut spheres = Vec::new();
+        let settings = AccelSettings {
+            name: accel::registered(&file.accelerator.0)
+                .ok_or_else(|| {
+                    source.error(
+                        &key_path!["accelerator"],
+                        format!(
+                            "unknown acceleration structure `{}`; known: {}",
+                            file.accelerator.0,
+                            accel::names().join(", ")
+                        ),
+                    )
+                })?
+                .name,
+            bvh_preset: file.bvh_preset,
+        };
         for (i, s) in file.spheres.iter().enumerate() {
             spheres.push(Sphere {
                 center: v.point(&s.center, &key_path!["spheres", i, "center"])?,
@@ -281,7 +307,7 @@ impl Scene {
                     skipped.non_finite
                 );
             }
-            triangles.mesh_of.extend(std::iter::repeat_n(i as u32, kept.len()));
+            triangles.object_of.extend(std::iter::repeat_n(i as u32, kept.len()));
             let bytes = std::fs::read(&path).map_err(|e| source.error(&at("path"), e.to_string()))?;
             meshes.push(Mesh {
                 source: path.display().to_string(),
@@ -294,12 +320,7 @@ impl Scene {
         }
         Ok(Scene::analytic(spheres, planes, lights)
             .with_cameras(cameras)
-            .with_triangles(meshes, triangles, file.bvh_preset))
-    }
-
-    /// Object id of plane `i` (ids are spheres first, then planes).
-    pub fn plane_id(&self, i: usize) -> u32 {
-        (self.spheres.len() + i) as u32
+            .with_meshes(meshes, triangles, settings))
     }
 
     /// The same scene moved by `offset`: a robustness probe (issue: hard cases stay stable).
@@ -321,21 +342,9 @@ impl Scene {
                 *width *= scale;
             }
         }
-        for s in &mut out.spheres {
-            s.center = f(s.center);
-            s.radius *= scale;
-        }
-        for p in &mut out.planes {
-            p.point = f(p.point);
-        }
-        if let Some(bvh) = &self.bvh {
-            let positions = bvh.world.iter().map(|t| t.map(&f)).collect();
-            let triangles = Triangles {
-                positions,
-                mesh_of: bvh.mesh_of.clone(),
-            };
-            out = out.with_triangles(self.meshes.clone(), triangles, bvh.preset);
-        }
+        out.shapes = self.shapes.iter().map(|s| s.transformed(&f, scale)).collect();
+        out.triangles.positions = self.triangles.positions.iter().map(|t| t.map(&f)).collect();
+        out = out.with_accelerator(self.accel_settings.clone());
         for l in &mut out.lights {
             match l {
                 Light::Point { position, power } => {

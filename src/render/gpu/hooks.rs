@@ -1,5 +1,6 @@
-//! Test hooks: kernels that expose the WGSL sampler and BVH traversal to tests, bound through
-//! their own group (probe rays) so nothing of theirs sits in the render layout.
+//! Test hooks: kernels (`shaders/hooks.wgsl`) that expose the WGSL sampler and the acceleration
+//! structure's queries to tests. They are compiled only when called and bound through their own
+//! group (probe rays), so nothing of theirs sits in the render pipelines or their layout.
 
 use super::layout::{self, pack};
 use super::GpuBackend;
@@ -34,8 +35,8 @@ impl GpuBackend {
     /// Runs a one-dimensional test-hook kernel over `groups` workgroups with `rays` bound as the
     /// hooks' probe rays.
     fn run_hook(
-        &self,
-        pipeline: &wgpu::ComputePipeline,
+        &mut self,
+        probe: bool,
         r: &super::FrameResources,
         rays: &[[f32; 4]],
         groups: u32,
@@ -48,12 +49,16 @@ impl GpuBackend {
         });
         let hook = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("test hooks"),
-            layout: &self.hook_layout,
+            layout: &self.layouts.hooks,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
                 resource: buffer.as_entire_binding(),
             }],
         });
+        let (dump, trace) = self
+            .pipelines
+            .hooks(&self.device, &self.layouts, r.accel, super::CUT_SHORT_SLOT);
+        let pipeline = if probe { trace } else { dump };
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         {
@@ -64,7 +69,8 @@ impl GpuBackend {
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
             cp.set_bind_group(1, &r.passes[0][0], &[]);
-            cp.set_bind_group(2, &hook, &[]);
+            cp.set_bind_group(2, &r.accel_group, &[]);
+            cp.set_bind_group(3, &hook, &[]);
             cp.dispatch_workgroups(groups, 1, 1);
         }
         self.submit(encoder, scope)
@@ -91,18 +97,18 @@ impl GpuBackend {
             pattern: crate::sampling::Pattern::PerPixel,
             seed,
         };
-        let mut packed = pack(&scene, view, sampling);
+        let mut packed = pack(&scene, view, sampling)?;
         packed.params.scheme = id;
         packed.params.height = pixel;
         let r = self.resources(&packed, View { height: 2, ..view }, 0);
-        self.run_hook(&self.dump, &r, &[], n.div_ceil(64))?;
+        self.run_hook(false, &r, &[], n.div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
         Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// Traces `rays` against the scene's mesh BVH with the WGSL closest-hit and any-hit
-    /// traversals, in the same local frame as a render: lets tests compare the GPU's traversal
-    /// with obvhs' and with brute force.
+    /// Traces `rays` against the scene's acceleration structure with its WGSL closest-hit and
+    /// any-hit queries, in the same local frame as a render: lets tests compare the GPU's
+    /// traversal with the CPU's and with brute force.
     pub fn probe(&mut self, scene: &crate::scene::Scene, rays: &[ProbeRay]) -> anyhow::Result<Vec<ProbeHit>> {
         let cam = scene.cameras.values().next().cloned().unwrap_or_else(dummy_camera);
         let view = View {
@@ -115,9 +121,10 @@ impl GpuBackend {
             pattern: crate::sampling::Pattern::PerPixel,
             seed: 0,
         };
-        let mut packed = pack(scene, view, sampling);
+        let mut packed = pack(scene, view, sampling)?;
         packed.params.width = rays.len() as u32;
-        let (origin, scale) = layout::local_frame(scene, view);
+        let frame = layout::local_frame(scene, view);
+        let (origin, scale) = (frame.origin, frame.scale);
         let probes: Vec<[f32; 4]> = rays
             .iter()
             .flat_map(|(o, d, tmax)| {
@@ -129,7 +136,7 @@ impl GpuBackend {
             })
             .collect();
         let r = self.resources(&packed, view, 3 * rays.len() as u64);
-        self.run_hook(&self.probe, &r, &probes, (rays.len() as u32).div_ceil(64))?;
+        self.run_hook(true, &r, &probes, (rays.len() as u32).div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
         Ok(raw
             .chunks(3)

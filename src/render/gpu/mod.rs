@@ -9,47 +9,30 @@
 mod hooks;
 mod layout;
 pub mod loop_cap;
+mod pipelines;
 mod resources;
 
 use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
-use crate::sampling::DiskScheme;
 use anyhow::{anyhow, bail, Context};
 use layout::{pack, HIT_BYTES};
+use pipelines::{Layouts, PipelineCache};
 use resources::{FrameResources, SceneBuffers};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 pub use hooks::{ProbeHit, ProbeRay};
+pub use pipelines::scheme_prelude;
 
 /// How long one frame may run before it is reported as a GPU timeout.
 pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
-
-const SHADER: &str = concat!(
-    include_str!("shaders/sampling.wgsl"),
-    include_str!("shaders/geometry.wgsl"),
-    include_str!("shaders/bvh.wgsl"),
-    include_str!("shaders/render.wgsl"),
-);
 
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; then the
 /// count of invocations whose loops were cut short.
 pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 1;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in bvh.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
-
-/// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`] and prepended
-/// to the shaders, so Rust and WGSL share one list.
-pub fn scheme_prelude() -> String {
-    DiskScheme::ALL
-        .iter()
-        .map(|s| {
-            let name = s.name().to_uppercase().replace('-', "_");
-            format!("const SCHEME_{name}: u32 = {}u;\n", s.gpu_id())
-        })
-        .collect()
-}
 
 /// What to install when no adapter is found, for the error message.
 pub const NO_ADAPTER_HELP: &str = "no GPU adapter found; on Debian install the software Vulkan driver with \
@@ -62,16 +45,9 @@ pub struct GpuBackend {
     info: AdapterInfo,
     timestamps: bool,
     lost: Arc<AtomicBool>,
-    layout0: wgpu::BindGroupLayout,
-    layout1: wgpu::BindGroupLayout,
-    /// The test hooks' own group (probe rays), outside the render layout.
-    hook_layout: wgpu::BindGroupLayout,
-    /// The plan's passes, compiled with (`[1]`) and without (`[0]`) mesh traversal: a scene
-    /// without meshes runs shaders in which the BVH walks are constant-folded away.
-    primary: [wgpu::ComputePipeline; 2],
-    shadow: [wgpu::ComputePipeline; 2],
-    dump: wgpu::ComputePipeline,
-    probe: wgpu::ComputePipeline,
+    layouts: Layouts,
+    /// The plan's passes compiled per acceleration structure, on first use.
+    pipelines: PipelineCache,
     /// Iterations after which the adapter leaves a loop, if it caps them ([`loop_cap`]).
     loop_cap: Option<u32>,
     /// The resident static scene data.
@@ -120,83 +96,7 @@ impl GpuBackend {
         device.set_device_lost_callback(move |_, _| flag.store(true, Ordering::SeqCst));
         device.on_uncaptured_error(Arc::new(|e: wgpu::Error| tracing::error!("uncaptured GPU error: {e}")));
         let loop_cap = loop_cap::detect(&device, &queue).context("probing the adapter's loop limits")?;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("render.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                format!(
-                    "{}const CUT_SHORT_SLOT: u32 = {CUT_SHORT_SLOT}u;\n{SHADER}",
-                    scheme_prelude()
-                )
-                .into(),
-            ),
-        });
-        let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let uniform = |binding: u32| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let mut entries = vec![uniform(0)];
-        entries.extend((1..=4).map(|b| storage(b, true)));
-        entries.extend((5..=8).map(|b| storage(b, false)));
-        entries.extend((9..=10).map(|b| storage(b, true)));
-        let layout0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &entries,
-        });
-        let layout1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pass"),
-            entries: &[uniform(0)],
-        });
-        let hook_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("test hooks"),
-            entries: &[storage(0, true)],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("render"),
-            bind_group_layouts: &[Some(&layout0), Some(&layout1)],
-            immediate_size: 0,
-        });
-        let hooks_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("test hooks"),
-            bind_group_layouts: &[Some(&layout0), Some(&layout1), Some(&hook_layout)],
-            immediate_size: 0,
-        });
-        let compile = |entry: &str, meshes: bool, layout: &wgpu::PipelineLayout| {
-            let constants = [("MESHES", if meshes { 1.0 } else { 0.0 })];
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
-                cache: None,
-            })
-        };
-        let variant = |entry: &str, meshes: bool| compile(entry, meshes, &pipeline_layout);
-        let (primary, shadow, dump, probe) = (
-            [variant("primary", false), variant("primary", true)],
-            [variant("shadow", false), variant("shadow", true)],
-            compile("dump_samples", true, &hooks_layout),
-            compile("trace_probes", true, &hooks_layout),
-        );
+        let layouts = Layouts::new(&device);
         let info = AdapterInfo {
             backend: "gpu".into(),
             name: ai.name.clone(),
@@ -210,13 +110,8 @@ impl GpuBackend {
             info,
             timestamps,
             lost,
-            layout0,
-            layout1,
-            hook_layout,
-            primary,
-            shadow,
-            dump,
-            probe,
+            layouts,
+            pipelines: PipelineCache::default(),
             loop_cap,
             scene: None,
             static_uploads: 0,
@@ -240,47 +135,35 @@ impl GpuBackend {
         self.static_uploads
     }
 
-    /// Compute dispatches recorded so far, every pass of every frame: what a test counts against
-    /// the plan.
-    pub fn dispatches(&self) -> u64 {
-        self.dispatches.get()
-    }
-
     /// What the capped chunk over the resident scene is divided by: doubled each time a frame
     /// came back cut short (1: never).
     pub fn chunk_divisor(&self) -> u32 {
         self.scene.as_ref().map_or(1, |s| s.chunk_divisor)
     }
 
-    fn check_limits(&self, scene: &crate::scene::Scene, view: View) -> anyhow::Result<()> {
-        let lights = scene.lights.len();
-        if let Some(b) = scene.bvh.as_ref().filter(|b| b.depth > 2 * 31) {
-            bail!(
-                "the BVH is {} levels deep; the GPU traversal stack holds 64 entries (depth 62 at most)",
-                b.depth
-            );
-        }
+    /// Checks every buffer a frame needs against the adapter's binding and buffer limits, naming
+    /// the buffer and the excess.
+    fn check_limits(&self, packed: &layout::Packed, view: View) -> anyhow::Result<()> {
         let limits = self.device.limits();
         let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        let (nodes, triangles) = scene
-            .bvh
-            .as_ref()
-            .map_or((0, 0), |b| (b.node_count(), b.tree.primitive_indices.len()));
-        for (what, bytes) in [
+        let mut buffers = vec![
             ("hit buffer", view.pixels() as u64 * HIT_BYTES),
-            ("visibility buffer", (view.pixels() * lights.max(1)) as u64 * 4),
             (
-                "BVH node buffer",
-                (nodes * std::mem::size_of::<layout::GpuNode>()) as u64,
+                "visibility buffer",
+                (view.pixels() * packed.lights.len().max(1)) as u64 * 4,
             ),
             (
-                "triangle buffer",
-                (triangles * std::mem::size_of::<layout::GpuTri>()) as u64,
+                "mesh triangle buffer",
+                std::mem::size_of_val(packed.mesh_tris.as_slice()) as u64,
             ),
-        ] {
+        ];
+        if let Some((_, s)) = &packed.accel {
+            buffers.extend(s.buffers.iter().map(|(label, b)| (*label, b.len() as u64)));
+        }
+        for (what, bytes) in buffers {
             if bytes > max {
                 bail!(
-                    "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
+                    "a {}x{} frame of this scene needs a {what} buffer of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
                     view.width,
                     view.height,
                     bytes - max
@@ -293,7 +176,8 @@ impl GpuBackend {
     /// Records the plan's passes into `encoder`, in the plan's order: the primary pass, and for
     /// each shadow pass one dispatch per sample chunk of its light. Nothing outside the plan is
     /// dispatched.
-    fn encode(&self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, plan: &RenderPlan) {
+    fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, r: &FrameResources, view: View, plan: &RenderPlan) {
+        let p = self.pipelines.get(&self.device, &self.layouts, r.accel, CUT_SHORT_SLOT);
         encoder.clear_buffer(&r.counters, 0, None);
         encoder.clear_buffer(&r.visibility, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
@@ -308,12 +192,13 @@ impl GpuBackend {
                 timestamp_writes,
             });
             // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
-            let (pipelines, chunks) = match pass {
-                Pass::Primary { .. } => (&self.primary, &r.passes[0][..1]),
-                Pass::Shadow { light, .. } => (&self.shadow, &r.passes[*light][..]),
+            let (pipeline, chunks) = match pass {
+                Pass::Primary { .. } => (&p.primary, &r.passes[0][..1]),
+                Pass::Shadow { light, .. } => (&p.shadow, &r.passes[*light][..]),
             };
-            cp.set_pipeline(&pipelines[r.meshes as usize]);
+            cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
+            cp.set_bind_group(2, &r.accel_group, &[]);
             for chunk in chunks {
                 cp.set_bind_group(1, chunk, &[]);
                 cp.dispatch_workgroups(groups.0, groups.1, 1);
@@ -425,10 +310,14 @@ impl Backend for GpuBackend {
         &self.info
     }
 
+    fn dispatches(&self) -> u64 {
+        self.dispatches.get()
+    }
+
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         let plan = RenderPlan::new(scene, view)?;
-        self.check_limits(scene, view)?;
-        let packed = pack(scene, view, sampling);
+        let packed = pack(scene, view, sampling)?;
+        self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
         let (r, counters) = loop {
             let r = self.resources(&packed, view, 0);
@@ -475,8 +364,8 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
-        self.check_limits(scene, view)?;
-        let packed = pack(scene, view, sampling);
+        let packed = pack(scene, view, sampling)?;
+        self.check_limits(&packed, view)?;
         loop {
             let r = self.resources(&packed, view, 0);
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;
@@ -490,7 +379,7 @@ impl Backend for GpuBackend {
 impl GpuBackend {
     /// `warmup` untimed and `repeats` timed frames over the same resources.
     fn time_frames(
-        &self,
+        &mut self,
         r: &FrameResources,
         view: View,
         plan: &RenderPlan,

@@ -1,12 +1,13 @@
 //! GPU resources split as wgpu's examples split them: the scene's static data (spheres, planes,
-//! BVH nodes, triangles) is uploaded once and stays resident while its packed content is
+//! mesh triangles, the acceleration structure's buffers) is uploaded once and stays resident while its packed content is
 //! unchanged; per-frame data (parameters, lights, shared sample points, pass infos, outputs,
 //! timestamp queries) is made for each call. Timed repeats and warm-up frames of one call run
 //! over the same resources, and successive calls on one scene upload no geometry.
 
 use super::layout::{GpuLight, Packed, PassInfo, HIT_BYTES};
+use super::pipelines::NO_ACCEL;
 use super::GpuBackend;
-use super::COUNTER_WORDS;
+use super::{COUNTER_WORDS, CUT_SHORT_SLOT};
 use crate::fingerprint::fnv1a;
 use crate::render::View;
 use bytemuck::{Pod, Zeroable};
@@ -20,8 +21,10 @@ pub(super) struct SceneBuffers {
     pub chunk_divisor: u32,
     spheres: wgpu::Buffer,
     planes: wgpu::Buffer,
-    nodes: wgpu::Buffer,
-    triangles: wgpu::Buffer,
+    mesh_tris: wgpu::Buffer,
+    /// The acceleration structure's name and its buffers' bind group (group 2).
+    accel: &'static str,
+    accel_group: wgpu::BindGroup,
 }
 
 /// Per-frame GPU resources.
@@ -34,19 +37,24 @@ pub(super) struct FrameResources {
     pub radiance: wgpu::Buffer,
     pub counters: wgpu::Buffer,
     pub queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    /// Whether the scene has meshes (selects the pipeline variant).
-    pub meshes: bool,
+    /// The acceleration structure (selects the pipelines) and its bind group.
+    pub accel: &'static str,
+    pub accel_group: wgpu::BindGroup,
 }
 
 /// Hash of the packed static data: equal hashes mean the resident buffers can be reused.
 fn static_key(p: &Packed) -> u64 {
     let mut bytes: Vec<u8> = Vec::new();
-    for (len, data) in [
+    let mut parts = vec![
         (p.spheres.len(), bytemuck::cast_slice::<_, u8>(&p.spheres)),
         (p.planes.len(), bytemuck::cast_slice(&p.planes)),
-        (p.nodes.len(), bytemuck::cast_slice(&p.nodes)),
-        (p.triangles.len(), bytemuck::cast_slice(&p.triangles)),
-    ] {
+        (p.mesh_tris.len(), bytemuck::cast_slice(&p.mesh_tris)),
+    ];
+    if let Some((name, s)) = &p.accel {
+        parts.push((0, name.as_bytes()));
+        parts.extend(s.buffers.iter().map(|(_, b)| (b.len(), b.as_slice())));
+    }
+    for (len, data) in parts {
         bytes.extend_from_slice(&(len as u64).to_le_bytes());
         bytes.extend_from_slice(&fnv1a(data).to_le_bytes());
     }
@@ -79,13 +87,38 @@ impl GpuBackend {
         let key = static_key(packed);
         if self.scene.as_ref().is_none_or(|s| s.key != key) {
             self.static_uploads += 1;
+            let accel = packed.accel.as_ref().map_or(NO_ACCEL, |(name, _)| *name);
+            let buffers: Vec<wgpu::Buffer> = packed
+                .accel
+                .iter()
+                .flat_map(|(_, s)| &s.buffers)
+                .map(|(label, bytes)| self.storage(label, bytes, 0u8))
+                .collect();
+            let layout = &self
+                .pipelines
+                .get(&self.device, &self.layouts, accel, CUT_SHORT_SLOT)
+                .accel;
+            let entries: Vec<_> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            let accel_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(accel),
+                layout,
+                entries: &entries,
+            });
             self.scene = Some(SceneBuffers {
                 key,
                 chunk_divisor: 1,
                 spheres: self.storage("spheres", &packed.spheres, Zeroable::zeroed()),
                 planes: self.storage("planes", &packed.planes, Zeroable::zeroed()),
-                nodes: self.storage("bvh nodes", &packed.nodes, Zeroable::zeroed()),
-                triangles: self.storage("triangles", &packed.triangles, Zeroable::zeroed()),
+                mesh_tris: self.storage("mesh triangles", &packed.mesh_tris, Zeroable::zeroed()),
+                accel,
+                accel_group,
             });
         }
         self.scene.as_ref().expect("just set")
@@ -121,8 +154,7 @@ impl GpuBackend {
             &visibility,
             &radiance,
             &counters,
-            &s.nodes,
-            &s.triangles,
+            &s.mesh_tris,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -134,7 +166,7 @@ impl GpuBackend {
             .collect();
         let bind0 = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame"),
-            layout: &self.layout0,
+            layout: &self.layouts.frame,
             entries: &entries,
         });
         let chunk = self.samples_per_dispatch(packed);
@@ -176,7 +208,8 @@ impl GpuBackend {
             radiance,
             counters,
             queries,
-            meshes: !packed.nodes.is_empty(),
+            accel: s.accel,
+            accel_group: s.accel_group.clone(),
         }
     }
 
@@ -194,7 +227,7 @@ impl GpuBackend {
         });
         self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pass"),
-            layout: &self.layout1,
+            layout: &self.layouts.pass,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
                 resource: buffer.as_entire_binding(),
@@ -219,19 +252,11 @@ impl GpuBackend {
 /// generators in sampling.wgsl (isqrt's two digit loops, at most 16 each; the strata search,
 /// at most sqrt(n) ≤ 64 for n ≤ 4096; Sobol's bit loop, at most 32), with room to spare.
 const SAMPLE_POINT_ITERATIONS: u32 = 192;
-/// Loop iterations budgeted for one any-hit BVH walk (node pops plus leaf triangles). obvhs's
-/// SAH trees over the shipped meshes stay in the low hundreds; grazing rays pay more.
-const BVH_WALK_ITERATIONS: u32 = 1536;
-
 /// Upper bound on the loop iterations of one shadow sample in render.wgsl: the sample loop's own
-/// step, the point generator, one test per sphere and per plane, and a BVH walk when the scene
-/// has meshes.
+/// step, the point generator, one test per sphere and per plane, and the acceleration
+/// structure's own budget for one any-hit query when the scene has triangles.
 pub(super) fn shadow_sample_iterations(packed: &Packed) -> u32 {
-    let walk = if packed.nodes.is_empty() {
-        0
-    } else {
-        BVH_WALK_ITERATIONS
-    };
+    let walk = packed.accel.as_ref().map_or(0, |(_, s)| s.walk_iterations);
     1 + SAMPLE_POINT_ITERATIONS + packed.spheres.len() as u32 + packed.planes.len() as u32 + walk
 }
 

@@ -1,6 +1,8 @@
 // The render plan's passes: `primary` (camera rays, closest hit) and `shadow` (per light, one
-// dispatch per chunk of its samples, any-hit with early exit). Mirrors src/render/cpu.rs and src/render/shading.rs in f32,
-// in coordinates re-based on the camera's look-at point so that large translations cost nothing.
+// dispatch per chunk of its samples, any-hit with early exit). Mirrors src/render/cpu.rs and
+// src/render/shading.rs in f32, in coordinates re-based on the camera's look-at point so that
+// large translations cost nothing. Shapes' structs and tests come from src/scene/shape/*.wgsl,
+// mesh queries from the scene's acceleration structure (accel_closest, accel_any).
 
 struct Params {
     width: u32,
@@ -18,27 +20,11 @@ struct Params {
     cam_up: vec3<f32>,
     half_y: f32,
     cam_forward: vec3<f32>,
-    node_count: u32,
-    object_base: u32,
+    triangle_count: u32,
     _q0: u32,
     _q1: u32,
     _q2: u32,
-}
-
-struct Sphere {
-    center: vec3<f32>,
-    radius: f32,
-    albedo: f32,
-    _p0: f32,
-    _p1: f32,
-    _p2: f32,
-}
-
-struct Plane {
-    point: vec3<f32>,
-    albedo: f32,
-    normal: vec3<f32>,
-    _pad: f32,
+    _q3: u32,
 }
 
 struct Light {
@@ -67,6 +53,12 @@ struct Hit {
     _h2: u32,
 }
 
+// What an acceleration structure's query returns (src/accel/mod.rs).
+struct AccelHit {
+    t: f32,
+    triangle: u32,
+}
+
 struct PassInfo {
     light: u32,
     first_sample: u32,
@@ -75,6 +67,11 @@ struct PassInfo {
 }
 
 const LIGHT_POINT: u32 = 0u;
+
+// Set when a loop ended before its own exit condition held (an adapter's loop-iteration cap) or
+// a traversal dropped work because its stack was full: the invocation's answer is not to be
+// trusted, and the kernel reports it in `counters[CUT_SHORT_SLOT]`.
+var<private> cut_short: bool = false;
 const NO_RECEIVER: f32 = -1.0;
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -86,15 +83,8 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(6) var<storage, read_write> visibility: array<f32>;
 @group(0) @binding(7) var<storage, read_write> radiance: array<f32>;
 @group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read> mesh_tris: array<MeshTri>;
 @group(1) @binding(0) var<uniform> pass_info: PassInfo;
-
-fn plane_t(origin: vec3<f32>, dir: vec3<f32>, pl: Plane) -> f32 {
-    let denom = dot(dir, pl.normal);
-    if (denom == 0.0) {
-        return -1.0;
-    }
-    return dot(pl.point - origin, pl.normal) / denom;
-}
 
 // Any-hit along origin -> origin + d, skipping the receiver's own sphere or plane (`skip`) or
 // triangle (`skip_tri`); see shading::Receiver for why.
@@ -104,19 +94,19 @@ fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
     var i = 0u;
     for (; i < params.sphere_count; i++) {
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
-        if (i != skip && r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
+        if (spheres[i].object != skip && r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
             return true;
         }
     }
     var j = 0u;
     for (; j < params.plane_count; j++) {
         let t = plane_t(origin, dir, planes[j]);
-        if (params.sphere_count + j != skip && t > 0.0 && t < len) {
+        if (planes[j].object != skip && t > 0.0 && t < len) {
             return true;
         }
     }
     cut_short = cut_short || i < params.sphere_count || j < params.plane_count;
-    return bvh_any(origin, dir, len, skip_tri);
+    return accel_any(origin, dir, len, skip_tri);
 }
 
 @compute @workgroup_size(8, 8)
@@ -134,6 +124,8 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else {
         dir = normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
     }
+    // Analytic shapes by kind (the first of equal distances wins), then the accelerator within
+    // the distance found; `best` indexes spheres, then planes.
     var best_t = 3.4e38;
     var best = NO_HIT;
     for (var i = 0u; i < params.sphere_count; i++) {
@@ -151,21 +143,18 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
             best = params.sphere_count + i;
         }
     }
-    let mesh_hit = bvh_closest(origin, dir, best_t, NO_HIT);
-    if (mesh_hit.slot != NO_HIT) {
-        best_t = mesh_hit.t;
-        best = params.object_base + tris[mesh_hit.slot].mesh;
-    }
+    let mesh_hit = accel_closest(origin, dir, best_t, NO_HIT);
     radiance[pixel] = 0.0;
     var hit: Hit;
-    hit.object = best;
+    hit.object = NO_HIT;
     hit.triangle = NO_HIT;
-    if (mesh_hit.slot != NO_HIT) {
-        let tri = tris[mesh_hit.slot];
-        hit.position = origin + best_t * dir;
+    if (mesh_hit.triangle != NO_HIT) {
+        let tri = mesh_tris[mesh_hit.triangle];
+        hit.object = tri.object;
+        hit.position = origin + mesh_hit.t * dir;
         hit.normal = normalize(cross(tri.e1, tri.e2));
         hit.albedo = tri.albedo;
-        hit.triangle = tri.index;
+        hit.triangle = mesh_hit.triangle;
         if (dot(hit.normal, dir) > 0.0) {
             hit.normal = -hit.normal;
         }
@@ -174,11 +163,13 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (best < params.sphere_count) {
             let s = spheres[best];
             let n = normalize(raw - s.center);
+            hit.object = s.object;
             hit.position = s.center + n * s.radius;
             hit.normal = n;
             hit.albedo = s.albedo;
         } else {
             let pl = planes[best - params.sphere_count];
+            hit.object = pl.object;
             hit.position = raw - pl.normal * dot(raw - pl.point, pl.normal);
             hit.normal = pl.normal;
             hit.albedo = pl.albedo;
@@ -272,42 +263,4 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (cut_short) {
         atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
     }
-}
-
-// Test hook: the unit-disk points a scheme gives pixel `seed`'s stream, for the CPU/GPU
-// sampler agreement test. Writes params.width points into `shared_points`' twin `visibility`.
-@compute @workgroup_size(64)
-fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
-    if (k >= params.width) {
-        return;
-    }
-    let stream = stream_pixel(params.seed, 0u, params.height);
-    let s = disk_point(params.scheme, params.width, k, stream);
-    visibility[2u * k] = s.x;
-    visibility[2u * k + 1u] = s.y;
-}
-
-// Test hook: closest and any hit of probe rays against the mesh BVH. Ray k is
-// probe_rays[2k] = (origin, tmax) and probe_rays[2k + 1] = (direction, 0); writes
-// visibility[3k..3k+3] = (t, triangle index as bits, any-hit flag).
-@group(2) @binding(0) var<storage, read> probe_rays: array<vec4<f32>>;
-
-@compute @workgroup_size(64)
-fn trace_probes(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let k = gid.x;
-    if (k >= params.width) {
-        return;
-    }
-    let o = probe_rays[2u * k].xyz;
-    let tmax = probe_rays[2u * k].w;
-    let d = probe_rays[2u * k + 1u].xyz;
-    let h = bvh_closest(o, d, tmax, NO_HIT);
-    var index = NO_HIT;
-    if (h.slot != NO_HIT) {
-        index = tris[h.slot].index;
-    }
-    visibility[3u * k] = select(-1.0, h.t, h.slot != NO_HIT);
-    visibility[3u * k + 1u] = bitcast<f32>(index);
-    visibility[3u * k + 2u] = select(0.0, 1.0, bvh_any(o, d, tmax, NO_HIT));
 }

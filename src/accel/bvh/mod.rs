@@ -1,11 +1,15 @@
 //! A BVH2 over a scene's triangles, built by obvhs (PLOC with parallel reinsertion), traversed
-//! by obvhs on the CPU and by `shaders/bvh.wgsl` on the GPU from the same node array.
+//! by obvhs on the CPU and by `traverse.wgsl` on the GPU from the same node array ([`gpu`]).
 //!
 //! Triangles keep full f32 positions for the GPU and f64 for the CPU's intersection tests:
 //! obvhs' compressed triangle stores edges in f16, which would move shadow boundaries, so it is
 //! not used. The tree is built in coordinates relative to the triangles' bounding-box centre so
 //! its f32 bounds stay precise wherever the mesh is placed.
 
+mod gpu;
+
+use super::{intersect, Accelerator, BuildStats, GpuStructure, TriHit};
+use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
 use glam::{DVec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
@@ -80,8 +84,6 @@ pub struct Bvh {
     pub local: Vec<Triangle>,
     /// Triangles in f64 world space, in input order.
     pub world: Vec<[DVec3; 3]>,
-    /// Mesh index per triangle.
-    pub mesh_of: Vec<u32>,
     /// Origin of the tree's coordinates.
     pub centre: DVec3,
     /// The preset used.
@@ -94,36 +96,8 @@ pub struct Bvh {
     pub depth: usize,
 }
 
-/// A closest hit: distance along the (unit) ray and the triangle's index.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TriHit {
-    /// Distance.
-    pub t: f64,
-    /// Triangle index (input order).
-    pub triangle: u32,
-}
-
-/// Möller-Trumbore ray-triangle intersection in f64; the distance, or None. Both sides hit.
-pub fn intersect(origin: DVec3, dir: DVec3, tri: &[DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (tri[1] - tri[0], tri[2] - tri[0]);
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    if det == 0.0 {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = origin - tri[0];
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(e1);
-    let v = dir.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    Some(e2.dot(q) * inv)
-}
+/// The BVH's WGSL: `accel_closest` and `accel_any` over its node and triangle buffers.
+pub const WGSL: &str = include_str!("traverse.wgsl");
 
 fn depth(tree: &Bvh2) -> usize {
     let mut deepest = 0;
@@ -167,7 +141,6 @@ impl Bvh {
             tree,
             local,
             world: triangles.positions.clone(),
-            mesh_of: triangles.mesh_of.clone(),
             centre,
             preset,
             build_time,
@@ -219,28 +192,71 @@ impl Bvh {
         })
     }
 
-    /// Closest hit by testing every triangle: the brute-force reference for tests.
-    pub fn brute_force(&self, origin: DVec3, dir: DVec3) -> Option<TriHit> {
-        self.world
-            .iter()
-            .enumerate()
-            .filter_map(|(i, t)| {
-                intersect(origin, dir, t)
-                    .filter(|t| *t > 0.0)
-                    .map(|t| TriHit { t, triangle: i as u32 })
-            })
-            .min_by(|a, b| a.t.total_cmp(&b.t))
-    }
-
     /// Number of nodes.
     pub fn node_count(&self) -> usize {
         self.tree.nodes.len()
+    }
+
+    /// Bytes of the GPU form: 32-byte nodes and 48-byte full-f32 triangles in leaf order.
+    pub fn gpu_bytes(&self) -> u64 {
+        (self.node_count() * std::mem::size_of::<gpu::GpuNode>()
+            + self.tree.primitive_indices.len() * std::mem::size_of::<gpu::GpuTri>()) as u64
+    }
+}
+
+impl Accelerator for Bvh {
+    fn name(&self) -> &'static str {
+        "bvh"
+    }
+
+    fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        Bvh::closest(self, origin, dir, tmax, skip)
+    }
+
+    fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        Bvh::any_hit(self, origin, dir, tmax, skip)
+    }
+
+    fn stats(&self) -> BuildStats {
+        let bytes = self.gpu_bytes();
+        BuildStats {
+            parameters: self.preset.name().to_string(),
+            build_time: self.total_time,
+            gpu_bytes: bytes,
+            triangles: self.world.len(),
+            description: format!(
+                "BVH2 (obvhs, preset `{}`): {} nodes, depth {}, built in {:.1} ms ({:.1} ms core); {:.1} GPU bytes per triangle (32-byte nodes, 48-byte full-f32 triangles)",
+                self.preset.name(),
+                self.node_count(),
+                self.depth,
+                self.total_time.as_secs_f64() * 1e3,
+                self.build_time.as_secs_f64() * 1e3,
+                bytes as f64 / self.world.len() as f64
+            ),
+        }
+    }
+
+    fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
+        gpu::structure(self, frame)
+    }
+}
+
+impl std::fmt::Debug for Bvh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Bvh({} triangles, {} nodes, {})",
+            self.world.len(),
+            self.node_count(),
+            self.preset.name()
+        )
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::brute_force;
 
     /// A closed box of 12 triangles with a pyramid on top, plus triangles with a corner at the
     /// origin and edges on the axes (the cases obvhs' own comment flags as leaky).
@@ -263,7 +279,7 @@ mod tests {
         let n = positions.len();
         Triangles {
             positions,
-            mesh_of: vec![0; n],
+            object_of: vec![0; n],
         }
     }
 
@@ -282,7 +298,7 @@ mod tests {
                 let o = DVec3::new(next() * 6.0 - 3.0, next() * 6.0 - 3.0, next() * 6.0 - 2.0);
                 let target = DVec3::new(next() * 1.4 - 0.2, next() * 1.4 - 0.2, next() * 2.4 - 0.2);
                 let d = (target - o).normalize();
-                let (a, b) = (bvh.closest(o, d, f64::INFINITY, u32::MAX), bvh.brute_force(o, d));
+                let (a, b) = (bvh.closest(o, d, f64::INFINITY, u32::MAX), brute_force(&tris, o, d));
                 assert_eq!(a.map(|h| h.triangle), b.map(|h| h.triangle), "{preset:?} o={o} d={d}");
                 if let (Some(a), Some(b)) = (a, b) {
                     assert!((a.t - b.t).abs() < 1e-12);

@@ -1,6 +1,7 @@
 // BVH2 traversal over full-f32 triangles: closest hit for camera rays, any hit with early exit
 // for shadow rays. The node array is obvhs' (children of an inner node are adjacent); leaves
-// index the triangle array directly (laid out in leaf order). Twin of src/accel/bvh.rs.
+// index the triangle array directly (laid out in leaf order). Twin of mod.rs beside it; the
+// interface (accel_closest, accel_any) is the accelerator seam's (src/accel/mod.rs).
 
 struct Node {
     min: vec3<f32>,
@@ -11,11 +12,11 @@ struct Node {
 
 struct Tri {
     v0: vec3<f32>,
-    mesh: u32,
+    _p0: u32,
     e1: vec3<f32>,
     index: u32,
     e2: vec3<f32>,
-    albedo: f32,
+    _p1: u32,
 }
 
 struct MeshHit {
@@ -25,8 +26,6 @@ struct MeshHit {
 
 const STACK_SIZE: u32 = 64u;
 
-// Pipeline constant: false compiles the walks away for scenes without meshes.
-override MESHES: bool = true;
 const BIG: f32 = 3.4e38;
 
 // One traversal stack per invocation, shared by both walks (never live at once). Module scope,
@@ -34,13 +33,8 @@ const BIG: f32 = 3.4e38;
 // array is cleared on each call, which tripled the cost of analytic-only shadow rays on lavapipe.
 var<private> stack: array<u32, STACK_SIZE>;
 
-// Set when a loop ended before its own exit condition held (an adapter's loop-iteration cap) or
-// a walk dropped children because its stack was full: the invocation's answer is not to be
-// trusted, and the kernel reports it in `counters[CUT_SHORT_SLOT]`.
-var<private> cut_short: bool = false;
-
-@group(0) @binding(9) var<storage, read> nodes: array<Node>;
-@group(0) @binding(10) var<storage, read> tris: array<Tri>;
+@group(2) @binding(0) var<storage, read> nodes: array<Node>;
+@group(2) @binding(1) var<storage, read> tris: array<Tri>;
 
 // Moller-Trumbore; the distance, or -1 on a miss. Both sides hit.
 fn tri_t(o: vec3<f32>, d: vec3<f32>, tri: Tri) -> f32 {
@@ -78,11 +72,16 @@ fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
 }
 
 // Closest triangle with 0 < t < tmax, skipping the triangle whose `index` is `skip`.
+fn accel_closest(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> AccelHit {
+    let h = bvh_closest(o, d, tmax, skip);
+    if (h.slot == NO_HIT) {
+        return AccelHit(h.t, NO_HIT);
+    }
+    return AccelHit(h.t, tris[h.slot].index);
+}
+
 fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
     var best = MeshHit(tmax_in, NO_HIT);
-    if (!MESHES || params.node_count == 0u) {
-        return best;
-    }
     let inv_d = safe_inverse(d);
     var sp = 1u;
     stack[0] = 0u;
@@ -118,10 +117,7 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
 // Whether any triangle other than `skip` is hit with 0 < t < tmax; stops at the first. (Written
 // with a flag and structured exits rather than a return from inside the loops: lavapipe
 // miscompiled the early return under divergence, dropping whole workgroups' shadow rays.)
-fn bvh_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
-    if (!MESHES || params.node_count == 0u) {
-        return false;
-    }
+fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     let inv_d = safe_inverse(d);
     var sp = 1u;
     stack[0] = 0u;

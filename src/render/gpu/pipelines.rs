@@ -1,0 +1,202 @@
+//! The render layout and the pipelines compiled per acceleration structure: the shapes' and the
+//! renderer's WGSL with one structure's module appended, whose buffers bind at group 2. A scene
+//! without triangles gets `shaders/no_accel.wgsl`, so its kernels hold no mesh traversal.
+
+use crate::accel;
+use crate::sampling::DiskScheme;
+use std::collections::HashMap;
+
+/// The renderer's WGSL without an acceleration structure.
+const RENDER: &str = concat!(
+    include_str!("shaders/sampling.wgsl"),
+    include_str!("shaders/geometry.wgsl"),
+    include_str!("../../scene/shape/sphere.wgsl"),
+    include_str!("../../scene/shape/plane.wgsl"),
+    include_str!("../../scene/shape/mesh.wgsl"),
+    include_str!("shaders/render.wgsl"),
+);
+
+/// Name of the structure-less module (no triangles in the scene).
+pub const NO_ACCEL: &str = "none";
+
+/// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`] and prepended
+/// to the shaders, so Rust and WGSL share one list.
+pub fn scheme_prelude() -> String {
+    DiskScheme::ALL
+        .iter()
+        .map(|s| {
+            let name = s.name().to_uppercase().replace('-', "_");
+            format!("const SCHEME_{name}: u32 = {}u;\n", s.gpu_id())
+        })
+        .collect()
+}
+
+/// The bind group layouts every pipeline shares: per frame (group 0), per dispatch (group 1),
+/// and the test hooks' own (group 3), which no render pipeline includes.
+pub(super) struct Layouts {
+    pub frame: wgpu::BindGroupLayout,
+    pub pass: wgpu::BindGroupLayout,
+    pub hooks: wgpu::BindGroupLayout,
+}
+
+/// One structure's pipelines.
+pub(super) struct Pipelines {
+    /// Its buffers' layout (group 2).
+    pub accel: wgpu::BindGroupLayout,
+    pub primary: wgpu::ComputePipeline,
+    pub shadow: wgpu::ComputePipeline,
+    hooks: Option<(wgpu::ComputePipeline, wgpu::ComputePipeline)>,
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl Layouts {
+    pub fn new(device: &wgpu::Device) -> Layouts {
+        // params; spheres, planes, lights, shared points; hits, visibility, radiance, counters;
+        // mesh triangles.
+        let mut entries = vec![uniform(0)];
+        entries.extend((1..=4).map(|b| storage(b, true)));
+        entries.extend((5..=8).map(|b| storage(b, false)));
+        entries.push(storage(9, true));
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        Layouts {
+            frame: layout("frame", &entries),
+            pass: layout("pass", &[uniform(0)]),
+            hooks: layout("test hooks", &[storage(0, true)]),
+        }
+    }
+}
+
+/// Pipelines by structure name, compiled on first use.
+#[derive(Default)]
+pub(super) struct PipelineCache {
+    by_name: HashMap<&'static str, Pipelines>,
+}
+
+impl PipelineCache {
+    /// The pipelines of structure `name` ([`NO_ACCEL`] or a registry name).
+    pub fn get(
+        &mut self,
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        name: &'static str,
+        cut_short_slot: usize,
+    ) -> &Pipelines {
+        self.by_name
+            .entry(name)
+            .or_insert_with(|| compile(device, layouts, name, cut_short_slot))
+    }
+
+    /// The test-hook kernels (`dump_samples`, `trace_probes`) of structure `name`, compiled on
+    /// first use so that rendering never builds them.
+    pub fn hooks(
+        &mut self,
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        name: &'static str,
+        cut_short_slot: usize,
+    ) -> &(wgpu::ComputePipeline, wgpu::ComputePipeline) {
+        let p = self
+            .by_name
+            .entry(name)
+            .or_insert_with(|| compile(device, layouts, name, cut_short_slot));
+        if p.hooks.is_none() {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("test hooks"),
+                bind_group_layouts: &[
+                    Some(&layouts.frame),
+                    Some(&layouts.pass),
+                    Some(&p.accel),
+                    Some(&layouts.hooks),
+                ],
+                immediate_size: 0,
+            });
+            let module = module(device, name, cut_short_slot, include_str!("shaders/hooks.wgsl"));
+            let dump = entry(device, &module, "dump_samples", &layout);
+            let probe = entry(device, &module, "trace_probes", &layout);
+            p.hooks = Some((dump, probe));
+        }
+        p.hooks.as_ref().expect("just compiled")
+    }
+}
+
+fn entry(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    name: &str,
+    layout: &wgpu::PipelineLayout,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(name),
+        layout: Some(layout),
+        module,
+        entry_point: Some(name),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// The renderer's module with structure `name`'s WGSL, and `extra` (the hooks) appended.
+fn module(device: &wgpu::Device, name: &'static str, cut_short_slot: usize, extra: &str) -> wgpu::ShaderModule {
+    let wgsl = accel::registered(name).map_or(include_str!("shaders/no_accel.wgsl"), |r| r.wgsl);
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(
+            format!(
+                "{}const CUT_SHORT_SLOT: u32 = {cut_short_slot}u;\n{RENDER}{wgsl}{extra}",
+                scheme_prelude()
+            )
+            .into(),
+        ),
+    })
+}
+
+fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_short_slot: usize) -> Pipelines {
+    let buffers = accel::registered(name).map_or(0, |r| r.gpu_buffers);
+    let module = module(device, name, cut_short_slot, "");
+    let entries: Vec<_> = (0..buffers).map(|b| storage(b, true)).collect();
+    let accel = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(name),
+        entries: &entries,
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("render"),
+        bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.pass), Some(&accel)],
+        immediate_size: 0,
+    });
+    Pipelines {
+        primary: entry(device, &module, "primary", &layout),
+        shadow: entry(device, &module, "shadow", &layout),
+        accel,
+        hooks: None,
+    }
+}
