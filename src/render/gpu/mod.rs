@@ -11,16 +11,17 @@ mod layout;
 pub mod loop_cap;
 mod pipelines;
 mod resources;
+mod timing;
 
 use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
-use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View};
+use super::{AdapterInfo, Backend, Frame, RayCounts, Sampling, Timing, View};
 use anyhow::{anyhow, bail, Context};
 use layout::{pack, HIT_BYTES};
 use pipelines::{Layouts, PipelineCache};
 use resources::{FrameResources, SceneBuffers};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 pub use hooks::{ProbeHit, ProbeRay};
 pub use pipelines::scheme_prelude;
@@ -283,26 +284,6 @@ impl GpuBackend {
             ),
         }
     }
-
-    /// (whole frame, primary pass) seconds from the timestamps around each pass.
-    fn frame_seconds(&self, r: &FrameResources) -> anyhow::Result<Option<(f64, f64)>> {
-        let Some((set, resolve)) = &r.queries else {
-            return Ok(None);
-        };
-        let mut encoder = self.device.create_command_encoder(&Default::default());
-        encoder.resolve_query_set(set, 0..set_count(resolve), resolve, 0);
-        self.submit(encoder, self.device.push_error_scope(wgpu::ErrorFilter::Validation))?;
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(resolve, resolve.size())?);
-        let (first, last) = (ticks[0], ticks[ticks.len() - 1]);
-        let period = self.queue.get_timestamp_period() as f64;
-        let seconds = |a: u64, b: u64| b.saturating_sub(a) as f64 * period * 1e-9;
-        Ok(Some((seconds(first, last), seconds(ticks[0], ticks[1]))))
-    }
-}
-
-/// Timestamps a resolve buffer holds.
-fn set_count(resolve: &wgpu::Buffer) -> u32 {
-    (resolve.size() / 8) as u32
 }
 
 impl Backend for GpuBackend {
@@ -373,41 +354,5 @@ impl Backend for GpuBackend {
                 return Ok(timing);
             }
         }
-    }
-}
-
-impl GpuBackend {
-    /// `warmup` untimed and `repeats` timed frames over the same resources.
-    fn time_frames(
-        &mut self,
-        r: &FrameResources,
-        view: View,
-        plan: &RenderPlan,
-        warmup: u32,
-        repeats: u32,
-    ) -> anyhow::Result<Timing> {
-        let (mut seconds, mut primary_seconds) = (Vec::new(), Vec::new());
-        for i in 0..warmup + repeats {
-            let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-            let mut encoder = self.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, r, view, plan);
-            let start = Instant::now();
-            self.submit(encoder, scope)?;
-            let wall = start.elapsed().as_secs_f64();
-            let passes = self.frame_seconds(r)?;
-            if i >= warmup {
-                seconds.push(passes.map_or(wall, |p| p.0));
-                primary_seconds.extend(passes.map(|p| p.1));
-            }
-        }
-        Ok(Timing {
-            seconds,
-            primary_seconds,
-            clock: if self.timestamps {
-                Clock::GpuTimestamp
-            } else {
-                Clock::WallClock
-            },
-        })
     }
 }

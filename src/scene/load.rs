@@ -1,0 +1,215 @@
+//! Reading a scene file: the TOML ([`super::description`]) validated into a [`Scene`], every
+//! error located by file, line and key.
+
+use super::camera::{Camera, Projection};
+use super::description::{LightDesc, ProjectionDesc, SceneFile};
+use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
+use crate::accel::{self, AccelSettings};
+use crate::config::{ConfigError, Seg, Source};
+use crate::key_path;
+use crate::mesh::{clean, obj, Triangles};
+use glam::{DMat4, DQuat, DVec3};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, ConfigError> {
+        let source = Source::read(path)?;
+        let file: SceneFile = source.parse()?;
+        Scene::from_file(&file, &source)
+    }
+
+    /// Validates a parsed scene file; errors are located in `source`.
+    pub fn from_file(file: &SceneFile, source: &Source) -> Result<Scene, ConfigError> {
+        let v = Validator { source };
+        let mut cameras = BTreeMap::new();
+        for (name, c) in &file.cameras {
+            let at = |k: &str| key_path!["cameras", name.as_str(), k];
+            let position = v.point(&c.position, &at("position"))?;
+            let look_at = v.point(&c.look_at, &at("look_at"))?;
+            let up = v.point(&c.up, &at("up"))?;
+            let projection = match c.projection {
+                ProjectionDesc::Perspective => {
+                    let fov = c.fov_y.ok_or_else(|| {
+                        source.error(&at("projection"), "a perspective camera needs `fov_y` (degrees)")
+                    })?;
+                    if !(fov > 0.0 && fov < 180.0) {
+                        return Err(source.error(&at("fov_y"), format!("must be in (0, 180) degrees, got {fov}")));
+                    }
+                    Projection::Perspective { fov_y_deg: fov }
+                }
+                ProjectionDesc::Orthographic => {
+                    let w = c.width.ok_or_else(|| {
+                        source.error(&at("projection"), "an orthographic camera needs `width` (metres)")
+                    })?;
+                    v.positive(w, &at("width"))?;
+                    Projection::Orthographic { width: w }
+                }
+            };
+            let camera = Camera {
+                position,
+                look_at,
+                up,
+                projection,
+            };
+            if camera.frame().is_none() {
+                return Err(source.error(
+                    &at("up"),
+                    "`up` must not be parallel to the viewing direction, and `look_at` must differ from `position`",
+                ));
+            }
+            cameras.insert(name.clone(), camera);
+        }
+        let mut spheres = Vec::new();
+        let settings = AccelSettings {
+            name: accel::registered(&file.accelerator.0)
+                .ok_or_else(|| {
+                    source.error(
+                        &key_path!["accelerator"],
+                        format!(
+                            "unknown acceleration structure `{}`; known: {}",
+                            file.accelerator.0,
+                            accel::names().join(", ")
+                        ),
+                    )
+                })?
+                .name,
+            bvh_preset: file.bvh_preset,
+        };
+        for (i, s) in file.spheres.iter().enumerate() {
+            spheres.push(Sphere {
+                center: v.point(&s.center, &key_path!["spheres", i, "center"])?,
+                radius: v.positive(s.radius, &key_path!["spheres", i, "radius"])?,
+                albedo: v.albedo(s.albedo, &key_path!["spheres", i, "albedo"])?,
+            });
+        }
+        let mut planes = Vec::new();
+        for (i, p) in file.planes.iter().enumerate() {
+            planes.push(Plane {
+                point: v.point(&p.point, &key_path!["planes", i, "point"])?,
+                normal: v.direction(&p.normal, &key_path!["planes", i, "normal"])?,
+                albedo: v.albedo(p.albedo, &key_path!["planes", i, "albedo"])?,
+            });
+        }
+        let mut lights = Vec::new();
+        for (i, l) in file.lights.iter().enumerate() {
+            let at = |k: &str| key_path!["lights", i, k];
+            lights.push(match l {
+                LightDesc::Point { position, power } => Light::Point {
+                    position: v.point(position, &at("position"))?,
+                    power: v.non_negative(*power, &at("power"))?,
+                },
+                LightDesc::Disk {
+                    center,
+                    normal,
+                    radius,
+                    power,
+                    samples,
+                } => Light::Disk(DiskLight {
+                    center: v.point(center, &at("center"))?,
+                    normal: v.direction(normal, &at("normal"))?,
+                    radius: v.positive(*radius, &at("radius"))?,
+                    power: v.non_negative(*power, &at("power"))?,
+                    samples: v.samples(*samples, &at("samples"))?,
+                }),
+            });
+        }
+        let mut meshes = Vec::new();
+        let mut triangles = Triangles::default();
+        let dir = source.path.parent().unwrap_or(std::path::Path::new("."));
+        for (i, m) in file.meshes.iter().enumerate() {
+            let at = |k: &str| key_path!["meshes", i, k];
+            v.positive(m.scale, &at("scale"))?;
+            v.point(&m.rotate, &at("rotate"))?;
+            let translate = v.point(&m.translate, &at("translate"))?;
+            let albedo = v.albedo(m.albedo, &at("albedo"))?;
+            let path = dir.join(&m.path);
+            let raw = obj::load(&path)
+                .map_err(|e| source.error(&at("path"), e.to_string()))?
+                .select(&m.groups, &path)
+                .map_err(|e| source.error(&at("groups"), e.to_string()))?;
+            let [rx, ry, rz] = m.rotate.map(f64::to_radians);
+            let rotation = DQuat::from_rotation_z(rz) * DQuat::from_rotation_y(ry) * DQuat::from_rotation_x(rx);
+            let transform = DMat4::from_scale_rotation_translation(DVec3::splat(m.scale), rotation, translate);
+            let (kept, skipped) = clean(raw, &transform);
+            if skipped.degenerate + skipped.non_finite > 0 {
+                tracing::warn!(
+                    "{}: skipped {} degenerate and {} non-finite triangles (they can never be hit)",
+                    path.display(),
+                    skipped.degenerate,
+                    skipped.non_finite
+                );
+            }
+            triangles.object_of.extend(std::iter::repeat_n(i as u32, kept.len()));
+            let bytes = std::fs::read(&path).map_err(|e| source.error(&at("path"), e.to_string()))?;
+            meshes.push(Mesh {
+                source: path.display().to_string(),
+                file_fnv1a: crate::fingerprint::fnv1a(&bytes),
+                albedo,
+                triangles: kept.len(),
+                skipped,
+            });
+            triangles.positions.extend(kept);
+        }
+        Ok(Scene::analytic(spheres, planes, lights)
+            .with_cameras(cameras)
+            .with_meshes(meshes, triangles, settings))
+    }
+}
+
+struct Validator<'a> {
+    source: &'a Source,
+}
+
+impl Validator<'_> {
+    fn point(&self, p: &[f64; 3], at: &[Seg]) -> Result<DVec3, ConfigError> {
+        if p.iter().all(|x| x.is_finite()) {
+            Ok(DVec3::from_array(*p))
+        } else {
+            Err(self.source.error(at, "coordinates must be finite"))
+        }
+    }
+
+    fn direction(&self, p: &[f64; 3], at: &[Seg]) -> Result<DVec3, ConfigError> {
+        self.point(p, at)?
+            .try_normalize()
+            .ok_or_else(|| self.source.error(at, "direction must be non-zero"))
+    }
+
+    fn positive(&self, x: f64, at: &[Seg]) -> Result<f64, ConfigError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.source.error(at, format!("must be positive and finite, got {x}")))
+        }
+    }
+
+    fn non_negative(&self, x: f64, at: &[Seg]) -> Result<f64, ConfigError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self
+                .source
+                .error(at, format!("must be non-negative and finite, got {x}")))
+        }
+    }
+
+    fn albedo(&self, x: f64, at: &[Seg]) -> Result<f64, ConfigError> {
+        if (0.0..=1.0).contains(&x) {
+            Ok(x)
+        } else {
+            Err(self.source.error(at, format!("albedo must be in [0, 1], got {x}")))
+        }
+    }
+
+    fn samples(&self, n: u32, at: &[Seg]) -> Result<u32, ConfigError> {
+        if (1..=MAX_SAMPLES).contains(&n) {
+            Ok(n)
+        } else {
+            Err(self
+                .source
+                .error(at, format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}")))
+        }
+    }
+}
