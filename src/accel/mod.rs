@@ -16,6 +16,7 @@
 //! structure's module into its own pipelines, chosen by name. Adding a structure is its module,
 //! its WGSL and one line in [`REGISTRY`].
 
+pub mod brute;
 pub mod bvh;
 
 pub use bvh::{Bvh, Preset};
@@ -145,12 +146,20 @@ pub struct Registered {
 }
 
 /// Every acceleration structure, the default first.
-pub const REGISTRY: &[Registered] = &[Registered {
-    name: "bvh",
-    wgsl: bvh::WGSL,
-    gpu_buffers: 2,
-    build: |t, s| Arc::new(Bvh::build(t, s.bvh_preset)),
-}];
+pub const REGISTRY: &[Registered] = &[
+    Registered {
+        name: "bvh",
+        wgsl: bvh::WGSL,
+        gpu_buffers: 2,
+        build: |t, s| Arc::new(Bvh::build(t, s.bvh_preset)),
+    },
+    Registered {
+        name: "brute",
+        wgsl: brute::WGSL,
+        gpu_buffers: 1,
+        build: |t, _| Arc::new(brute::Brute::build(t)),
+    },
+];
 
 /// The registered structure called `name`.
 pub fn registered(name: &str) -> Option<&'static Registered> {

@@ -1,0 +1,104 @@
+//! Brute force: every triangle tested against every ray, on the CPU and on the GPU. No build,
+//! no tree, nothing to get wrong: the independent path other structures are checked against
+//! (select it with `accelerator = "brute"`; it costs O(triangles) per ray).
+
+use super::{brute_force, intersect, Accelerator, BuildStats, GpuStructure, TriHit};
+use crate::geometry::LocalFrame;
+use crate::mesh::Triangles;
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use std::time::Duration;
+
+/// Its WGSL: `accel_closest` and `accel_any` as loops over every triangle.
+pub const WGSL: &str = include_str!("brute.wgsl");
+
+/// The triangles, in input order.
+#[derive(Clone, Debug)]
+pub struct Brute {
+    triangles: Triangles,
+}
+
+/// A triangle as vertex + two edges in full f32 (the same form as the BVH's leaves).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable, Debug)]
+struct GpuTri {
+    v0: [f32; 3],
+    _p0: u32,
+    e1: [f32; 3],
+    _p1: u32,
+    e2: [f32; 3],
+    _p2: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuTri>() == 48);
+
+impl Brute {
+    /// Keeps a copy of `triangles`.
+    pub fn build(triangles: &Triangles) -> Brute {
+        Brute {
+            triangles: triangles.clone(),
+        }
+    }
+}
+
+impl Accelerator for Brute {
+    fn name(&self) -> &'static str {
+        "brute"
+    }
+
+    fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        if skip == u32::MAX {
+            return brute_force(&self.triangles, origin, dir).filter(|h| h.t < tmax);
+        }
+        let mut best: Option<TriHit> = None;
+        for (i, tri) in self.triangles.positions.iter().enumerate() {
+            match intersect(origin, dir, tri) {
+                Some(t) if i as u32 != skip && t > 0.0 && t < tmax && best.is_none_or(|b| t < b.t) => {
+                    best = Some(TriHit { t, triangle: i as u32 });
+                }
+                _ => {}
+            }
+        }
+        best
+    }
+
+    fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        self.triangles
+            .positions
+            .iter()
+            .enumerate()
+            .any(|(i, tri)| i as u32 != skip && intersect(origin, dir, tri).is_some_and(|t| t > 0.0 && t < tmax))
+    }
+
+    fn stats(&self) -> BuildStats {
+        let n = self.triangles.positions.len();
+        BuildStats {
+            parameters: "none".into(),
+            build_time: Duration::ZERO,
+            gpu_bytes: (n * std::mem::size_of::<GpuTri>()) as u64,
+            triangles: n,
+            description: format!("brute force over {n} triangles (48 GPU bytes per triangle)"),
+        }
+    }
+
+    fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
+        let tris: Vec<GpuTri> = self
+            .triangles
+            .positions
+            .iter()
+            .map(|t| {
+                let p = t.map(|c| frame.point_f64(c));
+                GpuTri {
+                    v0: p[0].as_vec3().to_array(),
+                    e1: (p[1] - p[0]).as_vec3().to_array(),
+                    e2: (p[2] - p[0]).as_vec3().to_array(),
+                    ..Zeroable::zeroed()
+                }
+            })
+            .collect();
+        Ok(GpuStructure {
+            buffers: vec![("brute-force triangles", bytemuck::cast_slice(&tris).to_vec())],
+            walk_iterations: tris.len() as u32 + 1,
+        })
+    }
+}
