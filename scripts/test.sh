@@ -7,4 +7,5 @@ cd "$(dirname "$0")/.."
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 cargo fmt --check
 cargo clippy --release --all-targets -- -D warnings
-cargo test --release
+cargo clippy --release --all-targets --features test-hooks -- -D warnings
+cargo test --release --features test-hooks

@@ -146,6 +146,49 @@ fn frames_do_not_depend_on_the_structure() {
     }
 }
 
+/// Each structure's WGSL queries against the CPU's brute force on the same seeded rays: the same
+/// triangle and t within f32 rounding, and any-hit agreeing, except where the ray passes
+/// within f32 rounding of an edge.
+#[test]
+#[cfg(feature = "test-hooks")]
+fn every_structure_matches_brute_force_on_the_gpu() {
+    let Some(mut gpu) = common::gpu() else { return };
+    for r in REGISTRY {
+        let mut s = scene(r.name);
+        s.cameras.insert("c".into(), camera());
+        let stream = Stream::new(11, 0, None);
+        let rays: Vec<_> = (0..4000)
+            .map(|k| {
+                let u = |i: u32| stream.unit(6 * k + i);
+                let target = DVec3::new(u(0) * 0.8 - 0.4, u(1) * 0.8 - 0.4, u(2) * 0.6);
+                let d = DVec3::new(u(3) - 0.5, u(4) - 0.5, u(5) - 0.5).normalize_or(DVec3::Z);
+                (target - d * 2.0, d, f64::INFINITY)
+            })
+            .collect();
+        let got = gpu.probe(&s, &rays).unwrap();
+        let mut differ = 0;
+        for ((o, d, _), g) in rays.iter().zip(&got) {
+            let want = accel::brute_force(&s.triangles, *o, *d);
+            match (g.closest, want) {
+                (Some((t, tri)), Some(w)) if tri == w.triangle => {
+                    assert!((t - w.t).abs() < 1e-5 * w.t.max(1.0), "{}: t {t} vs {}", r.name, w.t)
+                }
+                (None, None) => {}
+                _ => differ += 1,
+            }
+            assert_eq!(g.any, g.closest.is_some(), "{}: any-hit and closest disagree", r.name);
+        }
+        let hits = got.iter().filter(|g| g.closest.is_some()).count();
+        assert!(hits > 400, "{}: the rays must meet the meshes ({hits} hits)", r.name);
+        assert!(
+            differ <= 4,
+            "{}: {differ} of {} rays differ from brute force",
+            r.name,
+            rays.len()
+        );
+    }
+}
+
 /// An unknown structure name in a scene file is an error naming the file, the key and the
 /// known names.
 #[test]

@@ -74,6 +74,7 @@ fn cpu_traversal_matches_brute_force() {
 /// between two triangles, where f32 rounding may pick the neighbour), distance within 1e-4
 /// relative when the triangle agrees, and any-hit agreeing with closest-hit on each backend.
 #[test]
+#[cfg(feature = "test-hooks")]
 fn gpu_traversal_matches_cpu() {
     let Some(mut gpu) = common::gpu() else { return };
     let s = body();

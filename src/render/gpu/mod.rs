@@ -6,6 +6,7 @@
 //! in one dispatch or, on adapters that cap loop iterations, several) with a timestamp pair
 //! around each pass when the adapter supports timestamp queries, and reads the outputs back.
 
+#[cfg(feature = "test-hooks")]
 mod hooks;
 mod layout;
 pub mod loop_cap;
@@ -23,6 +24,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
+#[cfg(feature = "test-hooks")]
 pub use hooks::{ProbeHit, ProbeRay};
 pub use pipelines::scheme_prelude;
 

@@ -32,10 +32,12 @@ pub fn scheme_prelude() -> String {
 }
 
 /// The bind group layouts every pipeline shares: per frame (group 0), per dispatch (group 1),
-/// and the test hooks' own (group 3), which no render pipeline includes.
+/// and, with the `test-hooks` feature, the hooks' own (group 3), which no render pipeline
+/// includes.
 pub(super) struct Layouts {
     pub frame: wgpu::BindGroupLayout,
     pub pass: wgpu::BindGroupLayout,
+    #[cfg(feature = "test-hooks")]
     pub hooks: wgpu::BindGroupLayout,
 }
 
@@ -45,6 +47,7 @@ pub(super) struct Pipelines {
     pub accel: wgpu::BindGroupLayout,
     pub primary: wgpu::ComputePipeline,
     pub shadow: wgpu::ComputePipeline,
+    #[cfg(feature = "test-hooks")]
     hooks: Option<(wgpu::ComputePipeline, wgpu::ComputePipeline)>,
 }
 
@@ -91,6 +94,7 @@ impl Layouts {
         Layouts {
             frame: layout("frame", &entries),
             pass: layout("pass", &[uniform(0)]),
+            #[cfg(feature = "test-hooks")]
             hooks: layout("test hooks", &[storage(0, true)]),
         }
     }
@@ -116,6 +120,7 @@ impl PipelineCache {
             .or_insert_with(|| compile(device, layouts, name, cut_short_slot))
     }
 
+    #[cfg(feature = "test-hooks")]
     /// The test-hook kernels (`dump_samples`, `trace_probes`) of structure `name`, compiled on
     /// first use so that rendering never builds them.
     pub fn hooks(
@@ -197,6 +202,7 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
         primary: entry(device, &module, "primary", &layout),
         shadow: entry(device, &module, "shadow", &layout),
         accel,
+        #[cfg(feature = "test-hooks")]
         hooks: None,
     }
 }
