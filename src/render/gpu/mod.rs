@@ -18,7 +18,7 @@ use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Frame, RayCounts, Sampling, Timing, View};
 use anyhow::{anyhow, bail, Context};
 use layout::{pack, HIT_BYTES};
-use pipelines::{Layouts, PipelineCache};
+use pipelines::{Layouts, PipelineCache, NO_ACCEL};
 use resources::{FrameResources, SceneBuffers};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -201,7 +201,9 @@ impl GpuBackend {
             };
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
-            cp.set_bind_group(2, &r.accel_group, &[]);
+            if r.accel != NO_ACCEL {
+                cp.set_bind_group(2, &r.accel_group, &[]);
+            }
             for chunk in chunks {
                 cp.set_bind_group(1, chunk, &[]);
                 cp.dispatch_workgroups(groups.0, groups.1, 1);

@@ -195,7 +195,12 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("render"),
-        bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.pass), Some(&accel)],
+        // A structure without buffers leaves group 2 out of the layout altogether.
+        bind_group_layouts: &[
+            Some(&layouts.frame),
+            Some(&layouts.pass),
+            (buffers > 0).then_some(&accel),
+        ],
         immediate_size: 0,
     });
     Pipelines {
