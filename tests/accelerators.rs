@@ -118,6 +118,34 @@ fn every_structure_matches_brute_force_on_the_cpu() {
     }
 }
 
+/// Rays aimed exactly at mesh vertices (hits on shared edges and corners, where f32 box tests
+/// are decided by rounding) from inside and outside the body mesh's bounds: every structure
+/// finds brute force's distance.
+#[test]
+fn vertex_aimed_rays_on_the_body_match_brute_force() {
+    let body = Scene::load(&common::repo("experiments/scenes/body.toml")).unwrap();
+    let t = &body.triangles;
+    let stream = Stream::new(1, 0, None);
+    for r in REGISTRY {
+        let s = body.clone().with_accelerator(AccelSettings {
+            name: r.name,
+            ..Default::default()
+        });
+        let a = s.accel.as_ref().unwrap();
+        let mut wrong = 0;
+        for k in 0..3000 {
+            let u = |i: u32| stream.unit(6 * k + i);
+            let p = t.positions[(u(0) * t.positions.len() as f64) as usize % t.positions.len()][(k % 3) as usize];
+            let d = (DVec3::new(u(1), u(2), u(3)) - 0.5).normalize();
+            let o = p - d * (0.5 + 20.0 * u(4));
+            let want = accel::brute_force(t, o, d).map(|h| h.t);
+            wrong += (a.closest(o, d, f64::INFINITY, u32::MAX).map(|h| h.t) != want) as u32;
+            wrong += (a.any_hit(o, d, f64::INFINITY, u32::MAX) != want.is_some()) as u32;
+        }
+        assert_eq!(wrong, 0, "{}: {wrong} answers differ from brute force", r.name);
+    }
+}
+
 /// Frames rendered through each structure are identical to the default structure's, on the
 /// CPU and on the GPU: hits, visibility and radiance, bit for bit (both walk the same f32 or f64
 /// triangles and the meshes' faces meet only along edges of equal normal or not at all).

@@ -11,7 +11,7 @@ mod gpu;
 use super::{intersect, Accelerator, BuildStats, GpuStructure, TriHit};
 use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
-use glam::{DVec3, Vec3A};
+use glam::{DVec3, Vec3, Vec3A};
 use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::bvh2::Bvh2;
 use obvhs::ray::Ray;
@@ -78,8 +78,12 @@ impl Preset {
 /// A built BVH with its triangles.
 #[derive(Clone)]
 pub struct Bvh {
-    /// The obvhs tree (node bounds relative to `centre`).
+    /// The obvhs tree (node bounds relative to `centre`), as built: what the GPU form packs.
     pub tree: Bvh2,
+    /// The same tree with every box widened by a few f32 ulps of the scene's size, for the CPU
+    /// walk: the tree bounds f32-rounded triangles and walks an f32-rounded ray, while hits are
+    /// tested in f64, so unwidened boxes drop hits at vertices and edges.
+    cpu_tree: Bvh2,
     /// Triangles in f32 relative to `centre`, in input order.
     pub local: Vec<Triangle>,
     /// Triangles in f64 world space, in input order.
@@ -136,9 +140,19 @@ impl Bvh {
         let mut build_time = Duration::default();
         let tree = build_bvh2_from_tris(&local, preset.params(), &mut build_time);
         let depth = depth(&tree);
+        let mut cpu_tree = tree.clone();
+        if let Some(root) = tree.nodes.first() {
+            let size = root.aabb.min.abs().max(root.aabb.max.abs()).max_element();
+            let pad = Vec3A::splat(size * 8.0 * f32::EPSILON);
+            for n in &mut cpu_tree.nodes {
+                n.aabb.min -= pad;
+                n.aabb.max += pad;
+            }
+        }
         Bvh {
             depth,
             tree,
+            cpu_tree,
             local,
             world: triangles.positions.clone(),
             centre,
@@ -148,14 +162,36 @@ impl Bvh {
         }
     }
 
-    fn ray(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Ray {
-        // Conservative f32 extent: node culling must never drop a hit the f64 test would find.
-        Ray::new(
-            Vec3A::from((origin - self.centre).as_vec3()),
+    /// The f32 ray the CPU walk follows, and its parameter shift `s`, or None when the segment
+    /// misses the (widened) root box. A ray from outside the box starts just before it enters,
+    /// so that rounding its origin to f32 moves it by ulps of the scene's size rather than of
+    /// its distance, which the boxes' widening covers. Its far end is widened too: node culling
+    /// must never drop a hit the f64 test would find.
+    fn ray(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(Ray, f64)> {
+        let root = self.cpu_tree.nodes.first()?;
+        let lo = Vec3::from(root.aabb.min).as_dvec3() + self.centre;
+        let hi = Vec3::from(root.aabb.max).as_dvec3() + self.centre;
+        let (a, b) = ((lo - origin) / dir, (hi - origin) / dir);
+        let enter = a.min(b).max_element();
+        let exit = a.max(b).min_element();
+        let margin = (hi - lo).max_element() * 1e-3;
+        // An origin on a slab plane of a ray parallel to it gives NaN: walk such rays unshifted.
+        let defined = !(enter.is_nan() || exit.is_nan());
+        if defined && (exit < 0.0 || enter > exit + margin || enter > tmax + margin) {
+            return None;
+        }
+        let s = if defined && enter.is_finite() {
+            (enter - margin).max(0.0)
+        } else {
+            0.0
+        };
+        let ray = Ray::new(
+            Vec3A::from((origin + dir * s - self.centre).as_vec3()),
             Vec3A::from(dir.as_vec3()),
             0.0,
-            (tmax * (1.0 + 1e-6)) as f32,
-        )
+            ((tmax - s) * (1.0 + 1e-6) + margin) as f32,
+        );
+        Some((ray, s))
     }
 
     /// Closest triangle hit with 0 < t < `tmax` along unit `dir`, skipping triangle `skip`.
@@ -165,12 +201,14 @@ impl Bvh {
         }
         let mut best: Option<TriHit> = None;
         let mut hit = obvhs::ray::RayHit::none();
-        self.tree.ray_traverse(self.ray(origin, dir, tmax), &mut hit, |_, i| {
-            let tri = self.tree.primitive_indices[i];
+        let (ray, s) = self.ray(origin, dir, tmax)?;
+        self.cpu_tree.ray_traverse(ray, &mut hit, |_, i| {
+            let tri = self.cpu_tree.primitive_indices[i];
             match intersect(origin, dir, &self.world[tri as usize]) {
                 Some(t) if tri != skip && t > 0.0 && t < tmax && best.is_none_or(|b| t < b.t) => {
                     best = Some(TriHit { t, triangle: tri });
-                    t as f32
+                    // The walk's new far end, in its shifted parameter, rounded outwards.
+                    ((t - s) + (t - s).abs() * 1e-6 + 1e-30) as f32
                 }
                 _ => f32::INFINITY,
             }
@@ -183,10 +221,14 @@ impl Bvh {
         if self.world.is_empty() {
             return false;
         }
-        !self.tree.ray_traverse_miss(self.ray(origin, dir, tmax), |_, i| {
-            let tri = self.tree.primitive_indices[i];
+        let Some((ray, _)) = self.ray(origin, dir, tmax) else {
+            return false;
+        };
+        !self.cpu_tree.ray_traverse_miss(ray, |_, i| {
+            let tri = self.cpu_tree.primitive_indices[i];
             match intersect(origin, dir, &self.world[tri as usize]) {
-                Some(t) if tri != skip && t > 0.0 && t < tmax => 0.0,
+                // Below any far end the shifted walk may have.
+                Some(t) if tri != skip && t > 0.0 && t < tmax => f32::NEG_INFINITY,
                 _ => f32::INFINITY,
             }
         })
