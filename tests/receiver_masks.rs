@@ -6,10 +6,10 @@
 
 mod common;
 
-use penumbra::experiment::{run_sweep, Outcome, Spec};
+use penumbra::experiment::sweep::report::thresholds::Thresholds;
+use penumbra::experiment::sweep::{run_sweep, Outcome, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::Backend;
-use penumbra::report::thresholds::Thresholds;
 use std::path::Path;
 
 const SCENE: &str = r#"

@@ -4,12 +4,12 @@
 
 mod common;
 
-use penumbra::experiment::reference::Reference;
-use penumbra::experiment::runner::{figure_samples, verdict_radius};
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::reference::Reference;
+use penumbra::experiment::sweep::report::summary::{summarise, Summary};
+use penumbra::experiment::sweep::report::thresholds::{Check, Thresholds};
+use penumbra::experiment::sweep::runner::{figure_samples, verdict_radius};
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::open_backend;
-use penumbra::report::summary::{summarise, Summary};
-use penumbra::report::thresholds::{Check, Thresholds};
 use penumbra::sampling::DiskScheme;
 use std::sync::OnceLock;
 

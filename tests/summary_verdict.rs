@@ -5,10 +5,10 @@
 
 mod common;
 
-use penumbra::experiment::{run_sweep, Outcome, Spec};
+use penumbra::experiment::sweep::report::summary::{find, summarise, Summary};
+use penumbra::experiment::sweep::report::verdict::Verdict;
+use penumbra::experiment::sweep::{run_sweep, Outcome, Spec};
 use penumbra::render::cpu::CpuBackend;
-use penumbra::report::summary::{find, summarise, Summary};
-use penumbra::report::verdict::Verdict;
 use penumbra::sampling::{DiskScheme, Pattern};
 
 fn sweep(seeds: &str) -> (Outcome, Vec<Summary>) {
@@ -74,7 +74,7 @@ fn the_verdict_needs_two_seeds_and_never_prints_nan() {
     // Squared biases read as values with their intervals, never bare (or negative) numbers.
     for scheme in [DiskScheme::Paper, DiskScheme::Uniform] {
         let s = find(&three, scheme, Pattern::PerPixel, 16, 0.02, 1).unwrap();
-        let b = penumbra::report::numbers::bias2(&s.stats.split);
+        let b = penumbra::output::numbers::bias2(&s.stats.split);
         assert!(b.contains(" ± ") && text.contains(&b), "{b} not in {text}");
     }
 }

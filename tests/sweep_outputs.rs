@@ -4,7 +4,7 @@
 
 mod common;
 
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Frame, Sampling, Timing, View};
 use penumbra::scene::Scene;

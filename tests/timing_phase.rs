@@ -5,8 +5,8 @@
 
 mod common;
 
-use penumbra::experiment::timing::{faster, NOISE_VISITS};
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::timing::{faster, NOISE_VISITS};
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Clock, Frame, Sampling, Timing, View};
 use penumbra::sampling::DiskScheme;
@@ -97,7 +97,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     assert!(backend.calls.is_empty(), "{} frames re-timed", backend.calls.len());
     assert_eq!(again.timings.configs, out.timings.configs);
     assert_eq!(again.timings.noise.as_ref().map(|n| &n.1), Some(noise));
-    let frame_ms = |o: &penumbra::experiment::Outcome| -> Vec<String> {
+    let frame_ms = |o: &penumbra::experiment::sweep::Outcome| -> Vec<String> {
         o.records.iter().map(|r| r.get("frame_ms").to_string()).collect()
     };
     assert_eq!(frame_ms(&again), frame_ms(&out));

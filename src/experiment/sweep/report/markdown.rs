@@ -1,16 +1,16 @@
 //! report.md: what was run, the scene's acceleration structure, how far the ground truth is
 //! from the exact answer, the verdict, what accuracy costs in time, and where the outputs are.
 
-use super::numbers::or_na;
 use super::summary::{find, Summary};
 use super::verdict::Verdict;
-use crate::experiment::runner::{figure_samples, Outcome};
-use crate::experiment::timing::{faster, ConfigTiming};
-use crate::experiment::Spec;
+use crate::experiment::sweep::runner::{figure_samples, Outcome};
+use crate::experiment::sweep::timing::{faster, ConfigTiming};
+use crate::experiment::sweep::Spec;
+use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 
-pub use crate::experiment::runner::verdict_radius;
+pub use crate::experiment::sweep::runner::verdict_radius;
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
     or_na(x.unwrap_or(f64::NAN), f)
@@ -128,7 +128,7 @@ fn noise_floor(outcome: &Outcome) -> String {
     let (q1, med, q3) = t.frame_ms();
     format!(
         "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint and their medians differ by more than this noise floor's interquartile range; otherwise they are equal within timing noise.\n\n",
-        t.frame_seconds.len() / crate::experiment::timing::NOISE_VISITS as usize,
+        t.frame_seconds.len() / crate::experiment::sweep::timing::NOISE_VISITS as usize,
         t.clock,
         run.scheme,
         run.pattern,

@@ -5,9 +5,9 @@
 //! Two means are called different only when their 95 % intervals are disjoint; without intervals
 //! (fewer than two seeds) nothing is called different, and the verdict says it needs more seeds.
 
-use super::numbers::{bias2, or_na, with_ci};
 use super::summary::{find, Summary};
 use crate::metrics::BiasVariance;
+use crate::output::numbers::{bias2, or_na, with_ci};
 use crate::sampling::{DiskScheme, Pattern};
 
 /// A comparison of two means with 95 % CIs.

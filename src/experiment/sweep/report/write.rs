@@ -1,17 +1,17 @@
 //! Writes a finished sweep: tables, plots, images, report and manifest, each file atomically,
 //! the manifest last.
 
-use super::images::{diverging, grey, write_exr, Rgb};
 use super::markdown::{report, verdict_radius};
 use super::pictures::{picture_flip, write_fig2_picture};
-use super::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
 use super::summary::{self, Summary};
-use crate::experiment::pictures::Pictures;
-use crate::experiment::run::{num, RUN_COLUMNS};
-use crate::experiment::runner::{figure_samples, Outcome};
-use crate::experiment::timing::ConfigTiming;
-use crate::experiment::Spec;
+use crate::experiment::sweep::pictures::Pictures;
+use crate::experiment::sweep::run::{num, RUN_COLUMNS};
+use crate::experiment::sweep::runner::{figure_samples, Outcome};
+use crate::experiment::sweep::timing::ConfigTiming;
+use crate::experiment::sweep::Spec;
 use crate::files::{write_atomic, write_csv};
+use crate::output::images::{diverging, grey, write_exr, Rgb};
+use crate::output::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
@@ -133,7 +133,7 @@ fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
         "primary_ms",
         "clock",
     ];
-    let rows = |run: &crate::experiment::Run, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
+    let rows = |run: &crate::experiment::sweep::Run, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
         c.frame_seconds
             .iter()
             .enumerate()
@@ -456,29 +456,6 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The checkout's commit, suffixed `-dirty` when tracked files differ from it.
-pub fn git_commit() -> String {
-    let run = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    match run(&["rev-parse", "HEAD"]) {
-        Some(c) => {
-            let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
-            if dirty {
-                format!("{c}-dirty")
-            } else {
-                c
-            }
-        }
-        None => "unknown".into(),
-    }
-}
-
 fn manifest(r: &Results) -> String {
     let s = r.spec;
     let a = r.adapter;
@@ -487,7 +464,7 @@ fn manifest(r: &Results) -> String {
     let q = |t: &str| format!("{t:?}");
     let list = |v: Vec<String>| format!("[{}]", v.join(", "));
     let mut m = String::from("# Provenance of the results in this folder.\n");
-    m += &format!("git_commit = {}\n", q(&git_commit()));
+    m += &format!("git_commit = {}\n", q(&crate::output::git_commit()));
     m += &format!(
         "experiment = {}\nexperiment_fnv1a = {}\n",
         q(&s.path.display().to_string()),
@@ -516,12 +493,12 @@ fn manifest(r: &Results) -> String {
         "timing_warmup = {}\ntiming_repeats = {}\ntiming_order_seed = {}\n",
         s.timing.warmup,
         s.timing.repeats,
-        crate::experiment::timing::ORDER_SEED
+        crate::experiment::sweep::timing::ORDER_SEED
     );
     m += &format!(
         "ground_truth_samples = {}\nground_truth_seed = {}\n",
         s.ground_truth.samples,
-        crate::experiment::reference::GROUND_TRUTH_SEED
+        crate::experiment::sweep::reference::GROUND_TRUTH_SEED
     );
     m += &format!(
         "[adapter]\nbackend = {}\nname = {}\ndriver = {}\napi = {}\n",

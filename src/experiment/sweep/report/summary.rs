@@ -2,11 +2,11 @@
 //! frame time (median and quartiles of its interleaved timed frames), the per-pixel bias/variance
 //! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
-use crate::experiment::run::num;
-use crate::experiment::run::GroupStats;
-use crate::experiment::runner::Outcome;
-use crate::experiment::timing::ConfigTiming;
-use crate::experiment::{Record, Run};
+use crate::experiment::sweep::run::num;
+use crate::experiment::sweep::run::GroupStats;
+use crate::experiment::sweep::runner::Outcome;
+use crate::experiment::sweep::timing::ConfigTiming;
+use crate::experiment::sweep::{Record, Run};
 use crate::metrics::stats::mean_ci;
 use crate::sampling::{DiskScheme, Pattern};
 use std::collections::BTreeMap;

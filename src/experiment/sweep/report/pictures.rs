@@ -2,11 +2,11 @@
 //! exposure, tiled into fig2_picture.png, and each measured against the ground-truth picture
 //! with FLIP (Andersson et al. 2020), the perceptual stand-in for the paper's "equal quality".
 
-use super::images::{exposure, tonemap_with, Rgb};
-use super::plots::image_grid;
 use super::summary::PictureFlip;
-use crate::experiment::pictures::{Picture, Pictures};
+use crate::experiment::sweep::pictures::{Picture, Pictures};
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
+use crate::output::images::{exposure, tonemap_with, Rgb};
+use crate::output::plots::image_grid;
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 

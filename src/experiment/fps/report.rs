@@ -1,9 +1,9 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
 //! numbers, report.md and the manifest.
 
-use super::plots::{line_plot, Axes, Reference, Series};
-use crate::experiment::fps::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
+use super::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
 use crate::files::{write_atomic, write_csv};
+use crate::output::plots::{line_plot, Axes, Reference, Series};
 use crate::render::AdapterInfo;
 use std::path::Path;
 
@@ -101,7 +101,7 @@ pub fn write_fps(
     write_atomic(&out.join("report.md"), md.as_bytes())?;
     let manifest = format!(
         "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\n[adapter]\nbackend = {:?}\nname = {:?}\ndriver = {:?}\napi = {:?}\n",
-        super::write::git_commit(),
+        crate::output::git_commit(),
         spec.path.display().to_string(),
         seconds,
         adapter.backend,

@@ -2,6 +2,8 @@
 //! 16 shadow rays per pixel, sphere and dressed body, one and two lights) on today's adapter,
 //! with the paper's numbers beside ours.
 
+pub mod report;
+
 use crate::config::{ConfigError, Source};
 use crate::key_path;
 use crate::metrics::stats::median;
@@ -290,7 +292,7 @@ pub const FPS_COLUMNS: [&str; 18] = [
 
 /// fps.csv row.
 pub fn fps_row(spec: &FpsSpec, r: &FpsRow, a: &AdapterInfo) -> Vec<String> {
-    use super::run::num;
+    use crate::experiment::sweep::run::num;
     vec![
         r.scene.clone(),
         r.lights.to_string(),

@@ -4,7 +4,7 @@
 
 use super::summary::{find, Summary};
 use crate::config::{ConfigError, Source};
-use crate::experiment::reference::Reference;
+use crate::experiment::sweep::reference::Reference;
 use crate::metrics::stats::t975;
 use crate::sampling::{DiskScheme, Pattern};
 use serde::Deserialize;
