@@ -1,7 +1,8 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
 //! numbers, report.md and the manifest.
 
-use super::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
+use super::{FpsRow, FpsSpec};
+use crate::experiment::sweep::run::num;
 use crate::files::{write_atomic, write_csv};
 use crate::output::plots::{line_plot, Axes, Reference, Series};
 use crate::render::AdapterInfo;
@@ -110,4 +111,50 @@ pub fn write_fps(
         adapter.api
     );
     write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}
+
+/// fps.csv header.
+pub const FPS_COLUMNS: [&str; 18] = [
+    "scene",
+    "lights",
+    "width",
+    "height",
+    "samples",
+    "frames",
+    "median_ms",
+    "min_ms",
+    "max_ms",
+    "fps",
+    "paper_fps",
+    "primary_rays",
+    "shadow_rays",
+    "shadow_rays_per_s",
+    "clock",
+    "adapter",
+    "driver",
+    "api",
+];
+
+/// fps.csv row.
+pub fn fps_row(spec: &FpsSpec, r: &FpsRow, a: &AdapterInfo) -> Vec<String> {
+    vec![
+        r.scene.clone(),
+        r.lights.to_string(),
+        r.width.to_string(),
+        r.height.to_string(),
+        spec.samples.to_string(),
+        r.frames.to_string(),
+        num(r.median_s * 1e3),
+        num(r.min_s * 1e3),
+        num(r.max_s * 1e3),
+        num(r.fps()),
+        num(r.paper_fps),
+        r.primary_rays.to_string(),
+        r.shadow_rays.to_string(),
+        num(r.shadow_rays_per_s()),
+        r.clock.name().to_string(),
+        a.name.clone(),
+        a.driver.clone(),
+        a.api.clone(),
+    ]
 }

@@ -322,3 +322,25 @@ fn run_group(
     };
     (records, stats, images)
 }
+
+/// What `--dry-run` prints: every configuration with its seeds, then the render plan.
+pub fn dry_run(spec: &Spec) -> anyhow::Result<String> {
+    let groups = expand(spec);
+    let runs: usize = groups.iter().map(|g| g.runs.len()).sum();
+    let mut out = format!("{}: {runs} runs in {} configurations\n", spec.name, groups.len());
+    for g in &groups {
+        let r = g.head();
+        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
+        out += &format!(
+            "  scheme={} pattern={} samples={} light_radius={} lights={} seeds=[{}]\n",
+            r.scheme,
+            r.pattern,
+            r.samples,
+            r.light_radius,
+            r.lights,
+            seeds.join(", ")
+        );
+    }
+    out += &format!("render plan of a run:\n{}", sweep_plan(spec)?);
+    Ok(out)
+}

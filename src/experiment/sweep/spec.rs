@@ -2,6 +2,7 @@
 //! [`Spec`] with every error located in the file.
 
 use crate::config::{ConfigError, Source};
+use crate::experiment::kind::Kind;
 use crate::key_path;
 use crate::render::BackendChoice;
 use crate::sampling::{DiskScheme, Pattern};
@@ -13,6 +14,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct File {
+    #[serde(default)]
+    kind: Kind,
     name: String,
     scene: PathBuf,
     #[serde(default = "default_backend")]
@@ -139,9 +142,17 @@ pub struct Spec {
 impl Spec {
     /// Reads and validates an experiment file and the scene it names (relative to it).
     pub fn load(path: &Path) -> Result<Spec, ConfigError> {
-        let source = Source::read(path)?;
+        Spec::from_source(&Source::read(path)?)
+    }
+
+    /// Validates an experiment read from its file (`source`) and loads the scene it names.
+    pub fn from_source(source: &Source) -> Result<Spec, ConfigError> {
+        let path = source.path.as_path();
         let f: File = source.parse()?;
         let err = |p: &[crate::config::Seg], m: String| source.error(p, m);
+        if f.kind != Kind::Sweep {
+            return Err(err(&key_path!["kind"], "a sweep has kind = \"sweep\" (or none)".into()));
+        }
         let scene_path = path.parent().unwrap_or(Path::new(".")).join(&f.scene);
         if !scene_path.is_file() {
             return Err(err(
