@@ -4,6 +4,7 @@
 pub mod images;
 pub mod numbers;
 pub mod plots;
+pub mod table;
 
 /// The checkout's commit, suffixed `-dirty` when tracked files differ from it.
 pub fn git_commit() -> String {

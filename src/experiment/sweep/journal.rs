@@ -103,7 +103,7 @@ impl Journal {
             records?,
             GroupStats {
                 key: group.head().key(context),
-                run: *group.head(),
+                config: group.config(),
                 split,
             },
         ))

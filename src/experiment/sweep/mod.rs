@@ -2,6 +2,7 @@
 //! ([`reference`]), the runs ([`runner`]) with their resumable journal ([`journal`]), and the
 //! outputs ([`report`]).
 
+pub mod axes;
 pub mod filter;
 pub mod journal;
 pub mod measure;

@@ -1,28 +1,13 @@
-//! Runs (one point of the swept product) and records (a run plus everything measured on it):
-//! plain data, one record per row of runs.csv in tidy form.
+//! The sweep expanded into groups of runs, and the keys that tell runs apart across sweeps; and
+//! records (a run plus everything measured on it): plain data, one record per row of runs.csv in
+//! tidy form.
 
+use super::axes::Config;
+pub use super::axes::Run;
 use super::spec::Spec;
 use crate::fingerprint::{build_id, fnv1a};
 use crate::metrics::BiasVariance;
 use crate::render::AdapterInfo;
-use crate::sampling::{DiskScheme, Pattern};
-
-/// One point of the sweep.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Run {
-    /// Disk sampling scheme.
-    pub scheme: DiskScheme,
-    /// Per-pixel or shared.
-    pub pattern: Pattern,
-    /// Shadow rays per receiver point.
-    pub samples: u32,
-    /// Light radius, metres.
-    pub light_radius: f64,
-    /// Lights on (the scene's first k).
-    pub lights: u32,
-    /// Seed.
-    pub seed: u32,
-}
 
 /// Runs that differ only by seed: their images give the per-pixel bias/variance split.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +20,11 @@ impl Group {
     /// The group's runs share everything but the seed; this is the first.
     pub fn head(&self) -> &Run {
         &self.runs[0]
+    }
+
+    /// The configuration the group's runs share.
+    pub fn config(&self) -> Config {
+        self.head().config()
     }
 
     /// Journal key of the group's statistics: a hash of every run's key, so that another seed
@@ -50,43 +40,22 @@ impl Group {
 pub struct GroupStats {
     /// Key of the group's first run.
     pub key: String,
-    /// The group's axes (seed of the first run).
-    pub run: Run,
+    /// The group's configuration.
+    pub config: Config,
     /// Squared bias with its interval, and variance, over the ground truth's penumbra.
     pub split: BiasVariance,
 }
 
-/// The sweep in canonical order: lights on, light radius, then scheme, pattern, samples; seeds
-/// innermost, grouped. The order fixes the row order of runs.csv whatever order work was done in.
+/// The sweep in canonical order (the axes' expansion order, seeds innermost and grouped). The
+/// order fixes the row order of runs.csv whatever order work was done in.
 pub fn expand(spec: &Spec) -> Vec<Group> {
-    let a = &spec.axes;
-    let mut groups = Vec::new();
-    for (&lights, &light_radius) in a
-        .light_counts
+    spec.axes
+        .configs()
         .iter()
-        .flat_map(|l| a.light_radii.iter().map(move |r| (l, r)))
-    {
-        for &scheme in &a.schemes {
-            for &pattern in &a.patterns {
-                for &samples in &a.samples {
-                    let runs = a
-                        .seeds
-                        .iter()
-                        .map(|&seed| Run {
-                            scheme,
-                            pattern,
-                            samples,
-                            light_radius,
-                            lights,
-                            seed,
-                        })
-                        .collect();
-                    groups.push(Group { runs });
-                }
-            }
-        }
-    }
-    groups
+        .map(|c| Group {
+            runs: spec.axes.seeds.iter().map(|&seed| c.with_seed(seed)).collect(),
+        })
+        .collect()
 }
 
 /// Everything besides the run's own axes that determines its result: the scene file and the
@@ -116,10 +85,7 @@ impl Run {
     /// Hash of the run's configuration (scene text, measuring view, ground truth and axes),
     /// keying resumed work: a changed scene or view gives new keys.
     pub fn key(&self, context: &str) -> String {
-        let text = format!(
-            "{context};{};{};{};{:e};{};{}",
-            self.scheme, self.pattern, self.samples, self.light_radius, self.lights, self.seed
-        );
+        let text = format!("{context};{}", self.key_text());
         format!("{:016x}", fnv1a(text.as_bytes()))
     }
 }

@@ -1,11 +1,11 @@
 //! The experiment file: which scene, what to measure, which axes to sweep. Validated into a
 //! [`Spec`] with every error located in the file.
 
+pub use super::axes::Axes;
 use crate::config::{ConfigError, Source};
 use crate::experiment::kind::Kind;
 use crate::key_path;
 use crate::render::BackendChoice;
-use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
@@ -45,26 +45,6 @@ pub struct Measure {
     /// Index of the receiver plane (radial profiles and exact references are taken on it).
     #[serde(default)]
     pub plane: usize,
-}
-
-/// The swept axes; the sweep is their cartesian product.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Axes {
-    /// Disk sampling schemes.
-    pub schemes: Vec<DiskScheme>,
-    /// Per-pixel or shared patterns.
-    pub patterns: Vec<Pattern>,
-    /// Shadow-ray counts.
-    pub samples: Vec<u32>,
-    /// Light radii, metres.
-    pub light_radii: Vec<f64>,
-    /// Seeds.
-    pub seeds: Vec<u32>,
-    /// How many of the scene's lights are on (the first k); every light in use gets the swept
-    /// radius and shadow-ray count. Default: all of them.
-    #[serde(default)]
-    pub light_counts: Vec<u32>,
 }
 
 /// The high-sample reference image.
@@ -219,15 +199,13 @@ impl Spec {
             ));
         }
         let a = &axes;
-        for (key, empty) in [
-            ("schemes", a.schemes.is_empty()),
-            ("patterns", a.patterns.is_empty()),
-            ("samples", a.samples.is_empty()),
-            ("light_radii", a.light_radii.is_empty()),
-            ("seeds", a.seeds.is_empty()),
-        ] {
-            if empty {
-                return Err(err(&key_path!["sweep", key], "must list at least one value".into()));
+        let lists = a.texts();
+        for (axis, values) in &lists {
+            if values.is_empty() {
+                return Err(err(
+                    &key_path!["sweep", axis.list_key()],
+                    "must list at least one value".into(),
+                ));
             }
         }
         for (i, &n) in a.samples.iter().enumerate() {
@@ -246,20 +224,16 @@ impl Spec {
                 ));
             }
         }
-        let check_dupes = |key: &str, names: Vec<String>| -> Result<(), ConfigError> {
-            for (i, n) in names.iter().enumerate() {
-                if names[..i].contains(n) {
-                    return Err(err(&key_path!["sweep", key, i], format!("`{n}` is listed twice")));
+        for (axis, values) in &lists {
+            for (i, v) in values.iter().enumerate() {
+                if values[..i].contains(v) {
+                    return Err(err(
+                        &key_path!["sweep", axis.list_key(), i],
+                        format!("`{v}` is listed twice"),
+                    ));
                 }
             }
-            Ok(())
-        };
-        check_dupes("schemes", a.schemes.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("patterns", a.patterns.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("samples", a.samples.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("light_radii", a.light_radii.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("seeds", a.seeds.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("light_counts", a.light_counts.iter().map(|s| s.to_string()).collect())?;
+        }
         if !(1..=MAX_SAMPLES).contains(&f.ground_truth.samples) {
             return Err(err(
                 &key_path!["ground_truth", "samples"],

@@ -7,6 +7,7 @@
 //! random places in the order, measures the noise floor: the spread of one unchanging workload
 //! across the whole timing phase.
 
+use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::{Spec, TimingSpec};
 use crate::fingerprint::fnv1a;
@@ -91,7 +92,7 @@ pub struct Timings {
     /// Per configuration, keyed by its group key.
     pub configs: BTreeMap<String, ConfigTiming>,
     /// The noise probe's configuration and its frames.
-    pub noise: Option<(Run, ConfigTiming)>,
+    pub noise: Option<(Config, ConfigTiming)>,
 }
 
 /// Key of the timing settings: journaled timings are reused only under the same settings.

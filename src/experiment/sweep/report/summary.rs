@@ -2,14 +2,13 @@
 //! frame time (median and quartiles of its interleaved timed frames), the per-pixel bias/variance
 //! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
+use crate::experiment::sweep::axes::Config;
 use crate::experiment::sweep::run::num;
 use crate::experiment::sweep::run::GroupStats;
 use crate::experiment::sweep::runner::Outcome;
 use crate::experiment::sweep::timing::ConfigTiming;
-use crate::experiment::sweep::{Record, Run};
+use crate::experiment::sweep::Record;
 use crate::metrics::stats::mean_ci;
-use crate::sampling::{DiskScheme, Pattern};
-use std::collections::BTreeMap;
 
 /// Metrics aggregated over seeds as mean and CI half-width.
 pub const AGGREGATED: [&str; 10] = [
@@ -25,14 +24,14 @@ pub const AGGREGATED: [&str; 10] = [
     "penumbra_lost_share",
 ];
 
-/// FLIP of each seed's picture, per (scheme, pattern) at the figure ray count.
-pub type PictureFlip = BTreeMap<(DiskScheme, Pattern), Vec<f64>>;
+/// FLIP of each seed's picture, per configuration that has pictures.
+pub type PictureFlip = Vec<(Config, Vec<f64>)>;
 
 /// One configuration (all axes but the seed) summarised.
 #[derive(Clone, Debug)]
 pub struct Summary {
-    /// The configuration (seed of its first run).
-    pub run: Run,
+    /// The configuration.
+    pub config: Config,
     /// Seeds that rendered.
     pub seeds: usize,
     /// (mean, ci95 half-width) per [`AGGREGATED`] metric.
@@ -77,8 +76,8 @@ fn index(name: &str) -> usize {
 }
 
 /// Summaries of every group of the outcome, in canonical order; `flip` gives the picture errors
-/// of the configurations at (`samples`, `radius`, `lights`) that have pictures.
-pub fn summarise(outcome: &Outcome, flip: &PictureFlip, figure: (u32, f64, u32)) -> Vec<Summary> {
+/// of the configurations that have pictures.
+pub fn summarise(outcome: &Outcome, flip: &PictureFlip) -> Vec<Summary> {
     outcome
         .groups
         .iter()
@@ -86,20 +85,19 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip, figure: (u32, f64, u32))
             let rows: Vec<&Record> = outcome
                 .records
                 .iter()
-                .filter(|r| same_config(r, &g.run) && r.get("status") == "ok")
+                .filter(|r| same_config(r, &g.config) && r.get("status") == "ok")
                 .collect();
             let values = AGGREGATED
                 .iter()
                 .map(|m| mean_ci(&rows.iter().map(|r| r.num(m)).collect::<Vec<_>>()))
                 .collect();
             let first = |c: &str| rows.first().map_or(f64::NAN, |r| r.num(c));
-            let at_figure = (g.run.samples, g.run.light_radius, g.run.lights) == figure;
             let flip = flip
-                .get(&(g.run.scheme, g.run.pattern))
-                .filter(|_| at_figure)
-                .map_or((f64::NAN, f64::NAN), |v| mean_ci(v));
+                .iter()
+                .find(|(c, _)| *c == g.config)
+                .map_or((f64::NAN, f64::NAN), |(_, v)| mean_ci(v));
             Summary {
-                run: g.run,
+                config: g.config.clone(),
                 seeds: rows.len(),
                 values,
                 exact_width_10_90: first("exact_width_10_90"),
@@ -114,7 +112,7 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip, figure: (u32, f64, u32))
         .collect()
 }
 
-fn same_config(r: &Record, run: &Run) -> bool {
+fn same_config(r: &Record, run: &Config) -> bool {
     r.get("scheme") == run.scheme.name()
         && r.get("pattern") == run.pattern.name()
         && r.num("samples") == run.samples as f64
@@ -122,23 +120,9 @@ fn same_config(r: &Record, run: &Run) -> bool {
         && r.num("lights") == run.lights as f64
 }
 
-/// The summary of one configuration, if swept.
-pub fn find(
-    summaries: &[Summary],
-    scheme: DiskScheme,
-    pattern: Pattern,
-    samples: u32,
-    radius: f64,
-    lights: u32,
-) -> Option<&Summary> {
-    summaries.iter().find(|s| {
-        let r = &s.run;
-        r.scheme == scheme
-            && r.pattern == pattern
-            && r.samples == samples
-            && r.light_radius == radius
-            && r.lights == lights
-    })
+/// The summary of `config`, if swept.
+pub fn find<'a>(summaries: &'a [Summary], config: &Config) -> Option<&'a Summary> {
+    summaries.iter().find(|s| s.config == *config)
 }
 
 /// summary.csv header.
@@ -183,11 +167,11 @@ pub fn header() -> Vec<String> {
 /// summary.csv row.
 pub fn row(s: &Summary) -> Vec<String> {
     let mut r = vec![
-        s.run.scheme.to_string(),
-        s.run.pattern.to_string(),
-        s.run.samples.to_string(),
-        num(s.run.light_radius),
-        s.run.lights.to_string(),
+        s.config.scheme.to_string(),
+        s.config.pattern.to_string(),
+        s.config.samples.to_string(),
+        num(s.config.light_radius),
+        s.config.lights.to_string(),
         s.seeds.to_string(),
         num(s.exact_extent_width),
         num(s.exact_width_10_90),

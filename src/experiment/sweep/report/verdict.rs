@@ -6,6 +6,7 @@
 //! (fewer than two seeds) nothing is called different, and the verdict says it needs more seeds.
 
 use super::summary::{find, Summary};
+use crate::experiment::sweep::axes::Config;
 use crate::metrics::BiasVariance;
 use crate::output::numbers::{bias2, or_na, with_ci};
 use crate::sampling::{DiskScheme, Pattern};
@@ -79,18 +80,19 @@ pub struct Verdict {
 }
 
 impl Verdict {
-    /// Builds the verdict for one pattern, if both schemes were swept there.
-    pub fn new(summaries: &[Summary], samples: u32, light_radius: f64, pattern: Pattern) -> Option<Verdict> {
-        let p = find(summaries, DiskScheme::Paper, pattern, samples, light_radius, 1)?;
-        let u = find(summaries, DiskScheme::Uniform, pattern, samples, light_radius, 1)?;
+    /// Builds the verdict at configuration `at` (whatever its scheme), if both schemes were swept
+    /// there.
+    pub fn new(summaries: &[Summary], at: &Config) -> Option<Verdict> {
+        let with = |scheme| find(summaries, &Config { scheme, ..at.clone() });
+        let (p, u) = (with(DiskScheme::Paper)?, with(DiskScheme::Uniform)?);
         let cmp = |m: &str| Compare {
             a: (p.mean(m), p.ci(m)),
             b: (u.mean(m), u.ci(m)),
         };
         Some(Verdict {
-            samples,
-            light_radius,
-            pattern,
+            samples: at.samples,
+            light_radius: at.light_radius,
+            pattern: at.pattern,
             seeds: p.seeds.min(u.seeds),
             extent: cmp("extent_width"),
             width_10_90: cmp("width_10_90"),

@@ -4,6 +4,7 @@
 use super::markdown::{report, verdict_radius};
 use super::pictures::{picture_flip, write_fig2_picture};
 use super::summary::{self, Summary};
+use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::pictures::Pictures;
 use crate::experiment::sweep::run::{num, RUN_COLUMNS};
 use crate::experiment::sweep::runner::{figure_samples, Outcome};
@@ -38,9 +39,7 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
         Some(p) => picture_flip(p)?,
         None => Default::default(),
     };
-    let lights = *r.spec.axes.light_counts.iter().max().expect("validated non-empty");
-    let figure = (figure_samples(r.spec), verdict_radius(r.spec), lights);
-    let summaries = summary::summarise(r.outcome, &flip, figure);
+    let summaries = summary::summarise(r.outcome, &flip);
     write_csv(
         &out.join("runs.csv"),
         &RUN_COLUMNS,
@@ -133,17 +132,17 @@ fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
         "primary_ms",
         "clock",
     ];
-    let rows = |run: &crate::experiment::sweep::Run, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
+    let rows = |config: &Config, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
         c.frame_seconds
             .iter()
             .enumerate()
             .map(|(i, s)| {
                 vec![
-                    run.scheme.to_string(),
-                    run.pattern.to_string(),
-                    run.samples.to_string(),
-                    num(run.light_radius),
-                    run.lights.to_string(),
+                    config.scheme.to_string(),
+                    config.pattern.to_string(),
+                    config.samples.to_string(),
+                    num(config.light_radius),
+                    config.lights.to_string(),
                     probe.to_string(),
                     i.to_string(),
                     num(s * 1e3),
@@ -156,21 +155,24 @@ fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
     let mut all = Vec::new();
     for g in &r.outcome.groups {
         if let Some(c) = t.configs.get(&g.key) {
-            all.extend(rows(&g.run, false, c));
+            all.extend(rows(&g.config, false, c));
         }
     }
-    if let Some((run, c)) = &t.noise {
-        all.extend(rows(run, true, c));
+    if let Some((config, c)) = &t.noise {
+        all.extend(rows(config, true, c));
     }
     write_csv(&out.join("timings.csv"), &header, all)
 }
 
-/// Which summaries a plot shows.
+/// The axes the plots name; each plot is drawn once per value of the others.
+const PLOTS_SHOW: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
+
+/// Which summaries a plot shows: its slice's, at one radius or at one ray count.
 #[derive(Clone, Copy)]
-struct Filter {
+struct Filter<'a> {
     radius: Option<f64>,
     samples: Option<u32>,
-    lights: u32,
+    slice: &'a Slice,
 }
 
 /// Series of one metric against a per-summary x, per scheme (per-pixel solid, shared dashed).
@@ -186,9 +188,11 @@ fn series(
         for pattern in Pattern::ALL {
             let mut pts: Vec<(f64, f64, f64)> = summaries
                 .iter()
-                .filter(|s| s.run.scheme == *scheme && s.run.pattern == pattern && s.run.lights == f.lights)
+                .filter(|s| s.config.scheme == *scheme && s.config.pattern == pattern)
+                .filter(|s| f.slice.holds(&s.config, &PLOTS_SHOW))
                 .filter(|s| {
-                    f.radius.is_none_or(|r| s.run.light_radius == r) && f.samples.is_none_or(|n| s.run.samples == n)
+                    f.radius.is_none_or(|r| s.config.light_radius == r)
+                        && f.samples.is_none_or(|n| s.config.samples == n)
                 })
                 .map(|s| (x(s), s.mean(metric) * scale, s.ci(metric) * scale))
                 .filter(|p| p.1.is_finite())
@@ -210,29 +214,25 @@ fn series(
 }
 
 fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result<()> {
-    let spec = r.spec;
-    for &lights in &spec.axes.light_counts {
-        let suffix = if spec.axes.light_counts.len() > 1 {
-            format!("_{lights}lights")
-        } else {
-            String::new()
-        };
-        plots_for(r, summaries, dir, lights, &suffix)?;
+    for slice in slices(summaries.iter().map(|s| &s.config), &PLOTS_SHOW) {
+        let suffix: String = slice.varying.iter().map(|(a, v)| format!("_{v}{}", a.name())).collect();
+        plots_for(r, summaries, dir, &slice, &suffix)?;
     }
     Ok(())
 }
 
-fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix: &str) -> anyhow::Result<()> {
+fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suffix: &str) -> anyhow::Result<()> {
     use plotters::chart::SeriesLabelPosition::{LowerLeft, LowerRight};
     let spec = r.spec;
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
+    let lights = slice.config.lights;
     let at_radius = Filter {
         radius: Some(radius),
         samples: None,
-        lights,
+        slice,
     };
-    let samples = |s: &Summary| s.run.samples as f64;
+    let samples = |s: &Summary| s.config.samples as f64;
     let file = |name: &str| dir.join(format!("{name}{suffix}.png"));
     let title = |what: &str| format!("{what}, light radius {radius} m, {lights} light(s)");
     line_plot(
@@ -265,12 +265,11 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
         &series(summaries, at_radius, |s| s.frame_ms().1, "rmse", 1.0),
         &[],
     )?;
-    let Some((ri, reference)) = r
+    let Some(reference) = r
         .outcome
         .references
         .iter()
-        .enumerate()
-        .find(|(_, x)| x.light_radius == radius && x.lights == lights)
+        .find(|x| x.light_radius == radius && x.lights == lights)
     else {
         return Ok(());
     };
@@ -339,9 +338,9 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
             Filter {
                 radius: None,
                 samples: Some(n),
-                lights,
+                slice,
             },
-            |s| s.run.light_radius * 1e3,
+            |s| s.config.light_radius * 1e3,
             "extent_width",
             1e3,
         ),
@@ -354,7 +353,14 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, lights: u32, suffix
     let mut profiles = Vec::new();
     for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
         for pattern in Pattern::ALL {
-            if let Some(p) = r.outcome.profiles.get(&(*scheme, pattern, ri)) {
+            let config = Config {
+                scheme: *scheme,
+                pattern,
+                samples: n,
+                light_radius: radius,
+                ..slice.config.clone()
+            };
+            if let Some((_, p)) = r.outcome.profiles.iter().find(|(c, _)| *c == config) {
                 let points = p
                     .radius
                     .iter()
@@ -411,12 +417,11 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
     let n = figure_samples(spec);
     let (w, h) = (spec.measure.width, spec.measure.height);
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    if let Some((ri, reference)) = r
+    if let Some(reference) = r
         .outcome
         .references
         .iter()
-        .enumerate()
-        .find(|(_, x)| x.light_radius == radius && x.lights == lights)
+        .find(|x| x.light_radius == radius && x.lights == lights)
     {
         let gt = &reference.ground_truth;
         write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
@@ -428,7 +433,10 @@ fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
             (DiskScheme::Paper, Pattern::Shared),
             (DiskScheme::Sobol, Pattern::PerPixel),
         ] {
-            if let Some(img) = r.outcome.keep.get(&(scheme, pattern, ri)) {
+            let kept = r.outcome.keep.iter().find(|(c, _)| {
+                c.scheme == scheme && c.pattern == pattern && c.light_radius == radius && c.lights == lights
+            });
+            if let Some((_, img)) = kept {
                 write_exr(&dir.join(format!("{scheme}_{pattern}_{n}.exr")), img, w, h)?;
                 tiles.push((format!("{scheme} ({pattern}), {n} rays"), grey(img, w, h)));
                 errors.push((
