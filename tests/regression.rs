@@ -190,7 +190,7 @@ fn the_paper_width_check_rejects_too_much_widening() {
     let c = ci();
     let max = c.thresholds.paper.max_width_10_90_excess;
     // The exact width shrunk so that the paper's measured width exceeds it by max + 10 %.
-    let paper = |s: &Summary| s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+    let paper = |s: &Summary| s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
     let worst = c
         .summaries
         .iter()

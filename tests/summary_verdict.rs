@@ -33,22 +33,14 @@ fn sweep(seeds: &str) -> (Outcome, Vec<Summary>) {
 fn summaries_match_the_runs_recomputed_by_hand() {
     let (out, summaries) = sweep("seeds = [1, 2, 3]");
     for s in &summaries {
-        let rows: Vec<_> = out
-            .records
-            .iter()
-            .filter(|r| {
-                r.get("scheme") == s.config.scheme.name()
-                    && r.get("pattern") == s.config.pattern.name()
-                    && r.num("samples") == s.config.samples as f64
-            })
-            .collect();
+        let rows: Vec<_> = out.records.iter().filter(|r| r.run.config() == s.config).collect();
         assert_eq!((rows.len(), s.seeds), (3, 3));
-        let x: Vec<f64> = rows.iter().map(|r| r.num("rmse")).collect();
+        let x: Vec<f64> = rows.iter().map(|r| r.metrics.rmse).collect();
         let mean = x.iter().sum::<f64>() / 3.0;
         let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
-        assert!((s.mean("rmse") - mean).abs() < 1e-15);
+        assert!((s.metrics.rmse.mean - mean).abs() < 1e-15);
         // Student's t for 2 degrees of freedom: 4.303.
-        assert!((s.ci("rmse") - 4.303 * sd / 3f64.sqrt()).abs() < 1e-12);
+        assert!((s.metrics.rmse.ci95 - 4.303 * sd / 3f64.sqrt()).abs() < 1e-12);
         // Over the same mask, the mean of the runs' MSE is exactly bias^2 + variance.
         let mse = x.iter().map(|v| v * v).sum::<f64>() / 3.0;
         let split = s.stats.split;

@@ -2,10 +2,11 @@
 //! numbers, report.md and the manifest.
 
 use super::{FpsRow, FpsSpec};
-use crate::experiment::sweep::run::num;
-use crate::files::{write_atomic, write_csv};
+use crate::files::write_atomic;
 use crate::output::plots::{line_plot, Axes, Reference, Series};
+use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
+use serde::Serialize;
 use std::path::Path;
 
 /// Writes fps.csv, plots/fps.png, report.md and manifest.toml under `out`.
@@ -16,11 +17,7 @@ pub fn write_fps(
     seconds: f64,
     out: &Path,
 ) -> anyhow::Result<()> {
-    write_csv(
-        &out.join("fps.csv"),
-        &FPS_COLUMNS,
-        rows.iter().map(|r| fps_row(spec, r, adapter)),
-    )?;
+    write_rows(&out.join("fps.csv"), rows.iter().map(|r| CsvRow::of(spec, r, adapter)))?;
     let mut series = Vec::new();
     let mut refs = Vec::new();
     let pixels: Vec<f64> = spec.resolutions.iter().map(|r| (r[0] * r[1]) as f64 / 1e6).collect();
@@ -113,48 +110,56 @@ pub fn write_fps(
     write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
 }
 
-/// fps.csv header.
-pub const FPS_COLUMNS: [&str; 18] = [
-    "scene",
-    "lights",
-    "width",
-    "height",
-    "samples",
-    "frames",
-    "median_ms",
-    "min_ms",
-    "max_ms",
-    "fps",
-    "paper_fps",
-    "primary_rays",
-    "shadow_rays",
-    "shadow_rays_per_s",
-    "clock",
-    "adapter",
-    "driver",
-    "api",
-];
+/// A row of fps.csv: one timed configuration, with the device.
+#[derive(Serialize)]
+struct CsvRow<'a> {
+    scene: &'a str,
+    lights: u32,
+    width: u32,
+    height: u32,
+    samples: u32,
+    frames: usize,
+    #[serde(with = "float")]
+    median_ms: f64,
+    #[serde(with = "float")]
+    min_ms: f64,
+    #[serde(with = "float")]
+    max_ms: f64,
+    #[serde(with = "float")]
+    fps: f64,
+    #[serde(with = "float")]
+    paper_fps: f64,
+    primary_rays: u64,
+    shadow_rays: u64,
+    #[serde(with = "float")]
+    shadow_rays_per_s: f64,
+    clock: &'a str,
+    adapter: &'a str,
+    driver: &'a str,
+    api: &'a str,
+}
 
-/// fps.csv row.
-pub fn fps_row(spec: &FpsSpec, r: &FpsRow, a: &AdapterInfo) -> Vec<String> {
-    vec![
-        r.scene.clone(),
-        r.lights.to_string(),
-        r.width.to_string(),
-        r.height.to_string(),
-        spec.samples.to_string(),
-        r.frames.to_string(),
-        num(r.median_s * 1e3),
-        num(r.min_s * 1e3),
-        num(r.max_s * 1e3),
-        num(r.fps()),
-        num(r.paper_fps),
-        r.primary_rays.to_string(),
-        r.shadow_rays.to_string(),
-        num(r.shadow_rays_per_s()),
-        r.clock.name().to_string(),
-        a.name.clone(),
-        a.driver.clone(),
-        a.api.clone(),
-    ]
+impl<'a> CsvRow<'a> {
+    fn of(spec: &FpsSpec, r: &'a FpsRow, a: &'a AdapterInfo) -> CsvRow<'a> {
+        CsvRow {
+            scene: &r.scene,
+            lights: r.lights,
+            width: r.width,
+            height: r.height,
+            samples: spec.samples,
+            frames: r.frames,
+            median_ms: r.median_s * 1e3,
+            min_ms: r.min_s * 1e3,
+            max_ms: r.max_s * 1e3,
+            fps: r.fps(),
+            paper_fps: r.paper_fps,
+            primary_rays: r.primary_rays,
+            shadow_rays: r.shadow_rays,
+            shadow_rays_per_s: r.shadow_rays_per_s(),
+            clock: r.clock.name(),
+            adapter: &a.name,
+            driver: &a.driver,
+            api: &a.api,
+        }
+    }
 }

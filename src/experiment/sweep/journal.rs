@@ -4,16 +4,45 @@
 //! ground truth, axis or device gives different keys and the group is rendered again. Timed
 //! frames are journaled apart, under the timing settings' key, when the timing phase finishes.
 
-use super::run::{num, Group, GroupStats, Record, RUN_COLUMNS};
+use super::record::Record;
+use super::run::{Group, GroupStats};
 use super::timing::ConfigTiming;
 use crate::metrics::BiasVariance;
+use crate::output::table::{append_rows, float, read_rows};
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::fs::{self, OpenOptions};
-use std::io::Write;
+use std::fs;
 use std::path::{Path, PathBuf};
 
-const GROUP_COLUMNS: [&str; 5] = ["group_key", "seeds", "bias2", "bias2_ci95", "variance"];
-const TIMING_COLUMNS: [&str; 5] = ["key", "settings", "frame_seconds", "primary_seconds", "clock"];
+/// A completed group's bias/variance split (groups.csv).
+#[derive(Serialize, Deserialize)]
+struct GroupRow {
+    group_key: String,
+    seeds: usize,
+    #[serde(with = "float")]
+    bias2: f64,
+    #[serde(with = "float")]
+    bias2_ci95: f64,
+    #[serde(with = "float")]
+    variance: f64,
+}
+
+/// One timed frame of a configuration (timings.csv). A configuration's frames are appended
+/// together, numbered from 0; a later set under the same key and settings replaces an earlier
+/// one, and a set with fewer than `frames` rows (a torn write) is not taken.
+#[derive(Serialize, Deserialize)]
+struct FrameRow {
+    key: String,
+    settings: String,
+    frames: usize,
+    frame: usize,
+    #[serde(with = "float")]
+    frame_seconds: f64,
+    /// NaN where the clock does not split passes.
+    #[serde(with = "float")]
+    primary_seconds: f64,
+    clock: String,
+}
 
 /// Appending journal in a folder (`runs.csv`, `groups.csv`, `timings.csv`).
 pub struct Journal {
@@ -30,41 +59,52 @@ impl Journal {
             fs::remove_dir_all(dir)?;
         }
         fs::create_dir_all(dir)?;
-        let mut j = Journal {
+        let runs = read_rows::<Record>(&dir.join("runs.csv"))
+            .into_iter()
+            .map(|r| (r.run_key.clone(), r))
+            .collect();
+        let groups = read_rows::<GroupRow>(&dir.join("groups.csv"))
+            .into_iter()
+            .map(|g| {
+                let split = BiasVariance {
+                    seeds: g.seeds,
+                    bias2: g.bias2,
+                    bias2_ci: g.bias2_ci95,
+                    variance: g.variance,
+                };
+                (g.group_key, split)
+            })
+            .collect();
+        let mut sets: HashMap<(String, String), (usize, ConfigTiming)> = HashMap::new();
+        for f in read_rows::<FrameRow>(&dir.join("timings.csv")) {
+            let set = sets
+                .entry((f.key, f.settings))
+                .or_insert_with(|| (0, ConfigTiming::empty()));
+            if f.frame == 0 {
+                *set = (f.frames, ConfigTiming::empty());
+            }
+            let (frames, t) = set;
+            if f.frame != t.frame_seconds.len() || f.frames != *frames {
+                *frames = usize::MAX;
+                continue;
+            }
+            t.frame_seconds.push(f.frame_seconds);
+            if !f.primary_seconds.is_nan() {
+                t.primary_seconds.push(f.primary_seconds);
+            }
+            t.clock = f.clock;
+        }
+        let timings = sets
+            .into_iter()
+            .filter(|(_, (frames, t))| *frames == t.frame_seconds.len())
+            .map(|(k, (_, t))| (k, t))
+            .collect();
+        Ok(Journal {
             dir: dir.to_path_buf(),
-            runs: HashMap::new(),
-            groups: HashMap::new(),
-            timings: HashMap::new(),
-        };
-        for row in read_rows(&j.dir.join("runs.csv"), &RUN_COLUMNS) {
-            j.runs.insert(row[0].clone(), Record(row));
-        }
-        let float = |s: &str| if s.is_empty() { Some(f64::NAN) } else { s.parse().ok() };
-        for row in read_rows(&j.dir.join("groups.csv"), &GROUP_COLUMNS) {
-            if let (Ok(seeds), Some(bias2), Some(bias2_ci), Some(variance)) =
-                (row[1].parse(), float(&row[2]), float(&row[3]), float(&row[4]))
-            {
-                let bv = BiasVariance {
-                    seeds,
-                    bias2,
-                    bias2_ci,
-                    variance,
-                };
-                j.groups.insert(row[0].clone(), bv);
-            }
-        }
-        let list = |s: &str| -> Option<Vec<f64>> { s.split_whitespace().map(|x| x.parse().ok()).collect() };
-        for row in read_rows(&j.dir.join("timings.csv"), &TIMING_COLUMNS) {
-            if let (Some(frame_seconds), Some(primary_seconds)) = (list(&row[2]), list(&row[3])) {
-                let t = ConfigTiming {
-                    frame_seconds,
-                    primary_seconds,
-                    clock: row[4].clone(),
-                };
-                j.timings.insert((row[0].clone(), row[1].clone()), t);
-            }
-        }
-        Ok(j)
+            runs,
+            groups,
+            timings,
+        })
     }
 
     /// The timed frames journaled for `key` under timing settings `settings`.
@@ -74,17 +114,18 @@ impl Journal {
 
     /// Appends timed configurations and flushes them to disk.
     pub fn append_timings(&mut self, settings: &str, timings: &[(String, ConfigTiming)]) -> anyhow::Result<()> {
-        let join = |v: &[f64]| v.iter().map(|x| format!("{x:e}")).collect::<Vec<_>>().join(" ");
-        let rows = timings.iter().map(|(key, t)| {
-            vec![
-                key.clone(),
-                settings.to_string(),
-                join(&t.frame_seconds),
-                join(&t.primary_seconds),
-                t.clock.clone(),
-            ]
+        let rows = timings.iter().flat_map(|(key, t)| {
+            t.frame_seconds.iter().enumerate().map(move |(i, &s)| FrameRow {
+                key: key.clone(),
+                settings: settings.to_string(),
+                frames: t.frame_seconds.len(),
+                frame: i,
+                frame_seconds: s,
+                primary_seconds: t.primary_seconds.get(i).copied().unwrap_or(f64::NAN),
+                clock: t.clock.clone(),
+            })
         });
-        append_rows(&self.dir.join("timings.csv"), &TIMING_COLUMNS, rows)?;
+        append_rows(&self.dir.join("timings.csv"), rows)?;
         for (key, t) in timings {
             self.timings.insert((key.clone(), settings.to_string()), t.clone());
         }
@@ -116,58 +157,17 @@ impl Journal {
         if self.groups.contains_key(group_key) {
             return Ok(());
         }
-        append_rows(
-            &self.dir.join("runs.csv"),
-            &RUN_COLUMNS,
-            records.iter().map(|r| r.0.clone()),
-        )?;
+        append_rows(&self.dir.join("runs.csv"), records)?;
         let s = &stats.split;
-        let row = vec![
-            group_key.to_string(),
-            s.seeds.to_string(),
-            num(s.bias2),
-            num(s.bias2_ci),
-            num(s.variance),
-        ];
-        append_rows(&self.dir.join("groups.csv"), &GROUP_COLUMNS, std::iter::once(row))?;
+        let row = GroupRow {
+            group_key: group_key.to_string(),
+            seeds: s.seeds,
+            bias2: s.bias2,
+            bias2_ci95: s.bias2_ci,
+            variance: s.variance,
+        };
+        append_rows(&self.dir.join("groups.csv"), [row])?;
         self.groups.insert(group_key.to_string(), *s);
         Ok(())
     }
-}
-
-/// Rows of a CSV journal whose header matches `columns`; a torn last line (from a crash) and
-/// rows of the wrong width are dropped.
-fn read_rows(path: &Path, columns: &[&str]) -> Vec<Vec<String>> {
-    let Ok(text) = fs::read_to_string(path) else {
-        return vec![];
-    };
-    let complete = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
-    let mut reader = csv::ReaderBuilder::new()
-        .flexible(true)
-        .from_reader(complete.as_bytes());
-    match reader.headers() {
-        Ok(h) if h.iter().eq(columns.iter().copied()) => {}
-        _ => return vec![],
-    }
-    reader
-        .records()
-        .filter_map(Result::ok)
-        .filter(|r| r.len() == columns.len())
-        .map(|r| r.iter().map(String::from).collect())
-        .collect()
-}
-
-fn append_rows(path: &Path, columns: &[&str], rows: impl Iterator<Item = Vec<String>>) -> anyhow::Result<()> {
-    let new = !path.exists();
-    let mut f = OpenOptions::new().create(true).append(true).open(path)?;
-    let mut w = csv::WriterBuilder::new().from_writer(Vec::new());
-    if new {
-        w.write_record(columns)?;
-    }
-    for r in rows {
-        w.write_record(&r)?;
-    }
-    f.write_all(&w.into_inner()?)?;
-    f.sync_data()?;
-    Ok(())
 }

@@ -1,44 +1,33 @@
-//! One run measured: render it, compare it with its reference, and assemble its record (the
-//! timing columns stay blank until the timing phase fills them).
+//! One run measured: render it, compare it with its reference, and assemble its record (its frame
+//! time stays unmeasured until the timing phase fills it in).
 
+use super::record::{BvhColumns, Device, FrameTime, Metrics, Radial, RayCounts, Record, Status};
 use super::reference::{shadow_image, Reference};
-use super::run::{num, Record, Run, ADAPTER_COLUMNS, IDENTITY_COLUMNS, RUN_COLUMNS};
+use super::run::Run;
 use super::spec::Spec;
 use crate::metrics::{penumbra_coverage, ErrorMetrics, RadialProfile};
 use crate::render::{Backend, Sampling, View};
 use anyhow::Context;
 
-/// Columns of a record between the run's identity and the adapter's.
-const METRIC_COLUMNS: usize = RUN_COLUMNS.len() - IDENTITY_COLUMNS - ADAPTER_COLUMNS;
-
-fn assemble(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, status: &str, error: &str) -> Record {
-    let a = backend.adapter();
-    let mut row = vec![
-        run.key(context),
-        status.to_string(),
-        run.scheme.to_string(),
-        run.pattern.to_string(),
-        run.samples.to_string(),
-        num(run.light_radius),
-        run.lights.to_string(),
-        run.seed.to_string(),
-        spec.measure.width.to_string(),
-        spec.measure.height.to_string(),
-    ];
-    row.extend(std::iter::repeat_n(String::new(), METRIC_COLUMNS));
-    row.extend([
-        a.backend.clone(),
-        a.name.clone(),
-        a.driver.clone(),
-        a.api.clone(),
-        error.to_string(),
-    ]);
-    Record(row)
+/// The record of `run` with nothing measured yet.
+fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, status: Status, error: &str) -> Record {
+    Record {
+        run_key: run.key(context),
+        status,
+        run: run.clone(),
+        radial: Radial::unmeasured(spec.measure.width, spec.measure.height),
+        metrics: Metrics::NONE,
+        rays: RayCounts::default(),
+        time: FrameTime::UNTIMED,
+        bvh: BvhColumns::NONE,
+        device: Device::of(backend.adapter()),
+        error: error.to_string(),
+    }
 }
 
 /// The record of a run that failed, with its error.
 pub fn failed_record(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, error: &str) -> Record {
-    assemble(spec, backend, run, context, "failed", error)
+    unmeasured(spec, backend, run, context, Status::Failed, error)
 }
 
 /// Renders `run` and measures it against `reference`: its record and its shadow image.
@@ -64,59 +53,52 @@ pub fn measure_run(
     let frame = backend.render(&scene, view, sampling).context("render")?;
     let image = shadow_image(&frame.visibility);
     let rays = frame.rays;
-    let mut r = assemble(spec, backend, run, context, "ok", "");
-    for (column, value) in radial_metrics(&image, reference) {
-        r.set(column, num(value));
-    }
+    let mut r = unmeasured(spec, backend, run, context, Status::Ok, "");
+    measure_radial(&image, reference, &mut r);
     let vs_gt = ErrorMetrics::measure(&image, &reference.ground_truth, &reference.mask);
     let rmse_exact = reference
         .exact
         .as_ref()
         .map_or(f64::NAN, |e| ErrorMetrics::measure(&image, e, &reference.mask).rmse);
     let (area_ratio, lost) = penumbra_coverage(&image, &reference.mask, &reference.receivers);
-    for (column, value) in [
-        ("rmse", vs_gt.rmse),
-        ("relmse", vs_gt.relmse),
-        ("bias", vs_gt.bias),
-        ("rmse_exact", rmse_exact),
-        ("penumbra_area_ratio", area_ratio),
-        ("penumbra_lost_share", lost),
-    ] {
-        r.set(column, num(value));
-    }
-    r.set("primary_rays", rays.primary.to_string());
-    r.set("shadow_rays", rays.shadow_total().to_string());
+    let m = &mut r.metrics;
+    (m.rmse, m.relmse, m.bias, m.rmse_exact) = (vs_gt.rmse, vs_gt.relmse, vs_gt.bias, rmse_exact);
+    (m.penumbra_area_ratio, m.penumbra_lost_share) = (area_ratio, lost);
+    r.rays = RayCounts {
+        primary_rays: Some(rays.primary),
+        shadow_rays: Some(rays.shadow_total()),
+    };
     if let Some(b) = &scene.bvh {
-        r.set("bvh_preset", b.preset.name().to_string());
-        r.set("bvh_build_ms", num(b.total_time.as_secs_f64() * 1e3));
-        r.set(
-            "gpu_bytes_per_triangle",
-            num((b.node_count() * 32 + b.tree.primitive_indices.len() * 48) as f64 / b.world.len() as f64),
-        );
+        r.bvh = BvhColumns {
+            bvh_preset: Some(b.preset.name().to_string()),
+            bvh_build_ms: b.total_time.as_secs_f64() * 1e3,
+            gpu_bytes_per_triangle: (b.node_count() * 32 + b.tree.primitive_indices.len() * 48) as f64
+                / b.world.len() as f64,
+        };
     }
     Ok((r, image))
 }
 
 /// The on-axis columns (closed-form radii, exact and measured extents and 10-90 widths, profile
-/// bias); none when the scene has no rotationally symmetric exact shadow.
-fn radial_metrics(image: &[f32], reference: &Reference) -> Vec<(&'static str, f64)> {
+/// bias); left unmeasured when the scene has no rotationally symmetric exact shadow.
+fn measure_radial(image: &[f32], reference: &Reference, r: &mut Record) {
     let (Some(o), Some(exact)) = (&reference.on_axis, &reference.exact_profile) else {
-        return vec![];
+        return;
     };
     let profile = RadialProfile::new(&reference.receivers, image);
     let (inner, outer) = profile.extent();
     let (ex_in, ex_out) = exact.extent();
     let (bias, abs_bias) = profile.bias_against(exact);
-    vec![
-        ("exact_umbra_radius", o.umbra_radius()),
-        ("exact_penumbra_radius", o.penumbra_radius()),
-        ("exact_extent_width", ex_out - ex_in),
-        ("exact_width_10_90", exact.width_10_90()),
-        ("extent_inner", inner),
-        ("extent_outer", outer),
-        ("extent_width", outer - inner),
-        ("width_10_90", profile.width_10_90()),
-        ("profile_bias", bias),
-        ("profile_abs_bias", abs_bias),
-    ]
+    r.radial = Radial {
+        exact_umbra_radius: o.umbra_radius(),
+        exact_penumbra_radius: o.penumbra_radius(),
+        exact_extent_width: ex_out - ex_in,
+        exact_width_10_90: exact.width_10_90(),
+        extent_inner: inner,
+        extent_outer: outer,
+        ..r.radial
+    };
+    let m = &mut r.metrics;
+    (m.extent_width, m.width_10_90) = (outer - inner, profile.width_10_90());
+    (m.profile_bias, m.profile_abs_bias) = (bias, abs_bias);
 }

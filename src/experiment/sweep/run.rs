@@ -1,6 +1,4 @@
-//! The sweep expanded into groups of runs, and the keys that tell runs apart across sweeps; and
-//! records (a run plus everything measured on it): plain data, one record per row of runs.csv in
-//! tidy form.
+//! The sweep expanded into groups of runs, and the keys that tell runs apart across sweeps.
 
 use super::axes::Config;
 pub use super::axes::Run;
@@ -87,91 +85,5 @@ impl Run {
     pub fn key(&self, context: &str) -> String {
         let text = format!("{context};{}", self.key_text());
         format!("{:016x}", fnv1a(text.as_bytes()))
-    }
-}
-
-/// Formats a float for CSV: shortest round-trip representation, empty for NaN.
-pub fn num(x: f64) -> String {
-    if x.is_nan() {
-        String::new()
-    } else {
-        format!("{x}")
-    }
-}
-
-/// Columns of runs.csv, in order. Each is defined in `metrics` or README.md.
-pub const RUN_COLUMNS: [&str; 44] = [
-    "run_key",
-    "status",
-    "scheme",
-    "pattern",
-    "samples",
-    "light_radius",
-    "lights",
-    "seed",
-    "width",
-    "height",
-    "exact_umbra_radius",
-    "exact_penumbra_radius",
-    "exact_extent_width",
-    "exact_width_10_90",
-    "extent_inner",
-    "extent_outer",
-    "extent_width",
-    "width_10_90",
-    "profile_bias",
-    "profile_abs_bias",
-    "rmse",
-    "relmse",
-    "bias",
-    "rmse_exact",
-    "penumbra_area_ratio",
-    "penumbra_lost_share",
-    "primary_rays",
-    "shadow_rays",
-    "frame_ms",
-    "frame_ms_q1",
-    "frame_ms_q3",
-    "timed_frames",
-    "rays_per_s",
-    "primary_rays_per_s",
-    "shadow_rays_per_s",
-    "clock",
-    "bvh_preset",
-    "bvh_build_ms",
-    "gpu_bytes_per_triangle",
-    "backend",
-    "adapter",
-    "driver",
-    "api",
-    "error",
-];
-
-/// Columns naming the run (before the metrics).
-pub const IDENTITY_COLUMNS: usize = 10;
-/// Columns naming the device (after the metrics).
-pub const ADAPTER_COLUMNS: usize = 5;
-
-/// One row of runs.csv, as strings in [`RUN_COLUMNS`] order (kept as text so a resumed sweep
-/// reproduces earlier rows byte for byte).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Record(pub Vec<String>);
-
-impl Record {
-    /// The value of `column`.
-    pub fn get(&self, column: &str) -> &str {
-        let i = RUN_COLUMNS.iter().position(|c| *c == column).expect("known column");
-        &self.0[i]
-    }
-
-    /// The value of `column` as a number (NaN when empty).
-    pub fn num(&self, column: &str) -> f64 {
-        self.get(column).parse().unwrap_or(f64::NAN)
-    }
-
-    /// Sets `column` to `value`.
-    pub fn set(&mut self, column: &str, value: String) {
-        let i = RUN_COLUMNS.iter().position(|c| *c == column).expect("known column");
-        self.0[i] = value;
     }
 }

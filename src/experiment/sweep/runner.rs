@@ -5,8 +5,9 @@
 use super::axes::Config;
 use super::journal::Journal;
 use super::measure::{failed_record, measure_run};
+use super::record::{FrameTime, Record, Status};
 use super::reference::Reference;
-use super::run::{context_key, expand, num, Group, GroupStats, Record};
+use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
 use crate::metrics::{BiasVariance, RadialProfile};
@@ -139,7 +140,7 @@ pub fn run_sweep(
             if needed_for_figures {
                 keep_for_figures(&mut out, &reference, group.config(), &images);
             }
-            let failed = records.iter().filter(|r| r.get("status") != "ok").count();
+            let failed = records.iter().filter(|r| r.status != Status::Ok).count();
             out.failures += failed;
             if failed == 0 {
                 journal.append(&group.key(&context), &records, &stats)?;
@@ -172,9 +173,7 @@ fn time_sweep(
         .iter()
         .filter(|g| {
             let key = g.head().key(context);
-            out.records
-                .iter()
-                .any(|r| r.get("run_key") == key && r.get("status") == "ok")
+            out.records.iter().any(|r| r.run_key == key && r.status == Status::Ok)
         })
         .collect();
     let probe = timing::noise_probe(&rendered, figure_samples(spec), verdict_radius(spec));
@@ -236,32 +235,35 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
             g.runs.iter().map(move |r| (r.key(context), gk.clone()))
         })
         .collect();
+    let count = |n: Option<u64>| n.map_or(f64::NAN, |n| n as f64);
     let rays: HashMap<String, (f64, f64)> = out
         .records
         .iter()
         .map(|r| {
             (
-                r.get("run_key").to_string(),
-                (r.num("primary_rays"), r.num("shadow_rays")),
+                r.run_key.clone(),
+                (count(r.rays.primary_rays), count(r.rays.shadow_rays)),
             )
         })
         .collect();
-    for r in out.records.iter_mut().filter(|r| r.get("status") == "ok") {
-        let Some(gk) = group_of.get(r.get("run_key")) else {
+    for r in out.records.iter_mut().filter(|r| r.status == Status::Ok) {
+        let Some(gk) = group_of.get(&r.run_key) else {
             continue;
         };
         let Some(t) = out.timings.configs.get(gk) else { continue };
         let (q1, med, q3) = t.frame_ms();
         let (primary, shadow) = rays[gk];
         let (seconds, primary_seconds) = (med * 1e-3, t.primary_median());
-        r.set("frame_ms", num(med));
-        r.set("frame_ms_q1", num(q1));
-        r.set("frame_ms_q3", num(q3));
-        r.set("timed_frames", t.frame_seconds.len().to_string());
-        r.set("rays_per_s", num((primary + shadow) / seconds));
-        r.set("primary_rays_per_s", num(primary / primary_seconds));
-        r.set("shadow_rays_per_s", num(shadow / (seconds - primary_seconds)));
-        r.set("clock", t.clock.clone());
+        r.time = FrameTime {
+            frame_ms: med,
+            frame_ms_q1: q1,
+            frame_ms_q3: q3,
+            timed_frames: Some(t.frame_seconds.len()),
+            rays_per_s: (primary + shadow) / seconds,
+            primary_rays_per_s: primary / primary_seconds,
+            shadow_rays_per_s: shadow / (seconds - primary_seconds),
+            clock: Some(t.clock.clone()),
+        };
     }
 }
 

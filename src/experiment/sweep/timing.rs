@@ -33,6 +33,15 @@ pub struct ConfigTiming {
 }
 
 impl ConfigTiming {
+    /// No frames yet.
+    pub fn empty() -> ConfigTiming {
+        ConfigTiming {
+            frame_seconds: vec![],
+            primary_seconds: vec![],
+            clock: String::new(),
+        }
+    }
+
     /// First quartile, median and third quartile of the frame time, in milliseconds.
     pub fn frame_ms(&self) -> (f64, f64, f64) {
         let (a, b, c) = quartiles(&self.frame_seconds);
@@ -150,14 +159,7 @@ pub fn time_groups(
     if let Some(g) = noise {
         entries.extend((0..NOISE_VISITS).map(|_| (groups.len(), g.head())));
     }
-    let mut out = vec![
-        ConfigTiming {
-            frame_seconds: vec![],
-            primary_seconds: vec![],
-            clock: String::new(),
-        };
-        groups.len() + 1
-    ];
+    let mut out = vec![ConfigTiming::empty(); groups.len() + 1];
     for round in 0..t.repeats {
         for k in order(entries.len(), round) {
             let (slot, run) = entries[k];

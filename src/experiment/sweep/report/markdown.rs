@@ -214,22 +214,22 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32,
             .collect();
         rows.sort_by_key(|x| x.config.samples);
         let noise = outcome.timings.noise.as_ref().map(|n| &n.1);
-        let matched = match uniform.filter(|u| u.mean("rmse").is_finite()) {
+        let matched = match uniform.filter(|u| u.metrics.rmse.mean.is_finite()) {
             None => "n/a".to_string(),
-            Some(u) => rows
-                .iter()
-                .find(|x| x.mean("rmse") <= u.mean("rmse"))
-                .map_or("not reached".to_string(), |x| {
+            Some(u) => rows.iter().find(|x| x.metrics.rmse.mean <= u.metrics.rmse.mean).map_or(
+                "not reached".to_string(),
+                |x| {
                     let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), noise);
                     format!("{} rays, {}, {rank}", x.config.samples, ms_iqr(x.frame_ms()))
-                }),
+                },
+            ),
         };
         s += &format!(
             "| {} | {} | {} | {} | {} | {} | {} |\n",
             scheme,
-            or_na(at.mean("rmse"), |x| format!("{x:.4}")),
-            or_na(at.flip.0, |x| format!("{x:.4}")),
-            or_na(at.mean("penumbra_lost_share"), |x| format!("{x:.3}")),
+            or_na(at.metrics.rmse.mean, |x| format!("{x:.4}")),
+            or_na(at.flip.mean, |x| format!("{x:.4}")),
+            or_na(at.metrics.penumbra_lost_share.mean, |x| format!("{x:.3}")),
             ms_iqr(at.frame_ms()),
             or_na(at.rays_per_s[0], |x| format!("{x:.3e}")),
             matched

@@ -3,39 +3,26 @@
 //! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
 use crate::experiment::sweep::axes::Config;
-use crate::experiment::sweep::run::num;
+use crate::experiment::sweep::record::{Aggregated, Metrics, Record, Status};
 use crate::experiment::sweep::run::GroupStats;
 use crate::experiment::sweep::runner::Outcome;
 use crate::experiment::sweep::timing::ConfigTiming;
-use crate::experiment::sweep::Record;
-use crate::metrics::stats::mean_ci;
-
-/// Metrics aggregated over seeds as mean and CI half-width.
-pub const AGGREGATED: [&str; 10] = [
-    "extent_width",
-    "width_10_90",
-    "profile_bias",
-    "profile_abs_bias",
-    "rmse",
-    "relmse",
-    "bias",
-    "rmse_exact",
-    "penumbra_area_ratio",
-    "penumbra_lost_share",
-];
+use crate::metrics::stats::{mean_ci, MeanCi};
+use crate::output::table::float;
+use serde::{Serialize, Serializer};
 
 /// FLIP of each seed's picture, per configuration that has pictures.
 pub type PictureFlip = Vec<(Config, Vec<f64>)>;
 
-/// One configuration (all axes but the seed) summarised.
+/// One configuration (all axes but the seed) summarised: a row of summary.csv.
 #[derive(Clone, Debug)]
 pub struct Summary {
     /// The configuration.
     pub config: Config,
     /// Seeds that rendered.
     pub seeds: usize,
-    /// (mean, ci95 half-width) per [`AGGREGATED`] metric.
-    pub values: Vec<(f64, f64)>,
+    /// The runs' metrics over those seeds.
+    pub metrics: Aggregated,
     /// Exact 10-90 width of the configuration's light radius.
     pub exact_width_10_90: f64,
     /// Exact extent width (from the exact image, read with the same annulus as the runs).
@@ -48,31 +35,17 @@ pub struct Summary {
     pub timing: Option<ConfigTiming>,
     /// Rays per second at the median frame time: all, primary, shadow.
     pub rays_per_s: [f64; 3],
-    /// Mean and 95 % CI half-width of the FLIP of its pictures over seeds (NaN without pictures).
-    pub flip: (f64, f64),
+    /// FLIP of its pictures over seeds (NaN without pictures).
+    pub flip: MeanCi,
 }
 
 impl Summary {
-    /// Mean of metric `name`.
-    pub fn mean(&self, name: &str) -> f64 {
-        self.values[index(name)].0
-    }
-
-    /// 95 % CI half-width of metric `name`.
-    pub fn ci(&self, name: &str) -> f64 {
-        self.values[index(name)].1
-    }
-
     /// First quartile, median and third quartile of the frame time (ms); NaN when untimed.
     pub fn frame_ms(&self) -> (f64, f64, f64) {
         self.timing
             .as_ref()
             .map_or((f64::NAN, f64::NAN, f64::NAN), ConfigTiming::frame_ms)
     }
-}
-
-fn index(name: &str) -> usize {
-    AGGREGATED.iter().position(|m| *m == name).expect("aggregated metric")
 }
 
 /// Summaries of every group of the outcome, in canonical order; `flip` gives the picture errors
@@ -85,39 +58,34 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip) -> Vec<Summary> {
             let rows: Vec<&Record> = outcome
                 .records
                 .iter()
-                .filter(|r| same_config(r, &g.config) && r.get("status") == "ok")
+                .filter(|r| r.status == Status::Ok && r.run.config() == g.config)
                 .collect();
-            let values = AGGREGATED
-                .iter()
-                .map(|m| mean_ci(&rows.iter().map(|r| r.num(m)).collect::<Vec<_>>()))
-                .collect();
-            let first = |c: &str| rows.first().map_or(f64::NAN, |r| r.num(c));
+            let metrics: Vec<&Metrics> = rows.iter().map(|r| &r.metrics).collect();
+            let first = rows.first();
+            let radial = |f: fn(&Record) -> f64| first.map_or(f64::NAN, |r| f(r));
             let flip = flip
                 .iter()
                 .find(|(c, _)| *c == g.config)
-                .map_or((f64::NAN, f64::NAN), |(_, v)| mean_ci(v));
+                .map_or(MeanCi::NAN, |(_, v)| mean_ci(v));
             Summary {
                 config: g.config.clone(),
                 seeds: rows.len(),
-                values,
-                exact_width_10_90: first("exact_width_10_90"),
-                exact_extent_width: first("exact_extent_width"),
-                closed_form_width: first("exact_penumbra_radius") - first("exact_umbra_radius").max(0.0),
+                metrics: Metrics::aggregate(&metrics),
+                exact_width_10_90: radial(|r| r.radial.exact_width_10_90),
+                exact_extent_width: radial(|r| r.radial.exact_extent_width),
+                closed_form_width: radial(|r| r.radial.exact_penumbra_radius)
+                    - radial(|r| r.radial.exact_umbra_radius).max(0.0),
                 stats: g.clone(),
                 timing: outcome.timings.configs.get(&g.key).cloned(),
-                rays_per_s: ["rays_per_s", "primary_rays_per_s", "shadow_rays_per_s"].map(first),
+                rays_per_s: [
+                    radial(|r| r.time.rays_per_s),
+                    radial(|r| r.time.primary_rays_per_s),
+                    radial(|r| r.time.shadow_rays_per_s),
+                ],
                 flip,
             }
         })
         .collect()
-}
-
-fn same_config(r: &Record, run: &Config) -> bool {
-    r.get("scheme") == run.scheme.name()
-        && r.get("pattern") == run.pattern.name()
-        && r.num("samples") == run.samples as f64
-        && r.num("light_radius") == run.light_radius
-        && r.num("lights") == run.lights as f64
 }
 
 /// The summary of `config`, if swept.
@@ -125,79 +93,72 @@ pub fn find<'a>(summaries: &'a [Summary], config: &Config) -> Option<&'a Summary
     summaries.iter().find(|s| s.config == *config)
 }
 
-/// summary.csv header.
-pub fn header() -> Vec<String> {
-    let mut h: Vec<String> = [
-        "scheme",
-        "pattern",
-        "samples",
-        "light_radius",
-        "lights",
-        "seeds",
-        "exact_extent_width",
-        "exact_width_10_90",
-    ]
-    .map(String::from)
-    .to_vec();
-    for m in AGGREGATED {
-        h.push(format!("{m}_mean"));
-        h.push(format!("{m}_ci95"));
-    }
-    h.extend(
-        [
-            "frame_ms_median",
-            "frame_ms_q1",
-            "frame_ms_q3",
-            "timed_frames",
-            "rays_per_s",
-            "primary_rays_per_s",
-            "shadow_rays_per_s",
-            "bias2",
-            "bias2_ci95",
-            "variance",
-            "pixel_std",
-            "flip_mean",
-            "flip_ci95",
-        ]
-        .map(String::from),
-    );
-    h
+/// The columns after the configuration's.
+#[derive(Serialize)]
+struct Head {
+    seeds: usize,
+    #[serde(with = "float")]
+    exact_extent_width: f64,
+    #[serde(with = "float")]
+    exact_width_10_90: f64,
 }
 
-/// summary.csv row.
-pub fn row(s: &Summary) -> Vec<String> {
-    let mut r = vec![
-        s.config.scheme.to_string(),
-        s.config.pattern.to_string(),
-        s.config.samples.to_string(),
-        num(s.config.light_radius),
-        s.config.lights.to_string(),
-        s.seeds.to_string(),
-        num(s.exact_extent_width),
-        num(s.exact_width_10_90),
-    ];
-    for (m, c) in &s.values {
-        r.push(num(*m));
-        r.push(num(*c));
+/// The columns after the aggregated metrics.
+#[derive(Serialize)]
+struct Tail {
+    #[serde(with = "float")]
+    frame_ms_median: f64,
+    #[serde(with = "float")]
+    frame_ms_q1: f64,
+    #[serde(with = "float")]
+    frame_ms_q3: f64,
+    timed_frames: Option<usize>,
+    #[serde(with = "float")]
+    rays_per_s: f64,
+    #[serde(with = "float")]
+    primary_rays_per_s: f64,
+    #[serde(with = "float")]
+    shadow_rays_per_s: f64,
+    #[serde(with = "float")]
+    bias2: f64,
+    #[serde(with = "float")]
+    bias2_ci95: f64,
+    #[serde(with = "float")]
+    variance: f64,
+    #[serde(with = "float")]
+    pixel_std: f64,
+    #[serde(with = "float")]
+    flip_mean: f64,
+    #[serde(with = "float")]
+    flip_ci95: f64,
+}
+
+/// A row of summary.csv: the configuration's axes, then the summary's columns.
+impl Serialize for Summary {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let head = Head {
+            seeds: self.seeds,
+            exact_extent_width: self.exact_extent_width,
+            exact_width_10_90: self.exact_width_10_90,
+        };
+        let (q1, med, q3) = self.frame_ms();
+        let split = &self.stats.split;
+        let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] = self.rays_per_s;
+        let tail = Tail {
+            frame_ms_median: med,
+            frame_ms_q1: q1,
+            frame_ms_q3: q3,
+            timed_frames: self.timing.as_ref().map(|t| t.frame_seconds.len()),
+            rays_per_s,
+            primary_rays_per_s,
+            shadow_rays_per_s,
+            bias2: split.bias2,
+            bias2_ci95: split.bias2_ci,
+            variance: split.variance,
+            pixel_std: split.variance.sqrt(),
+            flip_mean: self.flip.mean,
+            flip_ci95: self.flip.ci95,
+        };
+        (&self.config, head, &self.metrics, tail).serialize(s)
     }
-    let (q1, med, q3) = s.frame_ms();
-    let split = &s.stats.split;
-    r.extend([
-        num(med),
-        num(q1),
-        num(q3),
-        s.timing
-            .as_ref()
-            .map_or(String::new(), |t| t.frame_seconds.len().to_string()),
-    ]);
-    r.extend(s.rays_per_s.map(num));
-    r.extend([
-        num(split.bias2),
-        num(split.bias2_ci),
-        num(split.variance),
-        num(split.variance.sqrt()),
-        num(s.flip.0),
-        num(s.flip.1),
-    ]);
-    r
 }

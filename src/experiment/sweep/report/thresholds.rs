@@ -165,7 +165,7 @@ impl Thresholds {
                     ),
                 ));
             }
-            let rel = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+            let rel = s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
             out.push(check(
                 rel.abs() <= t.width_10_90_tolerance,
                 format!(
@@ -194,7 +194,7 @@ impl Thresholds {
         let t = &self.paper;
         let out: Vec<Check> = at_counts(summaries, scheme, radius, 16)
             .map(|s| {
-                let excess = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+                let excess = s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
                 check(
                     excess >= t.min_width_10_90_excess && excess <= t.max_width_10_90_excess,
                     format!(
@@ -223,7 +223,7 @@ impl Thresholds {
         let rmse = |s: DiskScheme, n: u32| {
             at_counts(summaries, s, radius, n)
                 .find(|x| x.config.samples == n)
-                .map_or(f64::NAN, |x| x.mean("rmse"))
+                .map_or(f64::NAN, |x| x.metrics.rmse.mean)
         };
         let ratio = rmse(scheme, 64) / rmse(scheme, 4);
         let sobol = rmse(better, 16) / rmse(than, 16);

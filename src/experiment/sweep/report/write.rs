@@ -6,15 +6,18 @@ use super::pictures::{picture_flip, write_fig2_picture};
 use super::summary::{self, Summary};
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::pictures::Pictures;
-use crate::experiment::sweep::run::{num, RUN_COLUMNS};
+use crate::experiment::sweep::record::Aggregated;
 use crate::experiment::sweep::runner::{figure_samples, Outcome};
 use crate::experiment::sweep::timing::ConfigTiming;
 use crate::experiment::sweep::Spec;
-use crate::files::{write_atomic, write_csv};
+use crate::files::write_atomic;
+use crate::metrics::stats::MeanCi;
 use crate::output::images::{diverging, grey, write_exr, Rgb};
 use crate::output::plots::{image_grid, line_plot, Axes, Reference as RefLine, Series};
+use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
+use serde::Serialize;
 use std::path::Path;
 
 /// Everything a sweep produced, ready to write.
@@ -40,17 +43,8 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
         None => Default::default(),
     };
     let summaries = summary::summarise(r.outcome, &flip);
-    write_csv(
-        &out.join("runs.csv"),
-        &RUN_COLUMNS,
-        r.outcome.records.iter().map(|x| x.0.clone()),
-    )?;
-    let header = summary::header();
-    write_csv(
-        &out.join("summary.csv"),
-        &header.iter().map(String::as_str).collect::<Vec<_>>(),
-        summaries.iter().map(summary::row),
-    )?;
+    write_rows(&out.join("runs.csv"), &r.outcome.records)?;
+    write_rows(&out.join("summary.csv"), &summaries)?;
     write_ground_truth(r, out)?;
     write_timings(r, out)?;
     write_plots(r, &summaries, &out.join("plots"))?;
@@ -62,26 +56,42 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
     write_atomic(&out.join("manifest.toml"), manifest(r).as_bytes())
 }
 
+/// A row of ground_truth.csv: one reference (lights on, light radius) and its checks.
+#[derive(Serialize)]
+struct GroundTruthRow {
+    lights: u32,
+    #[serde(with = "float")]
+    light_radius: f64,
+    ground_truth_samples: u32,
+    #[serde(with = "float")]
+    exact_umbra_radius: f64,
+    #[serde(with = "float")]
+    exact_penumbra_radius: f64,
+    #[serde(with = "float")]
+    exact_extent_inner: f64,
+    #[serde(with = "float")]
+    exact_extent_outer: f64,
+    #[serde(with = "float")]
+    exact_width_10_90: f64,
+    #[serde(with = "float")]
+    gt_extent_inner: f64,
+    #[serde(with = "float")]
+    gt_extent_outer: f64,
+    #[serde(with = "float")]
+    gt_width_10_90: f64,
+    #[serde(with = "float")]
+    gt_max_abs_error: f64,
+    #[serde(with = "float")]
+    gt_rmse_penumbra: f64,
+    #[serde(with = "float")]
+    gt_bias_penumbra: f64,
+    penumbra_pixels: usize,
+    #[serde(with = "float")]
+    exact_max_error_bound: f64,
+    exact_depth_limited_pixels: Option<usize>,
+}
+
 fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
-    let header = [
-        "lights",
-        "light_radius",
-        "ground_truth_samples",
-        "exact_umbra_radius",
-        "exact_penumbra_radius",
-        "exact_extent_inner",
-        "exact_extent_outer",
-        "exact_width_10_90",
-        "gt_extent_inner",
-        "gt_extent_outer",
-        "gt_width_10_90",
-        "gt_max_abs_error",
-        "gt_rmse_penumbra",
-        "gt_bias_penumbra",
-        "penumbra_pixels",
-        "exact_max_error_bound",
-        "exact_depth_limited_pixels",
-    ];
     let nan2 = (f64::NAN, f64::NAN);
     let rows = r.outcome.references.iter().map(|x| {
         let (ru, rp) = x
@@ -90,28 +100,39 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
             .map_or(nan2, |o| (o.umbra_radius(), o.penumbra_radius()));
         let (ei, eo) = x.exact_profile.as_ref().map_or(nan2, |p| p.extent());
         let (gi, go) = x.gt_profile().map_or(nan2, |p| p.extent());
-        vec![
-            x.lights.to_string(),
-            num(x.light_radius),
-            r.spec.ground_truth.samples.to_string(),
-            num(ru),
-            num(rp),
-            num(ei),
-            num(eo),
-            num(x.exact_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90())),
-            num(gi),
-            num(go),
-            num(x.gt_profile().map_or(f64::NAN, |p| p.width_10_90())),
-            num(x.gt_max_abs_all().unwrap_or(f64::NAN)),
-            num(x.gt_vs_exact().map_or(f64::NAN, |e| e.rmse)),
-            num(x.gt_vs_exact().map_or(f64::NAN, |e| e.bias)),
-            x.mask.pixels.len().to_string(),
-            num(x.exact_quality.map_or(f64::NAN, |q| q.max_error_bound)),
-            x.exact_quality
-                .map_or(String::new(), |q| q.depth_limited_pixels.to_string()),
-        ]
+        GroundTruthRow {
+            lights: x.lights,
+            light_radius: x.light_radius,
+            ground_truth_samples: r.spec.ground_truth.samples,
+            exact_umbra_radius: ru,
+            exact_penumbra_radius: rp,
+            exact_extent_inner: ei,
+            exact_extent_outer: eo,
+            exact_width_10_90: x.exact_profile.as_ref().map_or(f64::NAN, |p| p.width_10_90()),
+            gt_extent_inner: gi,
+            gt_extent_outer: go,
+            gt_width_10_90: x.gt_profile().map_or(f64::NAN, |p| p.width_10_90()),
+            gt_max_abs_error: x.gt_max_abs_all().unwrap_or(f64::NAN),
+            gt_rmse_penumbra: x.gt_vs_exact().map_or(f64::NAN, |e| e.rmse),
+            gt_bias_penumbra: x.gt_vs_exact().map_or(f64::NAN, |e| e.bias),
+            penumbra_pixels: x.mask.pixels.len(),
+            exact_max_error_bound: x.exact_quality.map_or(f64::NAN, |q| q.max_error_bound),
+            exact_depth_limited_pixels: x.exact_quality.map(|q| q.depth_limited_pixels),
+        }
     });
-    write_csv(&out.join("ground_truth.csv"), &header, rows)
+    write_rows(&out.join("ground_truth.csv"), rows)
+}
+
+/// A row of timings.csv after its configuration's columns: one timed frame.
+#[derive(Serialize)]
+struct TimedFrame {
+    noise_probe: bool,
+    frame: usize,
+    #[serde(with = "float")]
+    frame_ms: f64,
+    #[serde(with = "float")]
+    primary_ms: f64,
+    clock: String,
 }
 
 /// timings.csv: every timed frame, one row each, so the spread behind each median can be seen.
@@ -120,48 +141,32 @@ fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
     if t.configs.is_empty() {
         return Ok(());
     }
-    let header = [
-        "scheme",
-        "pattern",
-        "samples",
-        "light_radius",
-        "lights",
-        "noise_probe",
-        "frame",
-        "frame_ms",
-        "primary_ms",
-        "clock",
-    ];
-    let rows = |config: &Config, probe: bool, c: &ConfigTiming| -> Vec<Vec<String>> {
+    let frames = |config: &Config, noise_probe: bool, c: &ConfigTiming| {
         c.frame_seconds
             .iter()
             .enumerate()
             .map(|(i, s)| {
-                vec![
-                    config.scheme.to_string(),
-                    config.pattern.to_string(),
-                    config.samples.to_string(),
-                    num(config.light_radius),
-                    config.lights.to_string(),
-                    probe.to_string(),
-                    i.to_string(),
-                    num(s * 1e3),
-                    num(c.primary_seconds.get(i).map_or(f64::NAN, |p| p * 1e3)),
-                    c.clock.clone(),
-                ]
+                let frame = TimedFrame {
+                    noise_probe,
+                    frame: i,
+                    frame_ms: s * 1e3,
+                    primary_ms: c.primary_seconds.get(i).map_or(f64::NAN, |p| p * 1e3),
+                    clock: c.clock.clone(),
+                };
+                (config.clone(), frame)
             })
-            .collect()
+            .collect::<Vec<_>>()
     };
     let mut all = Vec::new();
     for g in &r.outcome.groups {
         if let Some(c) = t.configs.get(&g.key) {
-            all.extend(rows(&g.config, false, c));
+            all.extend(frames(&g.config, false, c));
         }
     }
     if let Some((config, c)) = &t.noise {
-        all.extend(rows(config, true, c));
+        all.extend(frames(config, true, c));
     }
-    write_csv(&out.join("timings.csv"), &header, all)
+    write_rows(&out.join("timings.csv"), all)
 }
 
 /// The axes the plots name; each plot is drawn once per value of the others.
@@ -180,7 +185,7 @@ fn series(
     summaries: &[Summary],
     f: Filter,
     x: impl Fn(&Summary) -> f64,
-    metric: &str,
+    metric: fn(&Aggregated) -> MeanCi,
     scale: f64,
 ) -> Vec<(usize, Series)> {
     let mut out = Vec::new();
@@ -194,7 +199,10 @@ fn series(
                     f.radius.is_none_or(|r| s.config.light_radius == r)
                         && f.samples.is_none_or(|n| s.config.samples == n)
                 })
-                .map(|s| (x(s), s.mean(metric) * scale, s.ci(metric) * scale))
+                .map(|s| {
+                    let m = metric(&s.metrics);
+                    (x(s), m.mean * scale, m.ci95 * scale)
+                })
                 .filter(|p| p.1.is_finite())
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -247,7 +255,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
                 true,
             )
         },
-        &series(summaries, at_radius, samples, "rmse", 1.0),
+        &series(summaries, at_radius, samples, |m| m.rmse, 1.0),
         &[],
     )?;
     line_plot(
@@ -262,7 +270,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
                 true,
             )
         },
-        &series(summaries, at_radius, |s| s.frame_ms().1, "rmse", 1.0),
+        &series(summaries, at_radius, |s| s.frame_ms().1, |m| m.rmse, 1.0),
         &[],
     )?;
     let Some(reference) = r
@@ -297,7 +305,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             false,
         ),
-        &series(summaries, at_radius, samples, "extent_width", 1e3),
+        &series(summaries, at_radius, samples, |m| m.extent_width, 1e3),
         &flat("exact extent", b - a),
     )?;
     line_plot(
@@ -309,7 +317,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             false,
         ),
-        &series(summaries, at_radius, samples, "width_10_90", 1e3),
+        &series(summaries, at_radius, samples, |m| m.width_10_90, 1e3),
         &flat("exact 10-90 %", exact.width_10_90()),
     )?;
     let mut exact_vs_radius: Vec<(f64, f64)> = r
@@ -341,7 +349,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
                 slice,
             },
             |s| s.config.light_radius * 1e3,
-            "extent_width",
+            |m| m.extent_width,
             1e3,
         ),
         &[RefLine {
