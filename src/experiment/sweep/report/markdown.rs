@@ -4,14 +4,12 @@
 use super::summary::{find, Summary};
 use super::verdict::Verdict;
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
-use crate::experiment::sweep::runner::{figure_samples, Outcome};
+use crate::experiment::sweep::runner::{figure_samples, verdict_radius, Outcome};
 use crate::experiment::sweep::timing::{faster, ConfigTiming};
 use crate::experiment::sweep::Spec;
 use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
-
-pub use crate::experiment::sweep::runner::verdict_radius;
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
     or_na(x.unwrap_or(f64::NAN), f)
