@@ -10,6 +10,7 @@ use super::reference::Reference;
 use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
+use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::render::{Backend, RenderPlan, View};
 use std::collections::HashMap;
@@ -253,15 +254,16 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
         let Some(t) = out.timings.configs.get(gk) else { continue };
         let (q1, med, q3) = t.frame_ms();
         let (primary, shadow) = rays[gk];
-        let (seconds, primary_seconds) = (med * 1e-3, t.primary_median());
+        let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] =
+            rays_per_second(primary, shadow, med * 1e-3, t.primary_median());
         r.time = FrameTime {
             frame_ms: med,
             frame_ms_q1: q1,
             frame_ms_q3: q3,
             timed_frames: Some(t.frame_seconds.len()),
-            rays_per_s: (primary + shadow) / seconds,
-            primary_rays_per_s: primary / primary_seconds,
-            shadow_rays_per_s: shadow / (seconds - primary_seconds),
+            rays_per_s,
+            primary_rays_per_s,
+            shadow_rays_per_s,
             clock: Some(t.clock.clone()),
         };
     }
@@ -273,15 +275,8 @@ fn keep_for_figures(out: &mut Outcome, reference: &Reference, config: Config, im
     if reference.on_axis.is_none() {
         return;
     }
-    let mut avg = RadialProfile::new(&reference.receivers, first);
-    let profiles: Vec<_> = images
-        .iter()
-        .map(|im| RadialProfile::new(&reference.receivers, im))
-        .collect();
-    for (b, m) in avg.mean.iter_mut().enumerate() {
-        *m = profiles.iter().map(|p| p.mean[b]).sum::<f64>() / profiles.len() as f64;
-    }
-    out.profiles.push((config, avg));
+    out.profiles
+        .push((config, RadialProfile::mean_over(&reference.receivers, images)));
 }
 
 /// Renders and measures every seed of a group; a failed render becomes a failed record and the
