@@ -45,9 +45,8 @@ struct Args {
     /// Print the expanded runs and the render plan, then exit without rendering.
     #[arg(long)]
     dry_run: bool,
-    /// Run only the runs whose AXIS has VALUE (axes: scheme, pattern, samples, light_radius,
-    /// lights, seed); repeat to keep several values or restrict several axes.
-    #[arg(long, value_name = "AXIS=VALUE")]
+    /// Subset filters; the help text names the axes from the axis list.
+    #[arg(long, value_name = "AXIS=VALUE", help = filter::help())]
     filter: Vec<Filter>,
     /// More log output (repeatable).
     #[arg(short, long, action = clap::ArgAction::Count)]

@@ -49,6 +49,15 @@ pub fn restrict(axes: &Axes, filters: &[Filter]) -> Result<Axes, String> {
     Ok(a)
 }
 
+/// `--filter`'s help, naming the axes.
+pub fn help() -> String {
+    let names: Vec<&str> = Axis::ALL.iter().map(|a| a.name()).collect();
+    format!(
+        "Run only the runs whose AXIS has VALUE (axes: {}); repeat to keep several values or restrict several axes",
+        names.join(", ")
+    )
+}
+
 /// A results-folder suffix naming the filters, e.g. `scheme=paper,samples=16`.
 pub fn label(filters: &[Filter]) -> String {
     filters

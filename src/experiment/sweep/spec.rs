@@ -55,7 +55,7 @@ pub struct GroundTruth {
     pub samples: u32,
 }
 
-/// Frame timing (see `experiment::timing`).
+/// Frame timing (see [`super::timing`]).
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TimingSpec {
