@@ -63,3 +63,37 @@ fn identity_columns_and_row_order_come_from_the_axis_list() {
         assert_eq!(header[n - 1], next, "{file}");
     }
 }
+
+/// Plots and report sections that do not name an axis are drawn once per value of it: with two
+/// light counts, one set of plots and one cost section each, and the verdict (one light) once.
+#[test]
+fn reports_hold_an_axis_they_do_not_name_at_each_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| {
+        t.replace("seeds = [1, 2]", "seeds = [1, 2]\nlight_counts = [1, 2]")
+    });
+    std::fs::copy(
+        common::repo("experiments/scenes/sphere-two-lights.toml"),
+        dir.path().join("scenes/sphere.toml"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (code, e) = common::sweep(&[
+        exp.as_os_str(),
+        OsStr::new("--backend"),
+        OsStr::new("cpu"),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 0, "{e}");
+    for lights in [1, 2] {
+        assert!(out.join(format!("plots/rmse_vs_samples_{lights}lights.png")).is_file());
+    }
+    assert!(!out.join("plots/rmse_vs_samples.png").exists());
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for lights in [1, 2] {
+        let heading = format!("## What accuracy costs ({lights} light(s))");
+        assert_eq!(report.matches(&heading).count(), 1, "{report}");
+    }
+    assert_eq!(report.matches("pattern, 2 seeds.**").count(), 2, "{report}");
+}

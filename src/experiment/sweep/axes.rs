@@ -31,6 +31,7 @@ pub trait AxisValue: Clone + PartialEq + Debug + Display + FromStr + for<'de> De
 impl AxisValue for DiskScheme {}
 impl AxisValue for Pattern {}
 impl AxisValue for u32 {}
+impl AxisValue for String {}
 
 impl AxisValue for f64 {
     /// Exponent form: one text per value, whatever its magnitude.
@@ -243,21 +244,21 @@ fn nested(lens: &[usize], levels: &[u32]) -> Vec<Vec<usize>> {
     }
 }
 
-/// One combination of values on the axes a table, plot or section does not show: it is drawn
-/// once per slice, from the configurations that agree with [`Slice::config`] outside `shown`.
+/// One combination of values on the axes a plot or report section does not name: it is drawn
+/// once per slice, from the configurations that agree with [`Slice::config`] outside `named`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Slice {
-    /// The slice's first configuration; its values outside `shown` are the slice's.
+    /// The slice's first configuration; its values outside `named` are the slice's.
     pub config: Config,
-    /// The axes outside `shown` that take more than one value, with this slice's value: what
+    /// The axes outside `named` that take more than one value, with this slice's value: what
     /// tells the slices apart (empty when there is one slice).
     pub varying: Vec<(Axis, String)>,
 }
 
 impl Slice {
     /// Whether `c` belongs to this slice.
-    pub fn holds(&self, c: &Config, shown: &[Axis]) -> bool {
-        self.config.agrees_except(c, shown)
+    pub fn holds(&self, c: &Config, named: &[Axis]) -> bool {
+        self.config.agrees_except(c, named)
     }
 
     /// `name=value, ...` of the axes that tell the slices apart, but those in `skip` (which the
@@ -273,16 +274,15 @@ impl Slice {
     }
 }
 
-/// The slices of `configs` outside the axes `shown`, in the order they first appear.
-pub fn slices<'a>(configs: impl IntoIterator<Item = &'a Config>, shown: &[Axis]) -> Vec<Slice> {
-    let configs: Vec<&Config> = configs.into_iter().collect();
+/// The slices of `configs` outside the axes `named`, in the order they first appear.
+pub fn slices<'a>(configs: impl IntoIterator<Item = &'a Config>, named: &[Axis]) -> Vec<Slice> {
     let mut firsts: Vec<&Config> = Vec::new();
-    for c in &configs {
-        if !firsts.iter().any(|f| f.agrees_except(c, shown)) {
+    for c in configs {
+        if !firsts.iter().any(|f| f.agrees_except(c, named)) {
             firsts.push(c);
         }
     }
-    let varies = |a: Axis| !shown.contains(&a) && firsts.iter().any(|f| differs(f, firsts[0], a));
+    let varies = |a: Axis| !named.contains(&a) && firsts.iter().any(|f| differs(f, firsts[0], a));
     firsts
         .iter()
         .map(|f| Slice {
@@ -334,13 +334,13 @@ mod tests {
     }
 
     #[test]
-    fn slices_split_on_the_axes_not_shown() {
+    fn slices_split_on_the_axes_not_named() {
         let configs = axes().configs();
-        let shown = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
-        let s = slices(&configs, &shown);
+        let named = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
+        let s = slices(&configs, &named);
         assert_eq!(s.len(), 2);
         assert_eq!(s[1].varying, vec![(Axis::Lights, "2".to_string())]);
-        assert_eq!(configs.iter().filter(|c| s[1].holds(c, &shown)).count(), 8);
+        assert_eq!(configs.iter().filter(|c| s[1].holds(c, &named)).count(), 8);
         let all: Vec<Axis> = Axis::ALL.to_vec();
         let one = slices(&configs, &all);
         assert_eq!((one.len(), one[0].varying.len()), (1, 0));

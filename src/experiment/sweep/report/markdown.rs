@@ -87,27 +87,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
                 .map_or("n/a".into(), |q| q.depth_limited_pixels.to_string()),
         );
     }
-    // One light (the exact answer's case); axes the verdict does not name, each value in turn.
-    let named = [
-        Axis::Scheme,
-        Axis::Pattern,
-        Axis::Samples,
-        Axis::LightRadius,
-        Axis::Lights,
-    ];
-    let mut verdicts: Vec<(String, Verdict)> = Vec::new();
-    for slice in slices(summaries.iter().map(|x| &x.config), &named) {
-        for pattern in [Pattern::PerPixel, Pattern::Shared] {
-            let at = Config {
-                pattern,
-                samples: n,
-                light_radius: radius,
-                lights: 1,
-                ..slice.config.clone()
-            };
-            verdicts.extend(Verdict::new(summaries, &at).map(|v| (slice.label(&[]), v)));
-        }
-    }
+    let verdicts = verdicts(summaries, n, radius);
     if outcome.references.iter().any(|r| r.on_axis.is_some()) {
         s += "\n## Verdict\n\nThe claim (Vassilev 2012, Fig. 2): with eq. (2)+(3) the penumbra at 16 rays is wider than with eq. (1), at the same quality.\n\n";
         if verdicts.is_empty() {
@@ -121,7 +101,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
             s += "\n";
         }
     }
-    for slice in slices(summaries.iter().map(|x| &x.config), &COST_SHOWS) {
+    for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
         s += &cost_section(outcome, summaries, &slice, n, radius);
     }
     s += "\n## Outputs\n\n- `runs.csv`: one row per run; `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
@@ -172,8 +152,37 @@ fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, noise: Op
     }
 }
 
+/// The axes the verdict names (at one light: the exact answer's case); it is read once per value
+/// of the others.
+const VERDICT_NAMES: [Axis; 5] = [
+    Axis::Scheme,
+    Axis::Pattern,
+    Axis::Samples,
+    Axis::LightRadius,
+    Axis::Lights,
+];
+
+/// The verdict of each pattern at `n` rays and light radius `radius`, in each slice of the axes
+/// it does not name, with the slice's label (empty when there is one slice).
+fn verdicts(summaries: &[Summary], n: u32, radius: f64) -> Vec<(String, Verdict)> {
+    let mut out = Vec::new();
+    for slice in slices(summaries.iter().map(|x| &x.config), &VERDICT_NAMES) {
+        for pattern in [Pattern::PerPixel, Pattern::Shared] {
+            let at = Config {
+                pattern,
+                samples: n,
+                light_radius: radius,
+                lights: 1,
+                ..slice.config.clone()
+            };
+            out.extend(Verdict::new(summaries, &at).map(|v| (slice.label(&[]), v)));
+        }
+    }
+    out
+}
+
 /// The axes a cost section names; it is written once per value of the others.
-const COST_SHOWS: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
+const COST_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
 
 /// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
 /// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked

@@ -12,7 +12,7 @@ use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
 /// The axes the plots name; each plot is drawn once per value of the others.
-const PLOTS_SHOW: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
+const PLOT_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
 
 /// Which summaries a plot shows: its slice's, at one radius or at one ray count.
 #[derive(Clone, Copy)]
@@ -36,7 +36,7 @@ fn series(
             let mut pts: Vec<(f64, f64, f64)> = summaries
                 .iter()
                 .filter(|s| s.config.scheme == *scheme && s.config.pattern == pattern)
-                .filter(|s| f.slice.holds(&s.config, &PLOTS_SHOW))
+                .filter(|s| f.slice.holds(&s.config, &PLOT_NAMES))
                 .filter(|s| {
                     f.radius.is_none_or(|r| s.config.light_radius == r)
                         && f.samples.is_none_or(|n| s.config.samples == n)
@@ -65,7 +65,7 @@ fn series(
 
 /// Writes every plot into `dir`, one set per slice of the axes the plots do not name.
 pub fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result<()> {
-    for slice in slices(summaries.iter().map(|s| &s.config), &PLOTS_SHOW) {
+    for slice in slices(summaries.iter().map(|s| &s.config), &PLOT_NAMES) {
         let suffix: String = slice.varying.iter().map(|(a, v)| format!("_{v}{}", a.name())).collect();
         plots_for(r, summaries, dir, &slice, &suffix)?;
     }
