@@ -154,3 +154,41 @@ fn frame_rate_experiment_errors_are_located() {
     );
     assert!(!dir.path().join("r").exists());
 }
+
+#[test]
+fn unknown_kind() {
+    let e = rejects(|t| format!("kind = \"sweeps\"\n{t}"));
+    assert_located(&e, "tiny.toml", 1, "key `kind`");
+    assert!(
+        e.contains("sweeps") && e.contains("`sweep`") && e.contains("`fps`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn another_kinds_file_is_read_by_its_kind() {
+    let e = rejects(|t| format!("kind = \"fps\"\n{t}"));
+    assert!(e.contains("tiny.toml:") && e.contains("key `"), "{e}");
+    assert!(e.contains("unknown field") && e.contains("`frames`"), "{e}");
+}
+
+/// No `kind` means a sweep: the tiny experiment has none. A frame-rate file that lost its
+/// `kind` is read as a sweep, and the error says how the file was read.
+#[test]
+fn a_file_without_kind_is_a_sweep() {
+    use penumbra::experiment::Experiment;
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t);
+    assert!(!std::fs::read_to_string(&exp).unwrap().contains("kind"));
+    assert!(matches!(Experiment::load(&exp).unwrap(), Experiment::Sweep(_)));
+    let text = std::fs::read_to_string(common::repo("experiments/fps.toml"))
+        .unwrap()
+        .replace("kind = \"fps\"\n", "");
+    let fps = dir.path().join("fps.toml");
+    std::fs::write(&fps, &text).unwrap();
+    let line = 1 + text.lines().position(|l| l.starts_with("frames")).unwrap();
+    let (code, e) = common::sweep(&[fps.as_os_str(), OsStr::new("--dry-run")]);
+    assert_eq!(code, 2, "{e}");
+    assert_located(&e, "fps.toml", line, "key `frames`");
+    assert!(e.contains("a file without `kind` is read as kind = \"sweep\""), "{e}");
+}

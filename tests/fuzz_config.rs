@@ -1,7 +1,7 @@
 //! Bad input, fuzzed: random edits of valid experiment and scene files never panic the loader,
 //! and every rejection names the file (and, when the text parses as TOML, a line).
 
-use penumbra::experiment::Spec;
+use penumbra::experiment::sweep::Spec;
 use proptest::prelude::*;
 use std::path::PathBuf;
 

@@ -6,10 +6,10 @@
 
 mod common;
 
-use penumbra::experiment::{run_sweep, Outcome, Spec};
+use penumbra::experiment::sweep::report::thresholds::Thresholds;
+use penumbra::experiment::sweep::{run_sweep, Outcome, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::Backend;
-use penumbra::report::thresholds::Thresholds;
 use std::path::Path;
 
 const SCENE: &str = r#"
@@ -103,13 +103,13 @@ fn check(out: &Outcome, what: &str) {
         );
     }
     for rec in &out.records {
-        let (rmse, exact) = (rec.num("rmse"), rec.num("rmse_exact"));
-        eprintln!("{what}: {} rmse {rmse:.4} rmse_exact {exact:.4}", rec.get("scheme"));
+        let (rmse, exact) = (rec.metrics.rmse, rec.metrics.rmse_exact);
+        eprintln!("{what}: {} rmse {rmse:.4} rmse_exact {exact:.4}", rec.run.scheme);
         // rmse_exact^2 = rmse^2 + (GT error)^2 + a cross term; the GT error is ~1e-3 RMS.
         assert!(
             (exact - rmse).abs() <= 0.1 * rmse + 3e-3,
             "{what}: {} rmse_exact {exact} vs rmse {rmse}",
-            rec.get("scheme")
+            rec.run.scheme
         );
     }
 }

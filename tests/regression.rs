@@ -4,12 +4,11 @@
 
 mod common;
 
-use penumbra::experiment::reference::Reference;
-use penumbra::experiment::runner::{figure_samples, verdict_radius};
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::reference::Reference;
+use penumbra::experiment::sweep::report::summary::{summarise, Summary};
+use penumbra::experiment::sweep::report::thresholds::{Check, Thresholds};
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::open_backend;
-use penumbra::report::summary::{summarise, Summary};
-use penumbra::report::thresholds::{Check, Thresholds};
 use penumbra::sampling::DiskScheme;
 use std::sync::OnceLock;
 
@@ -39,8 +38,7 @@ fn ci() -> &'static Ci {
         )
         .unwrap();
         assert_eq!(out.failures, 0);
-        let figure = (figure_samples(&spec), verdict_radius(&spec), 1);
-        let summaries = summarise(&out, &Default::default(), figure);
+        let summaries = summarise(&out, &Default::default());
         Ci {
             spec,
             references: out.references,
@@ -168,7 +166,7 @@ fn the_convergence_checks_reject_a_scheme_that_stops_converging() {
 /// scheme's profile were off the exact one by 1/factor - 1.
 fn exact_width_scaled(scheme: DiskScheme, factor: f64) -> Vec<Summary> {
     let mut summaries = ci().summaries.clone();
-    for s in summaries.iter_mut().filter(|s| s.run.scheme == scheme) {
+    for s in summaries.iter_mut().filter(|s| s.config.scheme == scheme) {
         s.exact_width_10_90 *= factor;
     }
     summaries
@@ -192,11 +190,11 @@ fn the_paper_width_check_rejects_too_much_widening() {
     let c = ci();
     let max = c.thresholds.paper.max_width_10_90_excess;
     // The exact width shrunk so that the paper's measured width exceeds it by max + 10 %.
-    let paper = |s: &Summary| s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+    let paper = |s: &Summary| s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
     let worst = c
         .summaries
         .iter()
-        .filter(|s| s.run.scheme == DiskScheme::Paper)
+        .filter(|s| s.config.scheme == DiskScheme::Paper)
         .map(paper)
         .fold(f64::INFINITY, f64::min);
     let summaries = exact_width_scaled(DiskScheme::Paper, (1.0 + worst) / (1.0 + max + 0.1));
@@ -211,7 +209,7 @@ fn a_bound_on_a_scheme_the_sweep_lacks_fails() {
     let without: Vec<Summary> = c
         .summaries
         .iter()
-        .filter(|s| s.run.scheme != DiskScheme::Jittered)
+        .filter(|s| s.config.scheme != DiskScheme::Jittered)
         .cloned()
         .collect();
     for checks in [

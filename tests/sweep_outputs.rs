@@ -4,7 +4,8 @@
 
 mod common;
 
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::record::Status;
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Frame, Sampling, Timing, View};
 use penumbra::scene::Scene;
@@ -106,10 +107,10 @@ fn failed_runs_are_recorded_and_the_sweep_goes_on() {
     assert_eq!(out.records.len(), 16);
     assert_eq!(out.failures, 8);
     for r in &out.records {
-        let failed = r.get("seed") == "2";
-        assert_eq!(r.get("status"), if failed { "failed" } else { "ok" });
-        assert_eq!(r.get("error").contains("simulated device loss"), failed);
-        assert_eq!(r.get("rmse").is_empty(), failed);
+        let failed = r.run.seed == 2;
+        assert_eq!(r.status, if failed { Status::Failed } else { Status::Ok });
+        assert_eq!(r.error.contains("simulated device loss"), failed);
+        assert_eq!(r.metrics.rmse.is_nan(), failed);
     }
     // Groups with a failure are not journaled: a later sweep retries them.
     let journaled = std::fs::read_to_string(dir.path().join("j/groups.csv")).unwrap_or_default();

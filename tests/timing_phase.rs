@@ -5,8 +5,8 @@
 
 mod common;
 
-use penumbra::experiment::timing::{faster, NOISE_VISITS};
-use penumbra::experiment::{run_sweep, Spec};
+use penumbra::experiment::sweep::timing::{faster, NOISE_VISITS};
+use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Clock, Frame, Sampling, Timing, View};
 use penumbra::sampling::DiskScheme;
@@ -80,8 +80,8 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     assert_eq!(noise.frame_seconds.len(), 5 * NOISE_VISITS as usize);
     assert_eq!((probe.scheme, probe.samples), (DiskScheme::Uniform, 16));
     for r in &out.records {
-        assert_eq!(r.get("timed_frames"), "5");
-        let (q1, med, q3) = (r.num("frame_ms_q1"), r.num("frame_ms"), r.num("frame_ms_q3"));
+        assert_eq!(r.time.timed_frames, Some(5));
+        let (q1, med, q3) = (r.time.frame_ms_q1, r.time.frame_ms, r.time.frame_ms_q3);
         assert!(q1 <= med && med <= q3 && q1 > 10.0, "{q1} {med} {q3}");
     }
     // Every configuration does the same (fake) work; the drift must not rank any two of them,
@@ -100,9 +100,8 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     assert!(backend.calls.is_empty(), "{} frames re-timed", backend.calls.len());
     assert_eq!(again.timings.configs, out.timings.configs);
     assert_eq!(again.timings.noise.as_ref().map(|n| &n.1), Some(noise));
-    let frame_ms = |o: &penumbra::experiment::Outcome| -> Vec<String> {
-        o.records.iter().map(|r| r.get("frame_ms").to_string()).collect()
-    };
+    let frame_ms =
+        |o: &penumbra::experiment::sweep::Outcome| -> Vec<f64> { o.records.iter().map(|r| r.time.frame_ms).collect() };
     assert_eq!(frame_ms(&again), frame_ms(&out));
     // One configuration more: every configuration is timed again in one interleaved phase, so
     // the new one is never ranked against frames timed in another process.

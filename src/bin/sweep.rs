@@ -3,15 +3,14 @@
 use anyhow::Context;
 use clap::Parser;
 use penumbra::config::ConfigError;
-use penumbra::experiment::filter::{self, Filter};
-use penumbra::experiment::fps::{is_fps, run_fps, timed_scene, FpsSpec};
-use penumbra::experiment::run::expand;
-use penumbra::experiment::runner::sweep_plan;
-use penumbra::experiment::{pictures::render_pictures, run_sweep, Spec};
-use penumbra::render::{open_backend, BackendChoice, RenderPlan, View};
-use penumbra::report::fps::write_fps;
-use penumbra::report::markdown::verdict_radius;
-use penumbra::report::write::{write_all, Results};
+use penumbra::experiment::fps::{self, FpsSpec};
+use penumbra::experiment::sweep::filter::{self, Filter};
+use penumbra::experiment::sweep::report::{write_all, Results};
+use penumbra::experiment::sweep::run::expand;
+use penumbra::experiment::sweep::runner::{dry_run, verdict_radius};
+use penumbra::experiment::sweep::{pictures::render_pictures, run_sweep, Spec};
+use penumbra::experiment::Experiment;
+use penumbra::render::{open_backend, BackendChoice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,9 +45,8 @@ struct Args {
     /// Print the expanded runs and the render plan, then exit without rendering.
     #[arg(long)]
     dry_run: bool,
-    /// Run only the runs whose AXIS has VALUE (axes: scheme, pattern, samples, light_radius,
-    /// lights, seed); repeat to keep several values or restrict several axes.
-    #[arg(long, value_name = "AXIS=VALUE")]
+    /// Subset filters; the help text names the axes from the axis list.
+    #[arg(long, value_name = "AXIS=VALUE", help = filter::help())]
     filter: Vec<Filter>,
     /// More log output (repeatable).
     #[arg(short, long, action = clap::ArgAction::Count)]
@@ -80,26 +78,12 @@ fn load<T>(load: impl FnOnce() -> Result<T, ConfigError>) -> anyhow::Result<T> {
 }
 
 /// A frame-rate experiment (`kind = "fps"`): times configurations, no sweep.
-fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
-    let spec = load(|| FpsSpec::load(&args.experiment))?;
+fn run_fps_experiment(args: &Args, spec: FpsSpec, started: Instant) -> anyhow::Result<()> {
     if !args.filter.is_empty() {
         return Err(BadInput("--filter applies to sweeps, not to frame-rate experiments".into()).into());
     }
     if args.dry_run {
-        for s in &spec.scenes {
-            for &lights in &s.lights {
-                let scene = timed_scene(&spec, s, lights);
-                for &[width, height] in &spec.resolutions {
-                    let view = View {
-                        camera: &scene.cameras[&s.camera],
-                        width,
-                        height,
-                    };
-                    println!("{} with {lights} light(s) at {width}x{height}:", s.name);
-                    print!("{}", RenderPlan::new(&scene, view)?);
-                }
-            }
-        }
+        print!("{}", fps::runner::dry_run(&spec)?);
         return Ok(());
     }
     let out = args
@@ -108,8 +92,8 @@ fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
         .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
     let mut backend = open_backend(args.backend.unwrap_or(BackendChoice::Auto))?;
     let adapter = backend.adapter().clone();
-    let rows = run_fps(&spec, backend.as_mut())?;
-    write_fps(&spec, &rows, &adapter, started.elapsed().as_secs_f64(), &out)?;
+    let rows = fps::run_fps(&spec, backend.as_mut())?;
+    fps::report::write_fps(&spec, &rows, &adapter, started.elapsed().as_secs_f64(), &out)?;
     info!(
         "{} configurations timed; wrote {}",
         rows.len(),
@@ -118,37 +102,20 @@ fn run_fps_experiment(args: &Args, started: Instant) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The sweep's runs, one line per configuration with its seeds, then the render plan.
-fn print_dry_run(spec: &Spec) -> anyhow::Result<()> {
-    let groups = expand(spec);
-    let runs: usize = groups.iter().map(|g| g.runs.len()).sum();
-    println!("{}: {runs} runs in {} configurations", spec.name, groups.len());
-    for g in &groups {
-        let r = g.head();
-        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
-        println!(
-            "  scheme={} pattern={} samples={} light_radius={} lights={} seeds=[{}]",
-            r.scheme,
-            r.pattern,
-            r.samples,
-            r.light_radius,
-            r.lights,
-            seeds.join(", ")
-        );
-    }
-    print!("render plan of a run:\n{}", sweep_plan(spec)?);
-    Ok(())
-}
-
 fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    if is_fps(&args.experiment) {
-        return run_fps_experiment(&args, started);
+    match load(|| Experiment::load(&args.experiment))? {
+        Experiment::Sweep(spec) => run_sweep_experiment(&args, *spec, started),
+        Experiment::Fps(spec) => run_fps_experiment(&args, spec, started),
     }
-    let spec = load(|| Spec::load(&args.experiment))?;
+}
+
+/// A sweep: renders and measures every run, then writes the results folder.
+fn run_sweep_experiment(args: &Args, spec: Spec, started: Instant) -> anyhow::Result<()> {
     let spec = spec.filtered(&args.filter).map_err(BadInput)?;
     if args.dry_run {
-        return print_dry_run(&spec);
+        print!("{}", dry_run(&spec)?);
+        return Ok(());
     }
     let out = args.out.clone().unwrap_or_else(|| {
         let name = match args.filter.as_slice() {

@@ -1,17 +1,43 @@
-//! Experiments: the file ([`spec`]), its expansion into runs ([`run`]), the per-radius
-//! references ([`reference`]), the sweep ([`runner`]) and its resumable journal ([`journal`]).
+//! Experiments, one module per kind, each with its spec, runner and report: [`sweep`] (sampling
+//! schemes swept and measured against a ground truth) and [`fps`] (the paper's frame rates). An
+//! experiment file names its kind with `kind` ([`kind`]).
 
-pub mod filter;
 pub mod fps;
-pub mod journal;
-pub mod measure;
-pub mod pictures;
-pub mod reference;
-pub mod run;
-pub mod runner;
-pub mod spec;
-pub mod timing;
+pub mod kind;
+pub mod sweep;
 
-pub use run::{Record, Run};
-pub use runner::{run_sweep, Outcome};
-pub use spec::Spec;
+use crate::config::{ConfigError, Source};
+use kind::Kind;
+use std::path::Path;
+
+/// An experiment file, read by its kind.
+pub enum Experiment {
+    /// `kind = "sweep"`, or no `kind`.
+    Sweep(Box<sweep::Spec>),
+    /// `kind = "fps"`.
+    Fps(fps::FpsSpec),
+}
+
+impl Experiment {
+    /// Reads and validates an experiment file of any kind.
+    pub fn load(path: &Path) -> Result<Experiment, ConfigError> {
+        let source = Source::read(path)?;
+        let declared = Kind::declared(&source)?;
+        match declared.unwrap_or_default() {
+            Kind::Sweep => sweep::Spec::from_source(&source)
+                .map(|s| Experiment::Sweep(Box::new(s)))
+                .map_err(|e| if declared.is_none() { read_as_sweep(e) } else { e }),
+            Kind::Fps => fps::FpsSpec::from_source(&source).map(Experiment::Fps),
+        }
+    }
+}
+
+/// A key a sweep does not know, in a file without `kind`, may be another kind's: says how the
+/// file was read.
+fn read_as_sweep(mut e: ConfigError) -> ConfigError {
+    if e.message.starts_with("unknown field") {
+        e.message +=
+            " (a file without `kind` is read as kind = \"sweep\"; a frame-rate experiment says kind = \"fps\")";
+    }
+    e
+}

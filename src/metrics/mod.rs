@@ -7,6 +7,7 @@ pub mod flip;
 pub mod profile;
 pub mod seeds;
 pub mod stats;
+pub mod throughput;
 
 pub use error::{penumbra_coverage, ErrorMetrics, PenumbraMask};
 pub use profile::{RadialProfile, Receivers};

@@ -113,6 +113,17 @@ impl RadialProfile {
         p
     }
 
+    /// The profile of several images of one configuration (its seeds): per bin, the mean of
+    /// their bin means. Its extent pixels are the first image's.
+    pub fn mean_over(receivers: &Receivers, images: &[Vec<f32>]) -> Self {
+        let mut avg = RadialProfile::new(receivers, &images[0]);
+        let profiles: Vec<_> = images.iter().map(|im| RadialProfile::new(receivers, im)).collect();
+        for (b, m) in avg.mean.iter_mut().enumerate() {
+            *m = profiles.iter().map(|p| p.mean[b]).sum::<f64>() / profiles.len() as f64;
+        }
+        avg
+    }
+
     /// Inner and outer extent of partial shadow (m), see [`super::extent`].
     pub fn extent(&self) -> (f64, f64) {
         self.annuli.extent()

@@ -16,21 +16,41 @@ pub fn t975(dof: usize) -> f64 {
     }
 }
 
+/// A mean and the half-width of its 95 % confidence interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeanCi {
+    /// The mean.
+    pub mean: f64,
+    /// Half-width of its 95 % interval.
+    pub ci95: f64,
+}
+
+impl MeanCi {
+    /// Neither known.
+    pub const NAN: MeanCi = MeanCi {
+        mean: f64::NAN,
+        ci95: f64::NAN,
+    };
+}
+
 /// Mean and the half-width of its 95 % confidence interval, mean +- t s / sqrt(k); the
 /// half-width is NaN with fewer than two values. One NaN value (a seed whose metric is not
 /// measurable, e.g. an extent beyond the patch) makes both NaN: a mean over fewer seeds than the
 /// row claims would be another statistic.
-pub fn mean_ci(v: &[f64]) -> (f64, f64) {
+pub fn mean_ci(v: &[f64]) -> MeanCi {
     let k = v.len();
     if k == 0 || v.iter().any(|x| x.is_nan()) {
-        return (f64::NAN, f64::NAN);
+        return MeanCi::NAN;
     }
     let mean = v.iter().sum::<f64>() / k as f64;
     if k < 2 {
-        return (mean, f64::NAN);
+        return MeanCi { mean, ci95: f64::NAN };
     }
     let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
-    (mean, t975(k - 1) * (var / k as f64).sqrt())
+    MeanCi {
+        mean,
+        ci95: t975(k - 1) * (var / k as f64).sqrt(),
+    }
 }
 
 /// Median (mean of the middle two for an even count); NaN when empty.
@@ -66,13 +86,13 @@ mod tests {
 
     #[test]
     fn ci_of_known_sample() {
-        let (m, h) = mean_ci(&[1.0, 2.0, 3.0, 4.0]);
-        assert_eq!(m, 2.5);
+        let MeanCi { mean, ci95 } = mean_ci(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(mean, 2.5);
         // s = sqrt(5/3), t(3) = 3.182: h = 3.182 * sqrt(5/12).
-        assert!((h - 3.182 * (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
-        assert!(mean_ci(&[1.0]).1.is_nan());
-        let (m, h) = mean_ci(&[f64::NAN, 2.0, 4.0]);
-        assert!(m.is_nan() && h.is_nan());
+        assert!((ci95 - 3.182 * (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert!(mean_ci(&[1.0]).ci95.is_nan());
+        let MeanCi { mean, ci95 } = mean_ci(&[f64::NAN, 2.0, 4.0]);
+        assert!(mean.is_nan() && ci95.is_nan());
     }
 
     #[test]

@@ -1,19 +1,16 @@
-//! `--filter AXIS=VALUE`: runs a subset of an experiment's sweep. Each filter keeps, on its axis,
-//! only the values named (repeating an axis keeps each value named); a value the experiment does
-//! not sweep is an error, so a typo never runs an empty or unintended sweep.
+//! `--filter AXIS=VALUE`: runs a subset of an experiment's sweep. AXIS is any axis's name
+//! ([`Axis::name`]). Each filter keeps, on its axis, only the values named (repeating an axis keeps
+//! each value named); a value the experiment does not sweep is an error, so a typo never runs an
+//! empty or unintended sweep.
 
-use super::spec::{Axes, Spec};
-use crate::sampling::{DiskScheme, Pattern};
-use std::collections::BTreeMap;
-
-/// Axis names a filter may use, as in the experiment file's `[sweep]` table (singular).
-pub const AXES: [&str; 6] = ["scheme", "pattern", "samples", "light_radius", "lights", "seed"];
+use super::axes::{Axes, Axis};
+use super::spec::Spec;
 
 /// One `AXIS=VALUE` filter.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Filter {
-    /// One of [`AXES`].
-    pub axis: String,
+    /// The axis.
+    pub axis: Axis,
     /// The value as written.
     pub value: String,
 }
@@ -22,63 +19,50 @@ impl std::str::FromStr for Filter {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Filter, String> {
+        let names: Vec<&str> = Axis::ALL.iter().map(|a| a.name()).collect();
         let (axis, value) = s
             .split_once('=')
-            .ok_or_else(|| format!("`{s}`: a filter is AXIS=VALUE, AXIS one of {}", AXES.join(", ")))?;
+            .ok_or_else(|| format!("`{s}`: a filter is AXIS=VALUE, AXIS one of {}", names.join(", ")))?;
         let (axis, value) = (axis.trim(), value.trim());
-        if !AXES.contains(&axis) {
-            return Err(format!("`{s}`: unknown axis `{axis}`; one of {}", AXES.join(", ")));
-        }
+        let axis =
+            Axis::named(axis).ok_or_else(|| format!("`{s}`: unknown axis `{axis}`; one of {}", names.join(", ")))?;
         Ok(Filter {
-            axis: axis.into(),
+            axis,
             value: value.into(),
         })
     }
 }
 
-/// Keeps the values of `list` that some filter on `axis` names; every named value must be in it.
-fn keep<T: PartialEq + Copy>(
-    list: &mut Vec<T>,
-    axis: &str,
-    named: &BTreeMap<&str, Vec<&str>>,
-    parse: impl Fn(&str) -> Option<T>,
-) -> Result<(), String> {
-    let Some(values) = named.get(axis) else {
-        return Ok(());
-    };
-    let mut wanted = Vec::new();
-    for v in values {
-        let x = parse(v).ok_or_else(|| format!("--filter {axis}={v}: not a valid {axis}"))?;
-        if !list.contains(&x) {
-            return Err(format!("--filter {axis}={v}: the experiment does not sweep this value"));
-        }
-        wanted.push(x);
-    }
-    list.retain(|x| wanted.contains(x));
-    Ok(())
-}
-
 /// `axes` restricted by `filters`.
 pub fn restrict(axes: &Axes, filters: &[Filter]) -> Result<Axes, String> {
-    let mut named: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
-    for f in filters {
-        named.entry(f.axis.as_str()).or_default().push(f.value.as_str());
-    }
     let mut a = axes.clone();
-    keep(&mut a.schemes, "scheme", &named, |v| v.parse::<DiskScheme>().ok())?;
-    keep(&mut a.patterns, "pattern", &named, |v| v.parse::<Pattern>().ok())?;
-    keep(&mut a.samples, "samples", &named, |v| v.parse().ok())?;
-    keep(&mut a.light_radii, "light_radius", &named, |v| v.parse().ok())?;
-    keep(&mut a.light_counts, "lights", &named, |v| v.parse().ok())?;
-    keep(&mut a.seeds, "seed", &named, |v| v.parse().ok())?;
+    for &axis in Axis::ALL {
+        let values: Vec<&str> = filters
+            .iter()
+            .filter(|f| f.axis == axis)
+            .map(|f| f.value.as_str())
+            .collect();
+        if !values.is_empty() {
+            a.restrict(axis, &values)?;
+        }
+    }
     Ok(a)
+}
+
+/// `--filter`'s help, naming the axes.
+pub fn help() -> String {
+    let names: Vec<&str> = Axis::ALL.iter().map(|a| a.name()).collect();
+    format!(
+        "Run only the runs whose AXIS has VALUE (axes: {}); repeat to keep several values or restrict several axes",
+        names.join(", ")
+    )
 }
 
 /// A results-folder suffix naming the filters, e.g. `scheme=paper,samples=16`.
 pub fn label(filters: &[Filter]) -> String {
     filters
         .iter()
-        .map(|f| format!("{}={}", f.axis, f.value))
+        .map(|f| format!("{}={}", f.axis.name(), f.value))
         .collect::<Vec<_>>()
         .join(",")
 }
@@ -94,6 +78,7 @@ impl Spec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::{DiskScheme, Pattern};
 
     fn axes() -> Axes {
         Axes {

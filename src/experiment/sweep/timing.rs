@@ -7,6 +7,7 @@
 //! random places in the order, measures the noise floor: the spread of one unchanging workload
 //! across the whole timing phase.
 
+use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::{Spec, TimingSpec};
 use crate::fingerprint::fnv1a;
@@ -32,6 +33,15 @@ pub struct ConfigTiming {
 }
 
 impl ConfigTiming {
+    /// No frames yet.
+    pub fn empty() -> ConfigTiming {
+        ConfigTiming {
+            frame_seconds: vec![],
+            primary_seconds: vec![],
+            clock: String::new(),
+        }
+    }
+
     /// First quartile, median and third quartile of the frame time, in milliseconds.
     pub fn frame_ms(&self) -> (f64, f64, f64) {
         let (a, b, c) = quartiles(&self.frame_seconds);
@@ -91,7 +101,7 @@ pub struct Timings {
     /// Per configuration, keyed by its group key.
     pub configs: BTreeMap<String, ConfigTiming>,
     /// The noise probe's configuration and its frames.
-    pub noise: Option<(Run, ConfigTiming)>,
+    pub noise: Option<(Config, ConfigTiming)>,
 }
 
 /// Key of the timing settings: journaled timings are reused only under the same settings.
@@ -149,14 +159,7 @@ pub fn time_groups(
     if let Some(g) = noise {
         entries.extend((0..NOISE_VISITS).map(|_| (groups.len(), g.head())));
     }
-    let mut out = vec![
-        ConfigTiming {
-            frame_seconds: vec![],
-            primary_seconds: vec![],
-            clock: String::new(),
-        };
-        groups.len() + 1
-    ];
+    let mut out = vec![ConfigTiming::empty(); groups.len() + 1];
     for round in 0..t.repeats {
         for k in order(entries.len(), round) {
             let (slot, run) = entries[k];

@@ -1,10 +1,12 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
 //! numbers, report.md and the manifest.
 
-use super::plots::{line_plot, Axes, Reference, Series};
-use crate::experiment::fps::{fps_row, FpsRow, FpsSpec, FPS_COLUMNS};
-use crate::files::{write_atomic, write_csv};
+use super::{FpsRow, FpsSpec};
+use crate::files::write_atomic;
+use crate::output::plots::{line_plot, Axes, Reference, Series};
+use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
+use serde::Serialize;
 use std::path::Path;
 
 /// Writes fps.csv, plots/fps.png, report.md and manifest.toml under `out`.
@@ -15,11 +17,7 @@ pub fn write_fps(
     seconds: f64,
     out: &Path,
 ) -> anyhow::Result<()> {
-    write_csv(
-        &out.join("fps.csv"),
-        &FPS_COLUMNS,
-        rows.iter().map(|r| fps_row(spec, r, adapter)),
-    )?;
+    write_rows(&out.join("fps.csv"), rows.iter().map(|r| CsvRow::of(spec, r, adapter)))?;
     let mut series = Vec::new();
     let mut refs = Vec::new();
     let pixels: Vec<f64> = spec.resolutions.iter().map(|r| (r[0] * r[1]) as f64 / 1e6).collect();
@@ -101,7 +99,7 @@ pub fn write_fps(
     write_atomic(&out.join("report.md"), md.as_bytes())?;
     let manifest = format!(
         "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\n[adapter]\nbackend = {:?}\nname = {:?}\ndriver = {:?}\napi = {:?}\n",
-        super::write::git_commit(),
+        crate::output::git_commit(),
         spec.path.display().to_string(),
         seconds,
         adapter.backend,
@@ -110,4 +108,58 @@ pub fn write_fps(
         adapter.api
     );
     write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}
+
+/// A row of fps.csv: one timed configuration, with the device.
+#[derive(Serialize)]
+struct CsvRow<'a> {
+    scene: &'a str,
+    lights: u32,
+    width: u32,
+    height: u32,
+    samples: u32,
+    frames: usize,
+    #[serde(with = "float")]
+    median_ms: f64,
+    #[serde(with = "float")]
+    min_ms: f64,
+    #[serde(with = "float")]
+    max_ms: f64,
+    #[serde(with = "float")]
+    fps: f64,
+    #[serde(with = "float")]
+    paper_fps: f64,
+    primary_rays: u64,
+    shadow_rays: u64,
+    #[serde(with = "float")]
+    shadow_rays_per_s: f64,
+    clock: &'a str,
+    adapter: &'a str,
+    driver: &'a str,
+    api: &'a str,
+}
+
+impl<'a> CsvRow<'a> {
+    fn of(spec: &FpsSpec, r: &'a FpsRow, a: &'a AdapterInfo) -> CsvRow<'a> {
+        CsvRow {
+            scene: &r.scene,
+            lights: r.lights,
+            width: r.width,
+            height: r.height,
+            samples: spec.samples,
+            frames: r.frames,
+            median_ms: r.median_s * 1e3,
+            min_ms: r.min_s * 1e3,
+            max_ms: r.max_s * 1e3,
+            fps: r.fps(),
+            paper_fps: r.paper_fps,
+            primary_rays: r.primary_rays,
+            shadow_rays: r.shadow_rays,
+            shadow_rays_per_s: r.shadow_rays_per_s(),
+            clock: r.clock.name(),
+            adapter: &a.name,
+            driver: &a.driver,
+            api: &a.api,
+        }
+    }
 }

@@ -1,16 +1,15 @@
 //! report.md: what was run, the scene's acceleration structure, how far the ground truth is
 //! from the exact answer, the verdict, what accuracy costs in time, and where the outputs are.
 
-use super::numbers::or_na;
 use super::summary::{find, Summary};
 use super::verdict::Verdict;
-use crate::experiment::runner::{figure_samples, Outcome};
-use crate::experiment::timing::{faster, ConfigTiming};
-use crate::experiment::Spec;
+use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
+use crate::experiment::sweep::runner::{figure_samples, verdict_radius, Outcome};
+use crate::experiment::sweep::timing::{faster, ConfigTiming};
+use crate::experiment::sweep::Spec;
+use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
-
-pub use crate::experiment::runner::verdict_radius;
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
     or_na(x.unwrap_or(f64::NAN), f)
@@ -78,22 +77,22 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
                 .map_or("n/a".into(), |q| q.depth_limited_pixels.to_string()),
         );
     }
-    let verdicts: Vec<Verdict> = [Pattern::PerPixel, Pattern::Shared]
-        .into_iter()
-        .filter_map(|p| Verdict::new(summaries, n, radius, p))
-        .collect();
+    let verdicts = verdicts(summaries, n, radius);
     if outcome.references.iter().any(|r| r.on_axis.is_some()) {
         s += "\n## Verdict\n\nThe claim (Vassilev 2012, Fig. 2): with eq. (2)+(3) the penumbra at 16 rays is wider than with eq. (1), at the same quality.\n\n";
         if verdicts.is_empty() {
             s += "The sweep does not hold both `uniform` and `paper` at this sample count and radius, so no verdict.\n\n";
         }
-        for v in &verdicts {
+        for (label, v) in &verdicts {
+            if !label.is_empty() {
+                s += &format!("*{label}:*\n\n");
+            }
             s += &v.markdown();
             s += "\n";
         }
     }
-    for &lights in &spec.axes.light_counts {
-        s += &cost_section(outcome, summaries, n, radius, lights);
+    for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
+        s += &cost_section(outcome, summaries, &slice, n, radius);
     }
     s += "\n## Outputs\n\n- `runs.csv`: one row per run; `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
     s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time (any scene).\n";
@@ -112,18 +111,18 @@ fn ms_iqr((q1, med, q3): (f64, f64, f64)) -> String {
 
 /// The noise floor: one configuration's spread over the whole timing phase.
 fn noise_floor(outcome: &Outcome) -> String {
-    let Some((run, t)) = &outcome.timings.noise else {
+    let Some((config, t)) = &outcome.timings.noise else {
         return String::new();
     };
     let (q1, med, q3) = t.frame_ms();
     format!(
         "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint and their medians differ by more than this noise floor's interquartile range; otherwise they are equal within timing noise.\n\n",
-        t.frame_seconds.len() / crate::experiment::timing::NOISE_VISITS as usize,
+        t.frame_seconds.len() / crate::experiment::sweep::timing::NOISE_VISITS as usize,
         t.clock,
-        run.scheme,
-        run.pattern,
-        run.samples,
-        run.light_radius,
+        config.scheme,
+        config.pattern,
+        config.samples,
+        config.light_radius,
         t.frame_seconds.len(),
         ms_iqr((q1, med, q3)),
         100.0 * (q3 - q1) / med
@@ -143,47 +142,91 @@ fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, noise: Op
     }
 }
 
+/// The axes the verdict names (at one light: the exact answer's case); it is read once per value
+/// of the others.
+const VERDICT_NAMES: [Axis; 5] = [
+    Axis::Scheme,
+    Axis::Pattern,
+    Axis::Samples,
+    Axis::LightRadius,
+    Axis::Lights,
+];
+
+/// The verdict of each pattern at `n` rays and light radius `radius`, in each slice of the axes
+/// it does not name, with the slice's label (empty when there is one slice).
+fn verdicts(summaries: &[Summary], n: u32, radius: f64) -> Vec<(String, Verdict)> {
+    let mut out = Vec::new();
+    for slice in slices(summaries.iter().map(|x| &x.config), &VERDICT_NAMES) {
+        for pattern in [Pattern::PerPixel, Pattern::Shared] {
+            let at = Config {
+                pattern,
+                samples: n,
+                light_radius: radius,
+                lights: 1,
+                ..slice.config.clone()
+            };
+            out.extend(Verdict::new(summaries, &at).map(|v| (slice.label(&[]), v)));
+        }
+    }
+    out
+}
+
+/// The axes a cost section names; it is written once per value of the others.
+const COST_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
+
 /// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
 /// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked
 /// against uniform's time only where [`faster`] can tell them apart.
-fn cost_section(outcome: &Outcome, summaries: &[Summary], n: u32, radius: f64, lights: u32) -> String {
+fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
+    let lights = slice.config.lights;
+    let more = match slice.label(&[Axis::Lights]) {
+        l if l.is_empty() => l,
+        l => format!(", {l}"),
+    };
     let mut s = format!(
-        "\n## What accuracy costs ({lights} light(s))\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [first, third quartile] of the timed frames. `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and how it ranks against uniform@{n}'s.\n\n"
+        "\n## What accuracy costs ({lights} light(s){more})\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [first, third quartile] of the timed frames. `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and how it ranks against uniform@{n}'s.\n\n"
     );
     s += &noise_floor(outcome);
     s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays/s @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|---|\n");
-    let uniform = find(summaries, DiskScheme::Uniform, Pattern::PerPixel, n, radius, lights);
+    let base = Config {
+        pattern: Pattern::PerPixel,
+        samples: n,
+        light_radius: radius,
+        ..slice.config.clone()
+    };
+    let uniform = find(
+        summaries,
+        &Config {
+            scheme: DiskScheme::Uniform,
+            ..base.clone()
+        },
+    );
     for scheme in DiskScheme::ALL {
-        let Some(at) = find(summaries, scheme, Pattern::PerPixel, n, radius, lights) else {
+        let Some(at) = find(summaries, &Config { scheme, ..base.clone() }) else {
             continue;
         };
         let mut rows: Vec<&Summary> = summaries
             .iter()
-            .filter(|x| {
-                x.run.scheme == scheme
-                    && x.run.pattern == Pattern::PerPixel
-                    && x.run.light_radius == radius
-                    && x.run.lights == lights
-            })
+            .filter(|x| x.config.agrees_except(&at.config, &[Axis::Samples]))
             .collect();
-        rows.sort_by_key(|x| x.run.samples);
+        rows.sort_by_key(|x| x.config.samples);
         let noise = outcome.timings.noise.as_ref().map(|n| &n.1);
-        let matched = match uniform.filter(|u| u.mean("rmse").is_finite()) {
+        let matched = match uniform.filter(|u| u.metrics.rmse.mean.is_finite()) {
             None => "n/a".to_string(),
-            Some(u) => rows
-                .iter()
-                .find(|x| x.mean("rmse") <= u.mean("rmse"))
-                .map_or("not reached".to_string(), |x| {
+            Some(u) => rows.iter().find(|x| x.metrics.rmse.mean <= u.metrics.rmse.mean).map_or(
+                "not reached".to_string(),
+                |x| {
                     let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), noise);
-                    format!("{} rays, {}, {rank}", x.run.samples, ms_iqr(x.frame_ms()))
-                }),
+                    format!("{} rays, {}, {rank}", x.config.samples, ms_iqr(x.frame_ms()))
+                },
+            ),
         };
         s += &format!(
             "| {} | {} | {} | {} | {} | {} | {} |\n",
             scheme,
-            or_na(at.mean("rmse"), |x| format!("{x:.4}")),
-            or_na(at.flip.0, |x| format!("{x:.4}")),
-            or_na(at.mean("penumbra_lost_share"), |x| format!("{x:.3}")),
+            or_na(at.metrics.rmse.mean, |x| format!("{x:.4}")),
+            or_na(at.flip.mean, |x| format!("{x:.4}")),
+            or_na(at.metrics.penumbra_lost_share.mean, |x| format!("{x:.3}")),
             ms_iqr(at.frame_ms()),
             or_na(at.rays_per_s[0], |x| format!("{x:.3e}")),
             matched

@@ -1,10 +1,11 @@
 //! The experiment file: which scene, what to measure, which axes to sweep. Validated into a
 //! [`Spec`] with every error located in the file.
 
+pub use super::axes::Axes;
 use crate::config::{ConfigError, Source};
+use crate::experiment::kind::Kind;
 use crate::key_path;
 use crate::render::BackendChoice;
-use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
@@ -13,6 +14,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct File {
+    #[serde(default)]
+    kind: Kind,
     name: String,
     scene: PathBuf,
     #[serde(default = "default_backend")]
@@ -44,26 +47,6 @@ pub struct Measure {
     pub plane: usize,
 }
 
-/// The swept axes; the sweep is their cartesian product.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Axes {
-    /// Disk sampling schemes.
-    pub schemes: Vec<DiskScheme>,
-    /// Per-pixel or shared patterns.
-    pub patterns: Vec<Pattern>,
-    /// Shadow-ray counts.
-    pub samples: Vec<u32>,
-    /// Light radii, metres.
-    pub light_radii: Vec<f64>,
-    /// Seeds.
-    pub seeds: Vec<u32>,
-    /// How many of the scene's lights are on (the first k); every light in use gets the swept
-    /// radius and shadow-ray count. Default: all of them.
-    #[serde(default)]
-    pub light_counts: Vec<u32>,
-}
-
 /// The high-sample reference image.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -72,7 +55,7 @@ pub struct GroundTruth {
     pub samples: u32,
 }
 
-/// Frame timing (see `experiment::timing`).
+/// Frame timing (see [`super::timing`]).
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TimingSpec {
@@ -139,9 +122,17 @@ pub struct Spec {
 impl Spec {
     /// Reads and validates an experiment file and the scene it names (relative to it).
     pub fn load(path: &Path) -> Result<Spec, ConfigError> {
-        let source = Source::read(path)?;
+        Spec::from_source(&Source::read(path)?)
+    }
+
+    /// Validates an experiment read from its file (`source`) and loads the scene it names.
+    pub fn from_source(source: &Source) -> Result<Spec, ConfigError> {
+        let path = source.path.as_path();
         let f: File = source.parse()?;
         let err = |p: &[crate::config::Seg], m: String| source.error(p, m);
+        if f.kind != Kind::Sweep {
+            return Err(err(&key_path!["kind"], "a sweep has kind = \"sweep\" (or none)".into()));
+        }
         let scene_path = path.parent().unwrap_or(Path::new(".")).join(&f.scene);
         if !scene_path.is_file() {
             return Err(err(
@@ -208,15 +199,13 @@ impl Spec {
             ));
         }
         let a = &axes;
-        for (key, empty) in [
-            ("schemes", a.schemes.is_empty()),
-            ("patterns", a.patterns.is_empty()),
-            ("samples", a.samples.is_empty()),
-            ("light_radii", a.light_radii.is_empty()),
-            ("seeds", a.seeds.is_empty()),
-        ] {
-            if empty {
-                return Err(err(&key_path!["sweep", key], "must list at least one value".into()));
+        let lists = a.texts();
+        for (axis, values) in &lists {
+            if values.is_empty() {
+                return Err(err(
+                    &key_path!["sweep", axis.list_key()],
+                    "must list at least one value".into(),
+                ));
             }
         }
         for (i, &n) in a.samples.iter().enumerate() {
@@ -235,20 +224,16 @@ impl Spec {
                 ));
             }
         }
-        let check_dupes = |key: &str, names: Vec<String>| -> Result<(), ConfigError> {
-            for (i, n) in names.iter().enumerate() {
-                if names[..i].contains(n) {
-                    return Err(err(&key_path!["sweep", key, i], format!("`{n}` is listed twice")));
+        for (axis, values) in &lists {
+            for (i, v) in values.iter().enumerate() {
+                if values[..i].contains(v) {
+                    return Err(err(
+                        &key_path!["sweep", axis.list_key(), i],
+                        format!("`{v}` is listed twice"),
+                    ));
                 }
             }
-            Ok(())
-        };
-        check_dupes("schemes", a.schemes.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("patterns", a.patterns.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("samples", a.samples.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("light_radii", a.light_radii.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("seeds", a.seeds.iter().map(|s| s.to_string()).collect())?;
-        check_dupes("light_counts", a.light_counts.iter().map(|s| s.to_string()).collect())?;
+        }
         if !(1..=MAX_SAMPLES).contains(&f.ground_truth.samples) {
             return Err(err(
                 &key_path!["ground_truth", "samples"],

@@ -2,9 +2,9 @@
 //! check computes its statistic from the images and summaries it is given, so a test can hand it
 //! a broken input (a biased ground truth, a biased scheme) and watch it fail.
 
-use super::summary::{find, Summary};
+use super::summary::Summary;
 use crate::config::{ConfigError, Source};
-use crate::experiment::reference::Reference;
+use crate::experiment::sweep::reference::Reference;
 use crate::metrics::stats::t975;
 use crate::sampling::{DiskScheme, Pattern};
 use serde::Deserialize;
@@ -161,16 +161,16 @@ impl Thresholds {
                     b.bias2 <= bound,
                     format!(
                         "{scheme} n={}: per-pixel squared bias {:.2e} <= {:.1} x {se:.2e} + {:.0e}",
-                        s.run.samples, b.bias2, t.max_bias2_sigmas, t.bias2_floor
+                        s.config.samples, b.bias2, t.max_bias2_sigmas, t.bias2_floor
                     ),
                 ));
             }
-            let rel = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+            let rel = s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
             out.push(check(
                 rel.abs() <= t.width_10_90_tolerance,
                 format!(
                     "{scheme} n={}: 10-90 width {rel:+.3} relative to exact, within {}",
-                    s.run.samples, t.width_10_90_tolerance
+                    s.config.samples, t.width_10_90_tolerance
                 ),
             ));
         }
@@ -194,12 +194,12 @@ impl Thresholds {
         let t = &self.paper;
         let out: Vec<Check> = at_counts(summaries, scheme, radius, 16)
             .map(|s| {
-                let excess = s.mean("width_10_90") / s.exact_width_10_90 - 1.0;
+                let excess = s.metrics.width_10_90.mean / s.exact_width_10_90 - 1.0;
                 check(
                     excess >= t.min_width_10_90_excess && excess <= t.max_width_10_90_excess,
                     format!(
                         "{scheme} n={}: 10-90 width excess {excess:+.3} in [{}, {}]",
-                        s.run.samples, t.min_width_10_90_excess, t.max_width_10_90_excess
+                        s.config.samples, t.min_width_10_90_excess, t.max_width_10_90_excess
                     ),
                 )
             })
@@ -221,7 +221,9 @@ impl Thresholds {
     ) -> Vec<Check> {
         let t = &self.convergence;
         let rmse = |s: DiskScheme, n: u32| {
-            find(summaries, s, Pattern::PerPixel, n, radius, 1).map_or(f64::NAN, |x| x.mean("rmse"))
+            at_counts(summaries, s, radius, n)
+                .find(|x| x.config.samples == n)
+                .map_or(f64::NAN, |x| x.metrics.rmse.mean)
         };
         let ratio = rmse(scheme, 64) / rmse(scheme, 4);
         let sobol = rmse(better, 16) / rmse(than, 16);
@@ -272,10 +274,10 @@ fn not_swept(scheme: DiskScheme, radius: f64, min: u32) -> Check {
 /// Per-pixel summaries of `scheme` at `radius` with one light, from `min` rays up.
 fn at_counts(summaries: &[Summary], scheme: DiskScheme, radius: f64, min: u32) -> impl Iterator<Item = &Summary> {
     summaries.iter().filter(move |s| {
-        s.run.scheme == scheme
-            && s.run.pattern == Pattern::PerPixel
-            && s.run.light_radius == radius
-            && s.run.lights == 1
-            && s.run.samples >= min
+        s.config.scheme == scheme
+            && s.config.pattern == Pattern::PerPixel
+            && s.config.light_radius == radius
+            && s.config.lights == 1
+            && s.config.samples >= min
     })
 }

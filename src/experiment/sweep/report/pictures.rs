@@ -2,11 +2,11 @@
 //! exposure, tiled into fig2_picture.png, and each measured against the ground-truth picture
 //! with FLIP (Andersson et al. 2020), the perceptual stand-in for the paper's "equal quality".
 
-use super::images::{exposure, tonemap_with, Rgb};
-use super::plots::image_grid;
 use super::summary::PictureFlip;
-use crate::experiment::pictures::{Picture, Pictures};
+use crate::experiment::sweep::pictures::{Picture, Pictures};
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
+use crate::output::images::{exposure, tonemap_with, Rgb};
+use crate::output::plots::image_grid;
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
@@ -14,14 +14,14 @@ fn display(p: &Picture, p99: f64) -> Rgb {
     tonemap_with(&p.frame.radiance, p.frame.width, p.frame.height, p99)
 }
 
-/// Mean FLIP of every picture against the ground-truth picture, per (scheme, pattern), one value
-/// per seed in seed order.
+/// Mean FLIP of every picture against the ground-truth picture, per configuration, one value per
+/// seed in seed order.
 pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
     let gt = &pictures.ground_truth;
     let p99 = exposure(&gt.frame.radiance);
     let reference = display(gt, p99);
     let mut out = PictureFlip::new();
-    for p in &pictures.runs {
+    for (run, p) in &pictures.runs {
         let test = display(p, p99);
         let e = flip_mean(
             &reference.data,
@@ -30,7 +30,11 @@ pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
             reference.height,
             PIXELS_PER_DEGREE,
         )?;
-        out.entry((p.scheme, p.pattern)).or_default().push(e);
+        let config = run.config();
+        match out.iter_mut().find(|(c, _)| *c == config) {
+            Some((_, seeds)) => seeds.push(e),
+            None => out.push((config, vec![e])),
+        }
     }
     Ok(out)
 }
@@ -49,8 +53,8 @@ pub fn write_fig2_picture(pictures: &Pictures, seed: u32, path: &Path) -> anyhow
         let found = pictures
             .runs
             .iter()
-            .find(|p| p.scheme == scheme && p.pattern == pattern && p.seed == seed);
-        if let Some(p) = found {
+            .find(|(r, _)| r.scheme == scheme && r.pattern == pattern && r.seed == seed);
+        if let Some((_, p)) = found {
             tiles.push((format!("{scheme} ({pattern}), {} rays", p.samples), display(p, p99)));
         }
     }

@@ -5,26 +5,29 @@
 //! Two means are called different only when their 95 % intervals are disjoint; without intervals
 //! (fewer than two seeds) nothing is called different, and the verdict says it needs more seeds.
 
-use super::numbers::{bias2, or_na, with_ci};
 use super::summary::{find, Summary};
+use crate::experiment::sweep::axes::Config;
+use crate::experiment::sweep::record::Aggregated;
+use crate::metrics::stats::MeanCi;
 use crate::metrics::BiasVariance;
+use crate::output::numbers::{bias2, or_na, with_ci};
 use crate::sampling::{DiskScheme, Pattern};
 
 /// A comparison of two means with 95 % CIs.
 #[derive(Clone, Copy, Debug)]
 pub struct Compare {
     /// First mean and CI half-width.
-    pub a: (f64, f64),
+    pub a: MeanCi,
     /// Second mean and CI half-width.
-    pub b: (f64, f64),
+    pub b: MeanCi,
 }
 
 impl Compare {
     fn intervals(&self) -> Option<((f64, f64), (f64, f64))> {
-        let ok = |(m, c): (f64, f64)| m.is_finite() && c.is_finite();
+        let ok = |x: MeanCi| x.mean.is_finite() && x.ci95.is_finite();
         (ok(self.a) && ok(self.b)).then_some((
-            (self.a.0 - self.a.1, self.a.0 + self.a.1),
-            (self.b.0 - self.b.1, self.b.0 + self.b.1),
+            (self.a.mean - self.a.ci95, self.a.mean + self.a.ci95),
+            (self.b.mean - self.b.ci95, self.b.mean + self.b.ci95),
         ))
     }
 
@@ -45,7 +48,7 @@ impl Compare {
 
     /// a / b.
     pub fn ratio(&self) -> f64 {
-        self.a.0 / self.b.0
+        self.a.mean / self.b.mean
     }
 }
 
@@ -79,23 +82,24 @@ pub struct Verdict {
 }
 
 impl Verdict {
-    /// Builds the verdict for one pattern, if both schemes were swept there.
-    pub fn new(summaries: &[Summary], samples: u32, light_radius: f64, pattern: Pattern) -> Option<Verdict> {
-        let p = find(summaries, DiskScheme::Paper, pattern, samples, light_radius, 1)?;
-        let u = find(summaries, DiskScheme::Uniform, pattern, samples, light_radius, 1)?;
-        let cmp = |m: &str| Compare {
-            a: (p.mean(m), p.ci(m)),
-            b: (u.mean(m), u.ci(m)),
+    /// Builds the verdict at configuration `at` (whatever its scheme), if both schemes were swept
+    /// there.
+    pub fn new(summaries: &[Summary], at: &Config) -> Option<Verdict> {
+        let with = |scheme| find(summaries, &Config { scheme, ..at.clone() });
+        let (p, u) = (with(DiskScheme::Paper)?, with(DiskScheme::Uniform)?);
+        let cmp = |m: fn(&Aggregated) -> MeanCi| Compare {
+            a: m(&p.metrics),
+            b: m(&u.metrics),
         };
         Some(Verdict {
-            samples,
-            light_radius,
-            pattern,
+            samples: at.samples,
+            light_radius: at.light_radius,
+            pattern: at.pattern,
             seeds: p.seeds.min(u.seeds),
-            extent: cmp("extent_width"),
-            width_10_90: cmp("width_10_90"),
-            rmse: cmp("rmse"),
-            rmse_exact: cmp("rmse_exact"),
+            extent: cmp(|m| m.extent_width),
+            width_10_90: cmp(|m| m.width_10_90),
+            rmse: cmp(|m| m.rmse),
+            rmse_exact: cmp(|m| m.rmse_exact),
             flip: Compare { a: p.flip, b: u.flip },
             split: (p.stats.split, u.stats.split),
             exact: (p.exact_extent_width, p.exact_width_10_90),
@@ -111,7 +115,7 @@ impl Verdict {
     /// The verdict as markdown sentences, every claim with its numbers.
     pub fn markdown(&self) -> String {
         let mm = |x: f64| format!("{:.2} mm", x * 1e3);
-        let pm = |(m, c): (f64, f64)| with_ci(m, c, mm);
+        let pm = |x: MeanCi| with_ci(x.mean, x.ci95, mm);
         let mut s = format!(
             "**At {} shadow rays, light radius {} m, {} pattern, {} seeds.**\n\n",
             self.samples, self.light_radius, self.pattern, self.seeds
@@ -142,15 +146,16 @@ impl Verdict {
         let (wa, wb) = (self.width_10_90.a, self.width_10_90.b);
         // The paper's departure from exact is called a bias only when it exceeds uniform's by
         // more than both intervals together.
-        let departs = wa.1.is_finite() && wb.1.is_finite() && (wa.0 - w).abs() > (wb.0 - w).abs() + wa.1 + wb.1;
+        let departs =
+            wa.ci95.is_finite() && wb.ci95.is_finite() && (wa.mean - w).abs() > (wb.mean - w).abs() + wa.ci95 + wb.ci95;
         s += &format!(
             "- *Closer to the truth, or bias?* The 10-90 % width of the mean radial profile is {} (paper, {} vs exact) and {} (uniform, {}); exact {}. {}\n",
             pm(wa),
-            dev(wa.0),
+            dev(wa.mean),
             pm(wb),
-            dev(wb.0),
+            dev(wb.mean),
             or_na(w, mm),
-            if departs && wa.0 > w {
+            if departs && wa.mean > w {
                 "The paper's extra width is a departure from the exact profile: a bias, not a truer penumbra."
             } else if departs {
                 "The paper's profile is narrower than the exact one by more than uniform's departs, beyond noise: a bias."
@@ -166,13 +171,13 @@ impl Verdict {
         let e2 = |x: f64| format!("{x:.2e}");
         s += &format!(
             "- *Equal quality?* RMSE against the ground truth over the penumbra: {} (paper) vs {} (uniform), ratio {}; against the exact image {} vs {}. Perceptual error (FLIP, mean over the Fig. 2 picture against the ground-truth picture): {} vs {}{}. Per pixel over seeds, squared bias {} vs {} and variance {} vs {}.\n",
-            with_ci(self.rmse.a.0, self.rmse.a.1, four),
-            with_ci(self.rmse.b.0, self.rmse.b.1, four),
+            with_ci(self.rmse.a.mean, self.rmse.a.ci95, four),
+            with_ci(self.rmse.b.mean, self.rmse.b.ci95, four),
             or_na(self.rmse.ratio(), |r| format!("{r:.2}")),
-            or_na(self.rmse_exact.a.0, four),
-            or_na(self.rmse_exact.b.0, four),
-            with_ci(self.flip.a.0, self.flip.a.1, four),
-            with_ci(self.flip.b.0, self.flip.b.1, four),
+            or_na(self.rmse_exact.a.mean, four),
+            or_na(self.rmse_exact.b.mean, four),
+            with_ci(self.flip.a.mean, self.flip.a.ci95, four),
+            with_ci(self.flip.b.mean, self.flip.b.ci95, four),
             if self.flip.a_below() {
                 " (the paper's picture is closer, intervals disjoint)"
             } else if self.flip.a_above() {
@@ -206,22 +211,20 @@ mod tests {
     /// (paper, uniform) (mean, CI) pairs.
     fn verdict(extent: [(f64, f64); 2], width: [(f64, f64); 2]) -> Verdict {
         let none = Compare {
-            a: (f64::NAN, f64::NAN),
-            b: (f64::NAN, f64::NAN),
+            a: MeanCi::NAN,
+            b: MeanCi::NAN,
+        };
+        let compare = |[(a, ca), (b, cb)]: [(f64, f64); 2]| Compare {
+            a: MeanCi { mean: a, ci95: ca },
+            b: MeanCi { mean: b, ci95: cb },
         };
         Verdict {
             samples: 16,
             light_radius: 0.02,
             pattern: Pattern::PerPixel,
             seeds: 4,
-            extent: Compare {
-                a: extent[0],
-                b: extent[1],
-            },
-            width_10_90: Compare {
-                a: width[0],
-                b: width[1],
-            },
+            extent: compare(extent),
+            width_10_90: compare(width),
             rmse: none,
             rmse_exact: none,
             flip: none,

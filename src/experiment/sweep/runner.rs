@@ -2,16 +2,18 @@
 //! every run, measure it, and stream the records to a journal so an interrupted sweep resumes
 //! where it stopped; then time every configuration in interleaved rounds (see [`super::timing`]).
 
+use super::axes::Config;
 use super::journal::Journal;
 use super::measure::{failed_record, measure_run};
+use super::record::{FrameTime, Record, Status};
 use super::reference::Reference;
-use super::run::{context_key, expand, num, Group, GroupStats, Record, Run};
+use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
+use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::render::{Backend, RenderPlan, View};
-use crate::sampling::{DiskScheme, Pattern};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::path::Path;
 
 /// What a finished sweep hands to the report.
@@ -22,10 +24,12 @@ pub struct Outcome {
     pub groups: Vec<GroupStats>,
     /// The references, one per (lights on, light radius) pair, in sweep order.
     pub references: Vec<Reference>,
-    /// Seed-averaged radial profiles at the figure sample count: (scheme, pattern, reference index).
-    pub profiles: BTreeMap<(DiskScheme, Pattern, usize), RadialProfile>,
-    /// Measuring-view visibility of the first seed at the figure sample count.
-    pub keep: BTreeMap<(DiskScheme, Pattern, usize), Vec<f32>>,
+    /// Seed-averaged radial profiles of the configurations at the figure sample count (on-axis
+    /// scenes).
+    pub profiles: Vec<(Config, RadialProfile)>,
+    /// Measuring-view visibility of the first seed of each configuration at the figure sample
+    /// count.
+    pub keep: Vec<(Config, Vec<f32>)>,
     /// The render plan at the figure sample count with every swept light on, logged with the results.
     pub plan: RenderPlan,
     /// Frame times per configuration (empty when the experiment times nothing).
@@ -95,19 +99,22 @@ pub fn run_sweep(
         records: Vec::new(),
         groups: Vec::new(),
         references: Vec::new(),
-        profiles: BTreeMap::new(),
-        keep: BTreeMap::new(),
+        profiles: Vec::new(),
+        keep: Vec::new(),
         plan: sweep_plan(spec)?,
         timings: Timings::default(),
         failures: 0,
         resumed: 0,
     };
-    let pairs = spec
-        .axes
-        .light_counts
-        .iter()
-        .flat_map(|&l| spec.axes.light_radii.iter().map(move |&r| (l, r)));
-    for (ri, (lights, radius)) in pairs.enumerate() {
+    // Lights and radius nest outermost: each pair's reference is built once.
+    let mut pairs: Vec<(u32, f64)> = Vec::new();
+    for g in &groups {
+        let pair = (g.head().lights, g.head().light_radius);
+        if !pairs.contains(&pair) {
+            pairs.push(pair);
+        }
+    }
+    for (lights, radius) in pairs {
         bar.set_message(format!("runs; reference for {lights} light(s) of radius {radius} m"));
         let reference = Reference::build(spec, backend, lights, radius, cache, &context)?;
         for warning in reference.warnings() {
@@ -118,7 +125,7 @@ pub fn run_sweep(
             .iter()
             .filter(|g| g.head().light_radius == radius && g.head().lights == lights)
         {
-            let head = *group.head();
+            let head = group.head();
             let needed_for_figures = head.samples == fig_n;
             if !needed_for_figures {
                 if let Some((records, stats)) = journal.completed(group, &context) {
@@ -129,15 +136,12 @@ pub fn run_sweep(
                     continue;
                 }
             }
-            bar.set_message(format!(
-                "runs; {} {} n={} r={}",
-                head.scheme, head.pattern, head.samples, radius
-            ));
+            bar.set_message(format!("runs; {}", group.config()));
             let (records, stats, images) = run_group(spec, backend, group, &reference, &context, &bar);
             if needed_for_figures {
-                keep_for_figures(&mut out, &reference, head, ri, &images);
+                keep_for_figures(&mut out, &reference, group.config(), &images);
             }
-            let failed = records.iter().filter(|r| r.get("status") != "ok").count();
+            let failed = records.iter().filter(|r| r.status != Status::Ok).count();
             out.failures += failed;
             if failed == 0 {
                 journal.append(&group.key(&context), &records, &stats)?;
@@ -170,9 +174,7 @@ fn time_sweep(
         .iter()
         .filter(|g| {
             let key = g.head().key(context);
-            out.records
-                .iter()
-                .any(|r| r.get("run_key") == key && r.get("status") == "ok")
+            out.records.iter().any(|r| r.run_key == key && r.status == Status::Ok)
         })
         .collect();
     let probe = timing::noise_probe(&rendered, figure_samples(spec), verdict_radius(spec));
@@ -212,13 +214,13 @@ fn time_sweep(
             new.push((k.clone(), n.clone()));
         }
         journal.append_timings(&settings, &new)?;
-        result.noise = noise.map(|n| (*probe.expect("noise probe").head(), n));
+        result.noise = noise.map(|n| (probe.expect("noise probe").config(), n));
         result
             .configs
             .extend(new.into_iter().filter(|(k, _)| Some(k) != noise_key.as_ref()));
     }
     if let (Some(g), Some(n)) = (probe, journaled_noise) {
-        result.noise = Some((*g.head(), n));
+        result.noise = Some((g.config(), n));
     }
     Ok(result)
 }
@@ -234,51 +236,47 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
             g.runs.iter().map(move |r| (r.key(context), gk.clone()))
         })
         .collect();
+    let count = |n: Option<u64>| n.map_or(f64::NAN, |n| n as f64);
     let rays: HashMap<String, (f64, f64)> = out
         .records
         .iter()
         .map(|r| {
             (
-                r.get("run_key").to_string(),
-                (r.num("primary_rays"), r.num("shadow_rays")),
+                r.run_key.clone(),
+                (count(r.rays.primary_rays), count(r.rays.shadow_rays)),
             )
         })
         .collect();
-    for r in out.records.iter_mut().filter(|r| r.get("status") == "ok") {
-        let Some(gk) = group_of.get(r.get("run_key")) else {
+    for r in out.records.iter_mut().filter(|r| r.status == Status::Ok) {
+        let Some(gk) = group_of.get(&r.run_key) else {
             continue;
         };
         let Some(t) = out.timings.configs.get(gk) else { continue };
         let (q1, med, q3) = t.frame_ms();
         let (primary, shadow) = rays[gk];
-        let (seconds, primary_seconds) = (med * 1e-3, t.primary_median());
-        r.set("frame_ms", num(med));
-        r.set("frame_ms_q1", num(q1));
-        r.set("frame_ms_q3", num(q3));
-        r.set("timed_frames", t.frame_seconds.len().to_string());
-        r.set("rays_per_s", num((primary + shadow) / seconds));
-        r.set("primary_rays_per_s", num(primary / primary_seconds));
-        r.set("shadow_rays_per_s", num(shadow / (seconds - primary_seconds)));
-        r.set("clock", t.clock.clone());
+        let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] =
+            rays_per_second(primary, shadow, med * 1e-3, t.primary_median());
+        r.time = FrameTime {
+            frame_ms: med,
+            frame_ms_q1: q1,
+            frame_ms_q3: q3,
+            timed_frames: Some(t.frame_seconds.len()),
+            rays_per_s,
+            primary_rays_per_s,
+            shadow_rays_per_s,
+            clock: Some(t.clock.clone()),
+        };
     }
 }
 
-fn keep_for_figures(out: &mut Outcome, reference: &Reference, head: Run, ri: usize, images: &[Vec<f32>]) {
+fn keep_for_figures(out: &mut Outcome, reference: &Reference, config: Config, images: &[Vec<f32>]) {
     let Some(first) = images.first() else { return };
-    let key = (head.scheme, head.pattern, ri);
-    out.keep.insert(key, first.clone());
+    out.keep.push((config.clone(), first.clone()));
     if reference.on_axis.is_none() {
         return;
     }
-    let mut avg = RadialProfile::new(&reference.receivers, first);
-    let profiles: Vec<_> = images
-        .iter()
-        .map(|im| RadialProfile::new(&reference.receivers, im))
-        .collect();
-    for (b, m) in avg.mean.iter_mut().enumerate() {
-        *m = profiles.iter().map(|p| p.mean[b]).sum::<f64>() / profiles.len() as f64;
-    }
-    out.profiles.insert(key, avg);
+    out.profiles
+        .push((config, RadialProfile::mean_over(&reference.receivers, images)));
 }
 
 /// Renders and measures every seed of a group; a failed render becomes a failed record and the
@@ -300,16 +298,7 @@ fn run_group(
                 images.push(image);
             }
             Err(e) => {
-                bar.suspend(|| {
-                    tracing::error!(
-                        "run failed ({} {} n={} r={} seed={}): {e:#}",
-                        run.scheme,
-                        run.pattern,
-                        run.samples,
-                        run.light_radius,
-                        run.seed
-                    )
-                });
+                bar.suspend(|| tracing::error!("run failed ({} seed={}): {e:#}", run.config(), run.seed));
                 records.push(failed_record(spec, backend, run, context, &format!("{e:#}")));
             }
         }
@@ -317,8 +306,21 @@ fn run_group(
     }
     let stats = GroupStats {
         key: group.head().key(context),
-        run: *group.head(),
+        config: group.config(),
         split: BiasVariance::measure(&images, &reference.ground_truth, &reference.mask),
     };
     (records, stats, images)
+}
+
+/// What `--dry-run` prints: every configuration with its seeds, then the render plan.
+pub fn dry_run(spec: &Spec) -> anyhow::Result<String> {
+    let groups = expand(spec);
+    let runs: usize = groups.iter().map(|g| g.runs.len()).sum();
+    let mut out = format!("{}: {runs} runs in {} configurations\n", spec.name, groups.len());
+    for g in &groups {
+        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
+        out += &format!("  {} seeds=[{}]\n", g.config(), seeds.join(", "));
+    }
+    out += &format!("render plan of a run:\n{}", sweep_plan(spec)?);
+    Ok(out)
 }

@@ -1,7 +1,8 @@
-//! Fig. 2-style pictures: the picture camera rendered with every swept scheme and pattern at the
+//! Fig. 2-style pictures: the picture camera rendered with every swept configuration at the
 //! figure ray count, for every seed, beside a high-sample ground-truth picture. The report shows
 //! the first seed's and measures each against the ground truth perceptually (FLIP).
 
+use super::run::{expand, Run};
 use super::runner::figure_samples;
 use super::spec::Spec;
 use crate::render::{Backend, Frame, Sampling, View};
@@ -9,14 +10,8 @@ use crate::sampling::{DiskScheme, Pattern};
 
 /// One rendered picture.
 pub struct Picture {
-    /// Scheme.
-    pub scheme: DiskScheme,
-    /// Pattern.
-    pub pattern: Pattern,
     /// Shadow rays per pixel.
     pub samples: u32,
-    /// Seed.
-    pub seed: u32,
     /// The frame (radiance is what is shown).
     pub frame: Frame,
 }
@@ -25,8 +20,8 @@ pub struct Picture {
 pub struct Pictures {
     /// Jittered sampling at the figures' ground-truth ray count.
     pub ground_truth: Picture,
-    /// Every swept scheme x pattern x seed at the figure ray count.
-    pub runs: Vec<Picture>,
+    /// Every run at the figure ray count, `light_radius` and every swept light on, in sweep order.
+    pub runs: Vec<(Run, Picture)>,
 }
 
 /// Renders the pictures; `None` when the experiment has no `[figures]`.
@@ -43,13 +38,7 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
             height: f.height,
         };
         let frame = backend.render(&scene, view, Sampling { scheme, pattern, seed })?;
-        Ok(Picture {
-            scheme,
-            pattern,
-            samples,
-            seed,
-            frame,
-        })
+        Ok(Picture { samples, frame })
     };
     let ground_truth = render(
         DiskScheme::Jittered,
@@ -59,10 +48,11 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
     )?;
     let n = figure_samples(spec);
     let mut runs = Vec::new();
-    for &scheme in &spec.axes.schemes {
-        for &pattern in &spec.axes.patterns {
-            for &seed in &spec.axes.seeds {
-                runs.push(render(scheme, pattern, n, seed)?);
+    for group in expand(spec) {
+        for run in group.runs {
+            if run.samples == n && run.light_radius == light_radius && run.lights == lights {
+                let picture = render(run.scheme, run.pattern, n, run.seed)?;
+                runs.push((run, picture));
             }
         }
     }

@@ -1,0 +1,319 @@
+//! Records: one row of runs.csv per run, in tidy form. A record is typed data that the csv crate
+//! writes and reads back (the journal resumes from it, and a resumed sweep reproduces earlier
+//! rows byte for byte); each metric is defined in `metrics` or README.md.
+
+use super::axes::Run;
+use crate::metrics::stats::{mean_ci, MeanCi};
+use crate::output::table::{float, Float};
+use crate::render::AdapterInfo;
+use serde::ser::SerializeStruct;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+/// Whether a run rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Rendered and measured.
+    Ok,
+    /// Failed; the record's `error` says why.
+    Failed,
+}
+
+/// One row of runs.csv. Its columns are its fields' in order, each part's fields in turn: the
+/// key and status, the run's axes ([`Run`], so a new axis is a new column by itself), then what
+/// was measured. Values not measured (a failed run, a scene without an exact on-axis answer, an
+/// untimed sweep) are NaN or `None`, empty in the table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Record {
+    /// Hash of everything that determines the run ([`Run::key`]).
+    pub run_key: String,
+    /// Whether it rendered.
+    pub status: Status,
+    /// Its axes.
+    pub run: Run,
+    /// The measuring image and its radial reading.
+    pub radial: Radial,
+    /// The metrics summary.csv aggregates over seeds.
+    pub metrics: Metrics,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// Its configuration's frame time, from the timing phase.
+    pub time: FrameTime,
+    /// The scene's BVH, on mesh scenes.
+    pub bvh: BvhColumns,
+    /// The device that rendered it.
+    pub device: Device,
+    /// Why it failed; empty when it rendered.
+    pub error: String,
+}
+
+/// The columns before the run's axes.
+#[derive(Serialize, Deserialize)]
+struct Head {
+    run_key: String,
+    status: Status,
+}
+
+/// The column after the device's.
+#[derive(Serialize, Deserialize)]
+struct Tail {
+    error: String,
+}
+
+type Parts = (
+    Head,
+    Run,
+    Radial,
+    Metrics,
+    RayCounts,
+    FrameTime,
+    BvhColumns,
+    Device,
+    Tail,
+);
+
+impl Serialize for Record {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let head = Head {
+            run_key: self.run_key.clone(),
+            status: self.status,
+        };
+        let tail = Tail {
+            error: self.error.clone(),
+        };
+        (
+            head,
+            &self.run,
+            &self.radial,
+            &self.metrics,
+            &self.rays,
+            &self.time,
+            &self.bvh,
+            &self.device,
+            tail,
+        )
+            .serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for Record {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Record, D::Error> {
+        let (head, run, radial, metrics, rays, time, bvh, device, tail) = Parts::deserialize(d)?;
+        Ok(Record {
+            run_key: head.run_key,
+            status: head.status,
+            run,
+            radial,
+            metrics,
+            rays,
+            time,
+            bvh,
+            device,
+            error: tail.error,
+        })
+    }
+}
+
+/// The measuring image's size and its radial reading: the closed-form radii, the exact image's
+/// extent and 10-90 % width (read like the runs'), and the run's own extent.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Radial {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Closed-form umbra radius r_u (negative: no umbra).
+    #[serde(with = "float")]
+    pub exact_umbra_radius: f64,
+    /// Closed-form penumbra radius r_p.
+    #[serde(with = "float")]
+    pub exact_penumbra_radius: f64,
+    /// The exact image's visible extent, outer - inner.
+    #[serde(with = "float")]
+    pub exact_extent_width: f64,
+    /// The exact image's 10-90 % width.
+    #[serde(with = "float")]
+    pub exact_width_10_90: f64,
+    /// Inner edge of the run's visible extent.
+    #[serde(with = "float")]
+    pub extent_inner: f64,
+    /// Outer edge of the run's visible extent.
+    #[serde(with = "float")]
+    pub extent_outer: f64,
+}
+
+impl Radial {
+    /// A `width` x `height` image with no radial reading.
+    pub fn unmeasured(width: u32, height: u32) -> Radial {
+        Radial {
+            width,
+            height,
+            exact_umbra_radius: f64::NAN,
+            exact_penumbra_radius: f64::NAN,
+            exact_extent_width: f64::NAN,
+            exact_width_10_90: f64::NAN,
+            extent_inner: f64::NAN,
+            extent_outer: f64::NAN,
+        }
+    }
+}
+
+/// Declares the metrics summary.csv aggregates over seeds, once: a run's [`Metrics`] (runs.csv's
+/// columns) and their [`Aggregated`] means and 95 % CI half-widths (summary.csv's `NAME_mean`
+/// and `NAME_ci95` columns).
+macro_rules! aggregated_metrics {
+    ($($(#[$doc:meta])* $m:ident,)*) => {
+        /// The metrics of a run that summary.csv aggregates over seeds.
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+        pub struct Metrics {
+            $($(#[$doc])* #[serde(with = "float")] pub $m: f64,)*
+        }
+
+        impl Metrics {
+            /// Nothing measured.
+            pub const NONE: Metrics = Metrics { $($m: f64::NAN,)* };
+
+            /// Each metric's mean and 95 % CI half-width over `runs`.
+            pub fn aggregate(runs: &[&Metrics]) -> Aggregated {
+                Aggregated { $($m: mean_ci(&runs.iter().map(|r| r.$m).collect::<Vec<_>>()),)* }
+            }
+        }
+
+        /// Each metric of [`Metrics`] over the seeds of a configuration.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Aggregated {
+            $($(#[$doc])* pub $m: MeanCi,)*
+        }
+
+        impl Serialize for Aggregated {
+            fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                let mut row = s.serialize_struct("Aggregated", 2 * [$(stringify!($m)),*].len())?;
+                $(
+                    row.serialize_field(concat!(stringify!($m), "_mean"), &Float(self.$m.mean))?;
+                    row.serialize_field(concat!(stringify!($m), "_ci95"), &Float(self.$m.ci95))?;
+                )*
+                row.end()
+            }
+        }
+    };
+}
+
+aggregated_metrics! {
+    /// Visible extent of the penumbra, outer - inner (m).
+    extent_width,
+    /// 10-90 % width of the mean radial profile (m).
+    width_10_90,
+    /// Mean signed profile - exact profile inside the exact extent.
+    profile_bias,
+    /// Mean |profile - exact profile| inside the exact extent.
+    profile_abs_bias,
+    /// RMSE against the ground truth over its penumbra.
+    rmse,
+    /// Relative MSE against the ground truth over its penumbra.
+    relmse,
+    /// Mean signed error against the ground truth over its penumbra.
+    bias,
+    /// RMSE against the exact image over the ground truth's penumbra.
+    rmse_exact,
+    /// The run's penumbra area over the ground truth's.
+    penumbra_area_ratio,
+    /// Share of the true penumbra shown fully lit or fully dark.
+    penumbra_lost_share,
+}
+
+/// Rays one frame of the run traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RayCounts {
+    /// Camera rays.
+    pub primary_rays: Option<u64>,
+    /// Shadow rays, all lights.
+    pub shadow_rays: Option<u64>,
+}
+
+/// The frame time of the run's configuration (timed once, with its first seed).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameTime {
+    /// Median frame time (ms).
+    #[serde(with = "float")]
+    pub frame_ms: f64,
+    /// First quartile (ms).
+    #[serde(with = "float")]
+    pub frame_ms_q1: f64,
+    /// Third quartile (ms).
+    #[serde(with = "float")]
+    pub frame_ms_q3: f64,
+    /// Frames timed.
+    pub timed_frames: Option<usize>,
+    /// All rays per second at the median frame time.
+    #[serde(with = "float")]
+    pub rays_per_s: f64,
+    /// Camera rays per second of the primary pass.
+    #[serde(with = "float")]
+    pub primary_rays_per_s: f64,
+    /// Shadow rays per second of the shadow passes.
+    #[serde(with = "float")]
+    pub shadow_rays_per_s: f64,
+    /// How frames were timed (`gpu-timestamp` or `wall-clock`).
+    pub clock: Option<String>,
+}
+
+impl FrameTime {
+    /// Not timed.
+    pub const UNTIMED: FrameTime = FrameTime {
+        frame_ms: f64::NAN,
+        frame_ms_q1: f64::NAN,
+        frame_ms_q3: f64::NAN,
+        timed_frames: None,
+        rays_per_s: f64::NAN,
+        primary_rays_per_s: f64::NAN,
+        shadow_rays_per_s: f64::NAN,
+        clock: None,
+    };
+}
+
+/// The scene's BVH: its build preset and time, and its GPU memory per triangle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BvhColumns {
+    /// obvhs build preset.
+    pub bvh_preset: Option<String>,
+    /// Build time (ms).
+    #[serde(with = "float")]
+    pub bvh_build_ms: f64,
+    /// GPU bytes per triangle (nodes and triangles).
+    #[serde(with = "float")]
+    pub gpu_bytes_per_triangle: f64,
+}
+
+impl BvhColumns {
+    /// No BVH (no meshes).
+    pub const NONE: BvhColumns = BvhColumns {
+        bvh_preset: None,
+        bvh_build_ms: f64::NAN,
+        gpu_bytes_per_triangle: f64::NAN,
+    };
+}
+
+/// The device a run rendered on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Device {
+    /// `gpu` or `cpu`.
+    pub backend: String,
+    /// Adapter name.
+    pub adapter: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Graphics API, or the CPU thread count.
+    pub api: String,
+}
+
+impl Device {
+    /// The device `a` describes.
+    pub fn of(a: &AdapterInfo) -> Device {
+        Device {
+            backend: a.backend.clone(),
+            adapter: a.name.clone(),
+            driver: a.driver.clone(),
+            api: a.api.clone(),
+        }
+    }
+}

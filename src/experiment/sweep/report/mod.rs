@@ -1,0 +1,37 @@
+//! The sweep's outputs: CSV tables, plots, images, the markdown report with its verdict, and the
+//! regression thresholds checked against them. Each file is written atomically, the manifest
+//! last.
+
+pub mod images;
+pub mod manifest;
+pub mod markdown;
+pub mod pictures;
+pub mod plots;
+pub mod results;
+pub mod summary;
+pub mod tables;
+pub mod thresholds;
+pub mod verdict;
+
+use crate::files::write_atomic;
+use markdown::report;
+use pictures::picture_flip;
+pub use results::Results;
+use std::path::Path;
+
+/// Writes every output under `out`.
+pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
+    let flip = match r.pictures {
+        Some(p) => picture_flip(p)?,
+        None => Default::default(),
+    };
+    let summaries = summary::summarise(r.outcome, &flip);
+    tables::write_tables(r, &summaries, out)?;
+    plots::write_plots(r, &summaries, &out.join("plots"))?;
+    images::write_images(r, &out.join("images"))?;
+    write_atomic(
+        &out.join("report.md"),
+        report(r.spec, r.outcome, &summaries, r.adapter, r.seconds).as_bytes(),
+    )?;
+    write_atomic(&out.join("manifest.toml"), manifest::manifest(r).as_bytes())
+}

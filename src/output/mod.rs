@@ -1,0 +1,30 @@
+//! What every kind's report is made of: plots, images, how numbers read, and the provenance
+//! every manifest records.
+
+pub mod images;
+pub mod numbers;
+pub mod plots;
+pub mod table;
+
+/// The checkout's commit, suffixed `-dirty` when tracked files differ from it.
+pub fn git_commit() -> String {
+    let run = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match run(&["rev-parse", "HEAD"]) {
+        Some(c) => {
+            let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+            if dirty {
+                format!("{c}-dirty")
+            } else {
+                c
+            }
+        }
+        None => "unknown".into(),
+    }
+}

@@ -1,0 +1,190 @@
+//! CSV tables as serde rows, written and read by the csv crate. A row's columns are its fields;
+//! a row made of parts (a tuple, or a type that serializes as one) has its parts' fields in
+//! order. Floats are written in their shortest round-trip form (`format!("{x}")`, never exponent
+//! notation) and NaN as an empty field, so a row read back and written again is byte for byte
+//! the same.
+
+use crate::files::write_atomic;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use std::fmt::Display;
+use std::fs::{self, OpenOptions};
+use std::io::Write;
+use std::path::Path;
+use std::str::FromStr;
+
+/// Writes `rows` to `path` atomically, under the header csv names from the first row.
+pub fn write_rows<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T>) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r)?;
+    }
+    write_atomic(path, &w.into_inner()?)
+}
+
+/// Appends `rows` to the CSV file at `path` (a new file gets the header first) and flushes them
+/// to disk.
+pub fn append_rows<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T>) -> anyhow::Result<()> {
+    let new = !path.exists();
+    let mut w = csv::WriterBuilder::new().has_headers(new).from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r)?;
+    }
+    let mut f = OpenOptions::new().create(true).append(true).open(path)?;
+    f.write_all(&w.into_inner()?)?;
+    f.sync_data()?;
+    Ok(())
+}
+
+/// The rows of the CSV file at `path`, if its header is the one `T` is written under: a missing
+/// file or another header gives none; a torn last line (from a crash) and rows that do not read
+/// as a `T` are dropped. Rows are read by position, so that rows made of parts read back.
+pub fn read_rows<T: Serialize + DeserializeOwned>(path: &Path) -> Vec<T> {
+    let Ok(text) = fs::read_to_string(path) else {
+        return vec![];
+    };
+    let complete = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_reader(complete.as_bytes());
+    let Ok(header) = reader.headers().cloned() else {
+        return vec![];
+    };
+    let rows: Vec<T> = reader
+        .records()
+        .filter_map(Result::ok)
+        .filter(|r| r.len() == header.len())
+        .filter_map(|r| r.deserialize(None).ok())
+        .collect();
+    match rows.first().map(header_of) {
+        Some(Ok(h)) if h == header => rows,
+        _ => vec![],
+    }
+}
+
+/// The header csv writes for `row`.
+fn header_of<T: Serialize>(row: &T) -> anyhow::Result<csv::StringRecord> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.serialize(row)?;
+    let bytes = w.into_inner()?;
+    Ok(csv::Reader::from_reader(bytes.as_slice()).headers()?.clone())
+}
+
+/// A float as a table writes it: shortest round-trip text, NaN empty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Float(pub f64);
+
+impl Serialize for Float {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if self.0.is_nan() {
+            s.serialize_str("")
+        } else {
+            s.collect_str(&self.0)
+        }
+    }
+}
+
+/// `#[serde(with = "float")]` on an `f64` field: written as [`Float`], an empty field read as NaN.
+pub mod float {
+    use super::*;
+
+    /// Writes `x` as [`Float`].
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        Float(*x).serialize(s)
+    }
+
+    /// Reads a float; an empty field is NaN.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        let s = String::deserialize(d)?;
+        if s.is_empty() {
+            Ok(f64::NAN)
+        } else {
+            s.parse().map_err(serde::de::Error::custom)
+        }
+    }
+}
+
+/// `#[serde(with = "text")]`: a value as its `Display` text, read back with `FromStr` (axis
+/// values, which are written as they are named in experiment files and filters).
+pub mod text {
+    use super::*;
+
+    /// Writes `value`'s text.
+    pub fn serialize<T: Display, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(value)
+    }
+
+    /// Reads a value from its text.
+    pub fn deserialize<'de, T, D>(d: D) -> Result<T, D::Error>
+    where
+        T: FromStr,
+        T::Err: Display,
+        D: Deserializer<'de>,
+    {
+        String::deserialize(d)?.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    struct Head {
+        key: String,
+        #[serde(with = "float")]
+        x: f64,
+    }
+
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    struct Tail {
+        n: Option<u64>,
+        #[serde(with = "float")]
+        y: f64,
+    }
+
+    #[test]
+    fn rows_of_parts_round_trip_byte_for_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        let rows = [
+            (
+                Head {
+                    key: "a".into(),
+                    x: 1e-5,
+                },
+                Tail {
+                    n: Some(3),
+                    y: f64::NAN,
+                },
+            ),
+            (
+                Head {
+                    key: "b,c".into(),
+                    x: 1.0,
+                },
+                Tail { n: None, y: -0.25 },
+            ),
+        ];
+        append_rows(&path, rows[..1].iter().cloned()).unwrap();
+        append_rows(&path, rows[1..].iter().cloned()).unwrap();
+        let text = fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "key,x,n,y\na,0.00001,3,\n\"b,c\",1,,-0.25\n");
+        let back: Vec<(Head, Tail)> = read_rows(&path);
+        assert_eq!(back.len(), 2);
+        assert!(back[0].1.y.is_nan());
+        write_rows(&dir.path().join("u.csv"), &back).unwrap();
+        assert_eq!(fs::read_to_string(dir.path().join("u.csv")).unwrap(), text);
+    }
+
+    #[test]
+    fn torn_lines_and_other_headers_are_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        fs::write(&path, "key,x\na,1\nb,2\nc,").unwrap();
+        assert_eq!(read_rows::<Head>(&path).len(), 2);
+        fs::write(&path, "key,z\na,1\n").unwrap();
+        assert!(read_rows::<Head>(&path).is_empty());
+        assert!(read_rows::<Head>(&dir.path().join("missing.csv")).is_empty());
+    }
+}
