@@ -115,14 +115,14 @@ fn plan_follows_the_scene() {
     );
 }
 
-/// `scene` with a mesh: a 0.4 m square of two triangles, 1 m above the ground, indexed by the
-/// default acceleration structure.
+/// `scene` with a mesh: a 1.2 m square of two triangles, 0.4 m above the ground (below the
+/// camera, so its top is seen), indexed by the default acceleration structure.
 fn with_quad(scene: Scene) -> Scene {
-    let c = |x: f64, y: f64| DVec3::new(x, y, 1.0);
+    let c = |x: f64, y: f64| DVec3::new(x, y, 0.4);
     let triangles = Triangles {
         positions: vec![
-            [c(-0.2, -0.2), c(0.2, -0.2), c(0.2, 0.2)],
-            [c(-0.2, -0.2), c(0.2, 0.2), c(-0.2, 0.2)],
+            [c(-0.6, -0.6), c(0.6, -0.6), c(0.6, 0.6)],
+            [c(-0.6, -0.6), c(0.6, 0.6), c(-0.6, 0.6)],
         ],
         object_of: vec![0, 0],
     };
@@ -138,7 +138,7 @@ fn with_quad(scene: Scene) -> Scene {
 
 /// Receivers (pixels whose ray goes down to the plane) each trace 1 ray to the point light and
 /// 8 to the disk above; none to the light below the plane. Counted independently from the
-/// camera's rays.
+/// camera's rays, with and without a mesh over the plane (whose top faces receive the same).
 #[test]
 fn traced_rays_match_an_independent_count() {
     let (s, cam) = scene();
@@ -160,8 +160,9 @@ fn traced_rays_match_an_independent_count() {
         pattern: Pattern::PerPixel,
         seed: 3,
     };
-    let check = |name: &str, b: &mut dyn Backend| {
-        let f = b.render(&s, view, sampling).unwrap();
+    let meshed = with_quad(s.clone());
+    let check = |name: &str, b: &mut dyn Backend, s: &Scene| {
+        let f = b.render(s, view, sampling).unwrap();
         assert_eq!(f.rays.primary, 1200, "{name}");
         assert_eq!(f.rays.shadow[0], receivers, "{name}: point light");
         assert_eq!(f.rays.shadow[1], 8 * receivers, "{name}: disk light above");
@@ -172,10 +173,16 @@ fn traced_rays_match_an_independent_count() {
             below.iter().all(|v| *v == 0.0),
             "{name}: a light facing away is invisible"
         );
+        f
     };
-    check("cpu", &mut CpuBackend::default());
+    let quad_pixels = |f: &penumbra::render::Frame| f.hit.iter().filter(|&&h| h == 1).count();
+    let f = check("cpu", &mut CpuBackend::default(), &meshed);
+    assert!(quad_pixels(&f) >= 8, "the mesh must be in view: {}", quad_pixels(&f));
+    check("cpu", &mut CpuBackend::default(), &s);
     if let Some(mut g) = common::gpu() {
-        check("gpu", &mut *g);
+        check("gpu", &mut *g, &s);
+        let f = check("gpu", &mut *g, &meshed);
+        assert!(quad_pixels(&f) >= 8, "the mesh must be in view on the GPU");
     }
 }
 

@@ -111,7 +111,8 @@ pub struct BuildStats {
 pub struct GpuStructure {
     /// (label, bytes) per buffer, in binding order.
     pub buffers: Vec<(&'static str, Vec<u8>)>,
-    /// Upper bound on the loop iterations of one any-hit query, for adapters that cap loops.
+    /// Loop iterations budgeted for one any-hit query on adapters that cap loops (a query that
+    /// runs over is caught as cut short, and the frame redone with fewer samples per dispatch).
     pub walk_iterations: u32,
 }
 

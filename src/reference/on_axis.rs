@@ -30,7 +30,8 @@ impl OnAxis {
         let Some(Light::Disk(l)) = scene.lights.get(light) else {
             return None;
         };
-        let (spheres, _) = super::occluders(&scene.shapes)?;
+        // A mesh would cast a shadow the closed form does not know.
+        let (spheres, _) = super::occluders(scene)?;
         let [s] = spheres.as_slice() else {
             return None;
         };

@@ -117,6 +117,15 @@ impl Scene {
     /// Adds triangle meshes, whose world-space `triangles` name their mesh by its index in
     /// `meshes`, and indexes every triangle with the structure `settings` names.
     pub fn with_meshes(mut self, meshes: Vec<Mesh>, mut triangles: Triangles, settings: AccelSettings) -> Scene {
+        assert_eq!(
+            triangles.object_of.len(),
+            triangles.positions.len(),
+            "one owner per triangle"
+        );
+        assert!(
+            triangles.object_of.iter().all(|&m| (m as usize) < meshes.len()),
+            "every triangle names one of the meshes given"
+        );
         let base = self.shapes.len() as u32;
         triangles.object_of.iter_mut().for_each(|m| *m += base);
         self.shapes.extend(meshes.into_iter().map(Shape::Mesh));

@@ -97,7 +97,7 @@ impl Accelerator for Brute {
             })
             .collect();
         Ok(GpuStructure {
-            buffers: vec![("brute-force triangles", bytemuck::cast_slice(&tris).to_vec())],
+            buffers: vec![("brute-force triangle buffer", bytemuck::cast_slice(&tris).to_vec())],
             walk_iterations: tris.len() as u32 + 1,
         })
     }

@@ -87,8 +87,8 @@ pub(super) fn structure(bvh: &Bvh, frame: &LocalFrame) -> anyhow::Result<GpuStru
         .collect();
     Ok(GpuStructure {
         buffers: vec![
-            ("bvh nodes", bytemuck::cast_slice(&nodes).to_vec()),
-            ("bvh triangles", bytemuck::cast_slice(&triangles).to_vec()),
+            ("BVH node buffer", bytemuck::cast_slice(&nodes).to_vec()),
+            ("BVH triangle buffer", bytemuck::cast_slice(&triangles).to_vec()),
         ],
         walk_iterations: WALK_ITERATIONS,
     })

@@ -187,7 +187,7 @@ impl Reference {
 
 /// The exact reference covers disk lights and analytic shapes (no meshes, no point lights).
 pub fn has_exact_answer(scene: &Scene) -> bool {
-    crate::reference::occluders(&scene.shapes).is_some() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
+    crate::reference::occluders(scene).is_some() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
 }
 
 /// How accurate an exact image is, from its quadrature's own estimates.
@@ -203,7 +203,7 @@ pub struct ExactQuality {
 /// quadrature's accuracy (rayon; the penumbra dominates the cost).
 pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> (Vec<f32>, ExactQuality) {
     let (_, pl) = scene.plane(plane).expect("the measured plane was validated");
-    let (spheres, planes) = crate::reference::occluders(&scene.shapes).expect("an exact answer exists");
+    let (spheres, planes) = crate::reference::occluders(scene).expect("an exact answer exists");
     let points: Vec<(usize, glam::DVec3)> = receivers
         .pixels
         .iter()

@@ -100,7 +100,7 @@ impl GpuBackend {
         let mut packed = pack(&scene, view, sampling)?;
         packed.params.scheme = id;
         packed.params.height = pixel;
-        let r = self.resources(&packed, View { height: 2, ..view }, 0);
+        let r = self.resources(&packed, View { height: 2, ..view }, 0)?;
         self.run_hook(false, &r, &[], n.div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
         Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
@@ -135,7 +135,7 @@ impl GpuBackend {
                 ]
             })
             .collect();
-        let r = self.resources(&packed, view, 3 * rays.len() as u64);
+        let r = self.resources(&packed, view, 3 * rays.len() as u64)?;
         self.run_hook(true, &r, &probes, (rays.len() as u32).div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
         Ok(raw

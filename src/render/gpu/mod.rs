@@ -34,7 +34,7 @@ pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; then the
 /// count of invocations whose loops were cut short.
 pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 1;
-/// Word of the counters buffer that counts invocations cut short (`cut_short` in bvh.wgsl).
+/// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
 
 /// What to install when no adapter is found, for the error message.
@@ -166,7 +166,7 @@ impl GpuBackend {
         for (what, bytes) in buffers {
             if bytes > max {
                 bail!(
-                    "a {}x{} frame of this scene needs a {what} buffer of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
+                    "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
                     view.width,
                     view.height,
                     bytes - max
@@ -305,7 +305,7 @@ impl Backend for GpuBackend {
         self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
         let (r, counters) = loop {
-            let r = self.resources(&packed, view, 0);
+            let r = self.resources(&packed, view, 0)?;
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, &r, view, &plan);
@@ -352,7 +352,7 @@ impl Backend for GpuBackend {
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         loop {
-            let r = self.resources(&packed, view, 0);
+            let r = self.resources(&packed, view, 0)?;
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;
             if self.whole(&self.counters(&r)?, &packed)? {
                 return Ok(timing);

@@ -172,7 +172,13 @@ fn entry(
 
 /// The renderer's module with structure `name`'s WGSL, and `extra` (the hooks) appended.
 fn module(device: &wgpu::Device, name: &'static str, cut_short_slot: usize, extra: &str) -> wgpu::ShaderModule {
-    let wgsl = accel::registered(name).map_or(include_str!("shaders/no_accel.wgsl"), |r| r.wgsl);
+    let wgsl = if name == NO_ACCEL {
+        include_str!("shaders/no_accel.wgsl")
+    } else {
+        accel::registered(name)
+            .expect("names are checked against the registry before upload")
+            .wgsl
+    };
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(

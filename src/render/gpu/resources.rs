@@ -83,11 +83,22 @@ impl GpuBackend {
     }
 
     /// The resident static buffers for `packed`, uploading them only when its content changed.
-    fn scene_buffers(&mut self, packed: &Packed) -> &SceneBuffers {
+    fn scene_buffers(&mut self, packed: &Packed) -> anyhow::Result<&SceneBuffers> {
         let key = static_key(packed);
         if self.scene.as_ref().is_none_or(|s| s.key != key) {
             self.static_uploads += 1;
             let accel = packed.accel.as_ref().map_or(NO_ACCEL, |(name, _)| *name);
+            if let Some((name, s)) = &packed.accel {
+                let r = crate::accel::registered(name).ok_or_else(|| {
+                    anyhow::anyhow!("acceleration structure `{name}` is not registered in accel::REGISTRY")
+                })?;
+                anyhow::ensure!(
+                    s.buffers.len() == r.gpu_buffers as usize,
+                    "acceleration structure `{name}` packs {} buffers; its registry entry declares {}",
+                    s.buffers.len(),
+                    r.gpu_buffers
+                );
+            }
             let buffers: Vec<wgpu::Buffer> = packed
                 .accel
                 .iter()
@@ -121,13 +132,18 @@ impl GpuBackend {
                 accel_group,
             });
         }
-        self.scene.as_ref().expect("just set")
+        Ok(self.scene.as_ref().expect("just set"))
     }
 
     /// Per-frame resources over the resident static buffers. `extra_floats` widens the visibility
     /// buffer for the test hooks that write into it.
-    pub(super) fn resources(&mut self, packed: &Packed, view: View, extra_floats: u64) -> FrameResources {
-        self.scene_buffers(packed);
+    pub(super) fn resources(
+        &mut self,
+        packed: &Packed,
+        view: View,
+        extra_floats: u64,
+    ) -> anyhow::Result<FrameResources> {
+        self.scene_buffers(packed)?;
         let s = self.scene.as_ref().expect("resident");
         let params = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
@@ -200,7 +216,7 @@ impl GpuBackend {
             });
             (set, resolve)
         });
-        FrameResources {
+        Ok(FrameResources {
             bind0,
             passes,
             hits,
@@ -210,7 +226,7 @@ impl GpuBackend {
             queries,
             accel: s.accel,
             accel_group: s.accel_group.clone(),
-        }
+        })
     }
 
     fn pass_info(&self, light: u32, first_sample: u32, sample_count: u32) -> wgpu::BindGroup {

@@ -124,23 +124,26 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else {
         dir = normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
     }
-    // Analytic shapes by kind (the first of equal distances wins), then the accelerator within
-    // the distance found; `best` indexes spheres, then planes.
+    // Analytic shapes by kind, equal distances going to the lower object id as on the CPU, then
+    // the accelerator within the distance found; `best` indexes spheres, then planes.
     var best_t = 3.4e38;
     var best = NO_HIT;
+    var best_object = NO_HIT;
     for (var i = 0u; i < params.sphere_count; i++) {
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
         let t = select(r.y, r.x, r.x > 0.0);
-        if (r.z > 0.0 && t > 0.0 && t < best_t) {
+        if (r.z > 0.0 && t > 0.0 && (t < best_t || (t == best_t && spheres[i].object < best_object))) {
             best_t = t;
             best = i;
+            best_object = spheres[i].object;
         }
     }
     for (var i = 0u; i < params.plane_count; i++) {
         let t = plane_t(origin, dir, planes[i]);
-        if (t > 0.0 && t < best_t) {
+        if (t > 0.0 && (t < best_t || (t == best_t && planes[i].object < best_object))) {
             best_t = t;
             best = params.sphere_count + i;
+            best_object = planes[i].object;
         }
     }
     let mesh_hit = accel_closest(origin, dir, best_t, NO_HIT);
