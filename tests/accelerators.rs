@@ -232,3 +232,87 @@ fn unknown_structure_is_a_located_error() {
     assert!(e.contains("scene.toml:1") && e.contains("accelerator"), "{e}");
     assert!(e.contains("kd-tree") && e.contains("bvh") && e.contains("brute"), "{e}");
 }
+
+/// The sweep's `accelerator` axis: a mesh scene swept over every registered structure gives one
+/// row per structure per run, and (every structure being exact) the same measurements in each;
+/// an unregistered name is an error at its place in the list.
+#[test]
+fn sweeping_the_structure_changes_only_its_columns() {
+    let _gpu = common::gpu();
+    let dir = tempfile::tempdir().unwrap();
+    let names: Vec<String> = REGISTRY.iter().map(|r| format!("\"{}\"", r.name)).collect();
+    let exp = common::tiny_experiment(dir.path(), |t| {
+        t.replace(
+            "seeds = [1, 2]",
+            &format!("seeds = [1, 2]\naccelerators = [{}]", names.join(", ")),
+        )
+        .replace("samples = [4, 16]", "samples = [4]")
+    });
+    let tent = "v -0.1 -0.1 0.5\nv 0.1 -0.1 0.5\nv 0.0 0.1 0.5\nv 0.0 0.0 0.7\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    std::fs::write(dir.path().join("scenes/tent.obj"), tent).unwrap();
+    let mut text = std::fs::read_to_string(dir.path().join("scenes/sphere.toml")).unwrap();
+    text += "\n[[meshes]]\npath = \"tent.obj\"\nalbedo = 0.5\n";
+    std::fs::write(dir.path().join("scenes/sphere.toml"), text).unwrap();
+    let out = dir.path().join("out");
+    let (code, stderr) = common::sweep(&[exp.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    assert_eq!(code, 0, "{stderr}");
+    let mut rows = csv::Reader::from_path(out.join("runs.csv")).unwrap();
+    let header = rows.headers().unwrap().clone();
+    let col = |k: &str| header.iter().position(|h| h == k).unwrap();
+    let (acc, key) = (col("accelerator"), col("run_key"));
+    let structure_columns = [
+        "run_key",
+        "accelerator",
+        "bvh_preset",
+        "bvh_build_ms",
+        "gpu_bytes_per_triangle",
+    ];
+    let timing = |h: &str| h.contains("frame_ms") || h.contains("rays_per_s") || h == "timed_frames";
+    let mut by_structure: std::collections::BTreeMap<String, Vec<Vec<String>>> = Default::default();
+    let mut parameters = std::collections::BTreeSet::new();
+    for r in rows.records() {
+        let r = r.unwrap();
+        assert_eq!(r.get(col("status")), Some("ok"), "{r:?}");
+        let kept = r
+            .iter()
+            .zip(header.iter())
+            .filter(|(_, h)| !structure_columns.contains(h) && !timing(h))
+            .map(|(v, _)| v.to_string())
+            .collect();
+        assert!(!r[key].is_empty());
+        parameters.insert((r[acc].to_string(), r[col("bvh_preset")].to_string()));
+        by_structure.entry(r[acc].to_string()).or_default().push(kept);
+    }
+    assert_eq!(by_structure.len(), REGISTRY.len(), "{:?}", by_structure.keys());
+    // Each run was rendered with its own structure: the build parameters it records are that
+    // structure's (brute force records none).
+    let expected: std::collections::BTreeSet<_> = REGISTRY
+        .iter()
+        .map(|r| {
+            let settings = AccelSettings {
+                name: r.name,
+                ..AccelSettings::default()
+            };
+            (
+                r.name.to_string(),
+                (r.build)(&scene("bvh").triangles, &settings).stats().parameters,
+            )
+        })
+        .collect();
+    assert_eq!(parameters, expected);
+    let first = by_structure.values().next().unwrap();
+    assert_eq!(first.len(), 2 * 2 * 2);
+    for (name, rows) in &by_structure {
+        assert_eq!(rows, first, "{name}'s measurements differ");
+    }
+
+    let bad = common::tiny_experiment(dir.path(), |t| {
+        t.replace("seeds = [1, 2]", "seeds = [1, 2]\naccelerators = [\"bvh\", \"kd\"]")
+    });
+    let (code, stderr) = common::sweep(&[bad.as_os_str(), "--out".as_ref(), dir.path().join("bad").as_os_str()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("tiny.toml:15:") && stderr.contains("sweep.accelerators[1]") && stderr.contains("`kd`"),
+        "{stderr}"
+    );
+}

@@ -12,9 +12,10 @@
 //!
 //! over the storage buffers it declares at `@group(2)` ([`GpuStructure`]), with `AccelHit
 //! { t, triangle }` (`triangle` in input order, `NO_HIT` on a miss; `skip` is a triangle to
-//! ignore) and the flag `cut_short` set where a loop ended early. The GPU backend compiles each
-//! structure's module into its own pipelines, chosen by name. Adding a structure is its module,
-//! its WGSL and one line in [`REGISTRY`].
+//! ignore) and the flag `cut_short` set where a loop ended early. Every structure's module may
+//! call the shared ray-triangle test `triangle_t` ([`TRIANGLE_WGSL`], prepended to it). The GPU
+//! backend compiles each structure's module into its own pipelines, chosen by name. Adding a
+//! structure is its module, its WGSL and one line in [`REGISTRY`].
 
 pub mod brute;
 pub mod bvh;
@@ -27,6 +28,10 @@ use glam::DVec3;
 use serde::Deserialize;
 use std::sync::Arc;
 use std::time::Duration;
+
+/// The WGSL twin of [`intersect`], `triangle_t(o, d, v0, e1, e2) -> f32` (-1 on a miss), shared
+/// by every structure's module.
+pub const TRIANGLE_WGSL: &str = include_str!("triangle.wgsl");
 
 /// A closest hit: distance along the (unit) ray and the triangle's index in input order.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,33 +12,13 @@ struct BruteTri {
 
 @group(2) @binding(0) var<storage, read> brute_tris: array<BruteTri>;
 
-// Moller-Trumbore; the distance, or -1 on a miss. Both sides hit.
-fn brute_t(o: vec3<f32>, d: vec3<f32>, tri: BruteTri) -> f32 {
-    let p = cross(d, tri.e2);
-    let det = dot(tri.e1, p);
-    if (det == 0.0) {
-        return -1.0;
-    }
-    let inv = 1.0 / det;
-    let s = o - tri.v0;
-    let u = dot(s, p) * inv;
-    if (u < 0.0 || u > 1.0) {
-        return -1.0;
-    }
-    let q = cross(s, tri.e1);
-    let v = dot(d, q) * inv;
-    if (v < 0.0 || u + v > 1.0) {
-        return -1.0;
-    }
-    return dot(tri.e2, q) * inv;
-}
-
 fn accel_closest(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> AccelHit {
     var best = AccelHit(tmax, NO_HIT);
     let n = arrayLength(&brute_tris);
     var i = 0u;
     for (; i < n; i++) {
-        let t = brute_t(o, d, brute_tris[i]);
+        let tri = brute_tris[i];
+        let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
         if (i != skip && t > 0.0 && t < best.t) {
             best = AccelHit(t, i);
         }
@@ -52,7 +32,8 @@ fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     var found = false;
     var i = 0u;
     for (; i < n && !found; i++) {
-        let t = brute_t(o, d, brute_tris[i]);
+        let tri = brute_tris[i];
+        let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
         found = i != skip && t > 0.0 && t < tmax;
     }
     cut_short = cut_short || (i < n && !found);

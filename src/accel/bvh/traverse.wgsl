@@ -36,27 +36,6 @@ var<private> stack: array<u32, STACK_SIZE>;
 @group(2) @binding(0) var<storage, read> nodes: array<Node>;
 @group(2) @binding(1) var<storage, read> tris: array<Tri>;
 
-// Moller-Trumbore; the distance, or -1 on a miss. Both sides hit.
-fn tri_t(o: vec3<f32>, d: vec3<f32>, tri: Tri) -> f32 {
-    let p = cross(d, tri.e2);
-    let det = dot(tri.e1, p);
-    if (det == 0.0) {
-        return -1.0;
-    }
-    let inv = 1.0 / det;
-    let s = o - tri.v0;
-    let u = dot(s, p) * inv;
-    if (u < 0.0 || u > 1.0) {
-        return -1.0;
-    }
-    let q = cross(s, tri.e1);
-    let v = dot(d, q) * inv;
-    if (v < 0.0 || u + v > 1.0) {
-        return -1.0;
-    }
-    return dot(tri.e2, q) * inv;
-}
-
 // Entry distance into a node's box within [0, tmax], or BIG when missed.
 fn slab(o: vec3<f32>, inv_d: vec3<f32>, tmax: f32, n: Node) -> f32 {
     let t1 = (n.min - o) * inv_d;
@@ -92,7 +71,7 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
         if (entered && n.prim_count > 0u) {
             var i = n.first_index;
             for (; i < n.first_index + n.prim_count; i++) {
-                let t = tri_t(o, d, tris[i]);
+                let t = triangle_t(o, d, tris[i].v0, tris[i].e1, tris[i].e2);
                 if (t > 0.0 && t < best.t && tris[i].index != skip) {
                     best = MeshHit(t, i);
                 }
@@ -129,7 +108,7 @@ fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
         if (entered && n.prim_count > 0u) {
             var i = n.first_index;
             for (; i < n.first_index + n.prim_count; i++) {
-                let t = tri_t(o, d, tris[i]);
+                let t = triangle_t(o, d, tris[i].v0, tris[i].e1, tris[i].e2);
                 found = found || (t > 0.0 && t < tmax && tris[i].index != skip);
             }
             cut_short = cut_short || i < n.first_index + n.prim_count;

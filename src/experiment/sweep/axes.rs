@@ -173,6 +173,9 @@ axes! {
         LightRadius light_radius: f64, listed in light_radii, nest 1;
         /// Lights on, the scene's first k (default: all of them).
         Lights lights: u32, listed in light_counts, nest 0;
+        /// Acceleration structure over the meshes' triangles, by registry name (default: the
+        /// scene's): what the choice of structure costs at equal accuracy.
+        Accelerator accelerator: String, listed in accelerators, nest 2;
     }
     seed {
         /// Seed: the runs of a configuration differ only in it, and nest innermost.
@@ -308,6 +311,7 @@ mod tests {
             samples: vec![4, 16],
             light_radii: vec![0.01, 0.02],
             light_counts: vec![1, 2],
+            accelerators: vec!["bvh".into()],
             seeds: vec![1, 2],
         }
     }

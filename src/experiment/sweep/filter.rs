@@ -88,6 +88,7 @@ mod tests {
             light_radii: vec![0.01, 0.02],
             seeds: vec![1, 2, 3],
             light_counts: vec![1],
+            accelerators: vec!["bvh".into()],
         }
     }
 

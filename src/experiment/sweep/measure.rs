@@ -38,7 +38,7 @@ pub fn measure_run(
     reference: &Reference,
     context: &str,
 ) -> anyhow::Result<(Record, Vec<f32>)> {
-    let scene = spec.scene_with(run.lights, run.light_radius, run.samples);
+    let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
     let m = &spec.measure;
     let view = View {
         camera: &scene.cameras[&m.camera],

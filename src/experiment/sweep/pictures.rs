@@ -31,7 +31,7 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
     };
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
     let mut render = |scheme: DiskScheme, pattern: Pattern, samples: u32, seed: u32| -> anyhow::Result<Picture> {
-        let scene = spec.scene_with(lights, light_radius, samples);
+        let scene = spec.scene_with(lights, light_radius, samples, spec.scene.accel_settings.name);
         let view = View {
             camera: &scene.cameras[&f.camera],
             width: f.width,

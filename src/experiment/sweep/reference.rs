@@ -66,7 +66,12 @@ impl Reference {
         cache: &Path,
         context: &str,
     ) -> anyhow::Result<Reference> {
-        let scene = spec.scene_with(lights, radius, spec.ground_truth.samples);
+        let scene = spec.scene_with(
+            lights,
+            radius,
+            spec.ground_truth.samples,
+            spec.scene.accel_settings.name,
+        );
         let m = &spec.measure;
         let camera = &scene.cameras[&m.camera];
         let view = View {

@@ -56,7 +56,12 @@ pub fn figure_samples(spec: &Spec) -> u32 {
 /// count): logged with every sweep and printed by `--dry-run`.
 pub fn sweep_plan(spec: &Spec) -> anyhow::Result<RenderPlan> {
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    let s = spec.scene_with(lights, spec.axes.light_radii[0], figure_samples(spec));
+    let s = spec.scene_with(
+        lights,
+        spec.axes.light_radii[0],
+        figure_samples(spec),
+        spec.scene.accel_settings.name,
+    );
     let view = View {
         camera: &s.cameras[&spec.measure.camera],
         width: spec.measure.width,

@@ -2,6 +2,7 @@
 //! [`Spec`] with every error located in the file.
 
 pub use super::axes::Axes;
+use crate::accel::{AccelSettings, Accelerator};
 use crate::config::{ConfigError, Source};
 use crate::experiment::kind::Kind;
 use crate::key_path;
@@ -9,7 +10,9 @@ use crate::render::BackendChoice;
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -111,6 +114,9 @@ pub struct Spec {
     pub measure: Measure,
     /// Swept axes.
     pub axes: Axes,
+    /// Each swept acceleration structure, built once over the scene's triangles (None without
+    /// triangles).
+    pub structures: BTreeMap<String, Option<Arc<dyn Accelerator>>>,
     /// Ground-truth settings.
     pub ground_truth: GroundTruth,
     /// Timing settings.
@@ -177,6 +183,31 @@ impl Spec {
         let mut axes = f.sweep;
         if axes.light_counts.is_empty() {
             axes.light_counts = vec![scene.lights.len() as u32];
+        }
+        if axes.accelerators.is_empty() {
+            axes.accelerators = vec![scene.accel_settings.name.to_string()];
+        }
+        let mut structures = BTreeMap::new();
+        for (i, name) in axes.accelerators.iter().enumerate() {
+            let Some(r) = crate::accel::registered(name) else {
+                return Err(err(
+                    &key_path!["sweep", "accelerators", i],
+                    format!(
+                        "unknown acceleration structure `{name}`; known: {}",
+                        crate::accel::names().join(", ")
+                    ),
+                ));
+            };
+            let settings = AccelSettings {
+                name: r.name,
+                ..scene.accel_settings.clone()
+            };
+            let built = if settings == scene.accel_settings {
+                scene.clone()
+            } else {
+                scene.clone().with_accelerator(settings)
+            };
+            structures.insert(name.clone(), built.accel);
         }
         if !scene.lights.iter().any(|l| matches!(l, Light::Disk(_))) {
             return Err(err(
@@ -289,6 +320,7 @@ impl Spec {
             backend: f.backend,
             measure: f.measure,
             axes,
+            structures,
             ground_truth: f.ground_truth,
             timing: f.timing,
             figures: f.figures,
@@ -296,9 +328,13 @@ impl Spec {
     }
 
     /// The scene with its first `lights` lights on, every disk light among them set to `radius`
-    /// and `samples`.
-    pub fn scene_with(&self, lights: u32, radius: f64, samples: u32) -> Scene {
+    /// and `samples`, its triangles indexed by the swept structure `accelerator`.
+    pub fn scene_with(&self, lights: u32, radius: f64, samples: u32, accelerator: &str) -> Scene {
         let mut scene = self.scene.clone();
+        if let (Some(s), Some(r)) = (self.structures.get(accelerator), crate::accel::registered(accelerator)) {
+            scene.accel = s.clone();
+            scene.accel_settings.name = r.name;
+        }
         scene.lights.truncate(lights as usize);
         for l in &mut scene.lights {
             if let Light::Disk(d) = l {

@@ -163,7 +163,7 @@ pub fn time_groups(
     for round in 0..t.repeats {
         for k in order(entries.len(), round) {
             let (slot, run) = entries[k];
-            let scene = spec.scene_with(run.lights, run.light_radius, run.samples);
+            let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
             let view = View {
                 camera: &scene.cameras[&spec.measure.camera],
                 width: spec.measure.width,

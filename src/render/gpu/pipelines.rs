@@ -175,9 +175,8 @@ fn module(device: &wgpu::Device, name: &'static str, cut_short_slot: usize, extr
     let wgsl = if name == NO_ACCEL {
         include_str!("shaders/no_accel.wgsl")
     } else {
-        accel::registered(name)
-            .expect("names are checked against the registry before upload")
-            .wgsl
+        let r = accel::registered(name).expect("names are checked against the registry before upload");
+        &format!("{}{}", accel::TRIANGLE_WGSL, r.wgsl)
     };
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
