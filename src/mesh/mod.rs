@@ -1,7 +1,11 @@
-//! Triangle meshes placed in a scene: loaded from OBJ, transformed to metres, cleaned of
+//! Triangle meshes placed in a scene: loaded from OBJ or OFF, transformed to metres, cleaned of
 //! triangles that can never be hit.
 
+pub mod file;
 pub mod obj;
+pub mod off;
+
+pub use file::{load, MeshFile, MeshFileError};
 
 use glam::{DMat4, DVec3};
 

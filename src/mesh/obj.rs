@@ -3,51 +3,18 @@
 //! Polygons are split into triangle fans. Everything else (normals, texture coordinates,
 //! materials) is ignored. Errors name the file and line.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
-
-/// An OBJ file that could not be read, located.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ObjError {
-    /// The file.
-    pub file: PathBuf,
-    /// 1-based line, when the error is on a line.
-    pub line: Option<usize>,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for ObjError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{l}: {}", self.file.display(), self.message),
-            None => write!(f, "{}: {}", self.file.display(), self.message),
-        }
-    }
-}
-
-impl std::error::Error for ObjError {}
-
-/// Triangles of an OBJ file, as vertex positions, with the group each came from.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ObjMesh {
-    /// Triangle corner positions, in file units.
-    pub triangles: Vec<[[f64; 3]; 3]>,
-    /// Group index per triangle (into `groups`).
-    pub group_of: Vec<u32>,
-    /// Group names in order of first appearance (faces before any `g` are in group `default`).
-    pub groups: Vec<String>,
-}
+use super::file::{MeshFile, MeshFileError};
+use std::path::Path;
 
 /// Parses OBJ text; `file` is only used in errors.
-pub fn parse(text: &str, file: &Path) -> Result<ObjMesh, ObjError> {
-    let err = |line: usize, message: String| ObjError {
+pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
+    let err = |line: usize, message: String| MeshFileError {
         file: file.to_path_buf(),
         line: Some(line),
         message,
     };
     let mut positions: Vec<[f64; 3]> = Vec::new();
-    let mut mesh = ObjMesh::default();
+    let mut mesh = MeshFile::default();
     let mut group: Option<u32> = None;
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
@@ -113,43 +80,6 @@ pub fn parse(text: &str, file: &Path) -> Result<ObjMesh, ObjError> {
     Ok(mesh)
 }
 
-/// Reads an OBJ file.
-pub fn load(path: &Path) -> Result<ObjMesh, ObjError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ObjError {
-        file: path.to_path_buf(),
-        line: None,
-        message: format!("cannot read: {e}"),
-    })?;
-    parse(&text, path)
-}
-
-impl ObjMesh {
-    /// The triangles of the named groups (all triangles when `names` is empty); an unknown name
-    /// is an error listing the groups that exist.
-    pub fn select(&self, names: &[String], file: &Path) -> Result<Vec<[[f64; 3]; 3]>, ObjError> {
-        let mut wanted = Vec::new();
-        for n in names {
-            match self.groups.iter().position(|g| g == n) {
-                Some(i) => wanted.push(i as u32),
-                None => {
-                    return Err(ObjError {
-                        file: file.to_path_buf(),
-                        line: None,
-                        message: format!("no group `{n}`; the file has: {}", self.groups.join(", ")),
-                    })
-                }
-            }
-        }
-        Ok(self
-            .triangles
-            .iter()
-            .zip(&self.group_of)
-            .filter(|(_, g)| names.is_empty() || wanted.contains(g))
-            .map(|(t, _)| *t)
-            .collect())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,7 +116,7 @@ mod tests {
 
     #[test]
     fn missing_file_is_named() {
-        let e = load(Path::new("/nonexistent/x.obj")).unwrap_err();
+        let e = crate::mesh::file::load(Path::new("/nonexistent/x.obj")).unwrap_err();
         assert!(e.to_string().contains("/nonexistent/x.obj") && e.to_string().contains("cannot read"));
     }
 }

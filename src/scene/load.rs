@@ -7,7 +7,7 @@ use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
 use crate::accel::{self, AccelSettings};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
-use crate::mesh::{clean, obj, Triangles};
+use crate::mesh::{clean, Triangles};
 use glam::{DMat4, DQuat, DVec3};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -125,7 +125,7 @@ impl Scene {
             let translate = v.point(&m.translate, &at("translate"))?;
             let albedo = v.albedo(m.albedo, &at("albedo"))?;
             let path = dir.join(&m.path);
-            let raw = obj::load(&path)
+            let raw = crate::mesh::load(&path)
                 .map_err(|e| source.error(&at("path"), e.to_string()))?
                 .select(&m.groups, &path)
                 .map_err(|e| source.error(&at("groups"), e.to_string()))?;
