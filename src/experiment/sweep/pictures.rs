@@ -30,28 +30,30 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
         return Ok(None);
     };
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    let mut render = |scheme: DiskScheme, pattern: Pattern, samples: u32, seed: u32| -> anyhow::Result<Picture> {
-        let scene = spec.scene_with(lights, light_radius, samples, spec.scene.accel_settings.name);
-        let view = View {
-            camera: &scene.cameras[&f.camera],
-            width: f.width,
-            height: f.height,
+    let mut render =
+        |scheme: DiskScheme, pattern: Pattern, samples: u32, seed: u32, accelerator: &str| -> anyhow::Result<Picture> {
+            let scene = spec.scene_with(lights, light_radius, samples, accelerator);
+            let view = View {
+                camera: &scene.cameras[&f.camera],
+                width: f.width,
+                height: f.height,
+            };
+            let frame = backend.render(&scene, view, Sampling { scheme, pattern, seed })?;
+            Ok(Picture { samples, frame })
         };
-        let frame = backend.render(&scene, view, Sampling { scheme, pattern, seed })?;
-        Ok(Picture { samples, frame })
-    };
     let ground_truth = render(
         DiskScheme::Jittered,
         Pattern::PerPixel,
         f.ground_truth_samples,
         super::reference::GROUND_TRUTH_SEED,
+        spec.scene.accel_settings.name,
     )?;
     let n = figure_samples(spec);
     let mut runs = Vec::new();
     for group in expand(spec) {
         for run in group.runs {
             if run.samples == n && run.light_radius == light_radius && run.lights == lights {
-                let picture = render(run.scheme, run.pattern, n, run.seed)?;
+                let picture = render(run.scheme, run.pattern, n, run.seed, &run.accelerator)?;
                 runs.push((run, picture));
             }
         }

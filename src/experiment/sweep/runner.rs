@@ -53,14 +53,14 @@ pub fn figure_samples(spec: &Spec) -> u32 {
 }
 
 /// The render plan of the sweep's fullest run (most lights, first radius, the figures' ray
-/// count): logged with every sweep and printed by `--dry-run`.
+/// count, first swept structure): logged with every sweep and printed by `--dry-run`.
 pub fn sweep_plan(spec: &Spec) -> anyhow::Result<RenderPlan> {
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
     let s = spec.scene_with(
         lights,
         spec.axes.light_radii[0],
         figure_samples(spec),
-        spec.scene.accel_settings.name,
+        &spec.axes.accelerators[0],
     );
     let view = View {
         camera: &s.cameras[&spec.measure.camera],

@@ -209,6 +209,19 @@ impl Spec {
             };
             structures.insert(name.clone(), built.accel);
         }
+        if scene.triangles.positions.is_empty() {
+            // Nothing for a structure to index: every structure would render the same frames,
+            // and rows would name a structure that answered no ray.
+            if let Some(i) = axes.accelerators.iter().position(|n| n != scene.accel_settings.name) {
+                return Err(err(
+                    &key_path!["sweep", "accelerators", i],
+                    format!(
+                        "the scene has no triangle meshes for `{}` to index; sweep structures over a scene with meshes",
+                        axes.accelerators[i]
+                    ),
+                ));
+            }
+        }
         if !scene.lights.iter().any(|l| matches!(l, Light::Disk(_))) {
             return Err(err(
                 &key_path!["scene"],
