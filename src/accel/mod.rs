@@ -19,6 +19,7 @@
 
 pub mod brute;
 pub mod bvh;
+pub mod vlf;
 
 pub use bvh::{Bvh, Preset};
 

@@ -1,0 +1,174 @@
+//! One set of parallel subfields over a subset of the triangles, in flat arrays (paper Sections
+//! 3.2 and 4): per direction, `n x n` tiles in CSR form, each tile either a plain list of
+//! triangle ids or a tile BSP. Built direction by direction in parallel.
+//!
+//! Layout (every array a flat `Vec` of plain numbers, indexed with u32; the GPU reads the same):
+//! - `tile_first[k * n^2 + ty * n + tx]` (`D n^2 + 1` entries): start of the tile's block in
+//!   `ids`; the block ends where the next tile's starts (mask [`SPLIT`] off both). An empty tile
+//!   costs this one offset.
+//! - Bit 31 ([`SPLIT`]) set: the tile is split. `ids[start]` is its split record `s`; leaf `l`
+//!   holds `ids[leaf_end[s L + l - 1] .. leaf_end[s L + l]]` (leaf 0 starts at `start + 1`),
+//!   `L = 2^depth`; its split values are `split[s * stride ..]` ([`Split::stride`]).
+//! - Otherwise `ids[start .. end]` are the tile's triangles, in increasing index order.
+
+use super::bsp;
+use super::raster::{clipped_z_range, for_each_tile};
+use super::{Frame, VlfSettings, EPS};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Flag in `tile_first` marking a split tile.
+pub const SPLIT: u32 = 1 << 31;
+
+/// The flat arrays of one layer (see the module doc).
+#[derive(Clone, Debug, Default)]
+pub struct Layer {
+    /// Per tile, start in `ids` (bit 31: split); one more entry closes the last tile.
+    pub tile_first: Vec<u32>,
+    /// Triangle ids, and one split-record index at the head of each split tile.
+    pub ids: Vec<u32>,
+    /// Per split record, the end of each leaf in `ids`.
+    pub leaf_end: Vec<u32>,
+    /// Per split record, its split values.
+    pub split: Vec<f32>,
+    /// Triangles indexed (distinct).
+    pub triangles: usize,
+}
+
+/// One direction's part before merging (offsets relative to its own arrays).
+struct Part {
+    tile_first: Vec<u32>,
+    ids: Vec<u32>,
+    leaf_end: Vec<u32>,
+    split: Vec<f32>,
+}
+
+impl Layer {
+    /// Bytes the arrays occupy.
+    pub fn bytes(&self) -> usize {
+        4 * (self.tile_first.len() + self.ids.len() + self.leaf_end.len() + self.split.len())
+    }
+
+    /// Split tiles.
+    pub fn split_tiles(&self) -> usize {
+        self.tile_first.iter().filter(|f| *f & SPLIT != 0).count()
+    }
+
+    /// Builds the layer over triangles `subset` of `world`.
+    pub fn build(world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, settings: &VlfSettings) -> anyhow::Result<Layer> {
+        let dirs = frame.directions.len();
+        let parts: Vec<Part> = (0..dirs as u32)
+            .into_par_iter()
+            .map(|k| direction_part(k, world, subset, frame, settings))
+            .collect();
+        let total_ids: usize = parts.iter().map(|p| p.ids.len()).sum();
+        anyhow::ensure!(
+            total_ids < SPLIT as usize,
+            "visibility field: {total_ids} tile entries exceed the 2^31 a u32 offset with a flag bit addresses; use fewer directions or tiles"
+        );
+        let leaves = 1usize << settings.depth;
+        let mut layer = Layer {
+            tile_first: Vec::with_capacity(parts.iter().map(|p| p.tile_first.len()).sum::<usize>() + 1),
+            ids: Vec::with_capacity(total_ids),
+            leaf_end: Vec::with_capacity(parts.iter().map(|p| p.leaf_end.len()).sum()),
+            split: Vec::with_capacity(parts.iter().map(|p| p.split.len()).sum()),
+            triangles: subset.len(),
+        };
+        for p in parts {
+            let (base, records) = (layer.ids.len() as u32, (layer.leaf_end.len() / leaves) as u32);
+            layer.tile_first.extend(p.tile_first.iter().map(|f| f + base));
+            let at = layer.ids.len();
+            layer.ids.extend_from_slice(&p.ids);
+            for f in &p.tile_first {
+                if f & SPLIT != 0 {
+                    layer.ids[at + (f & !SPLIT) as usize] += records;
+                }
+            }
+            layer.leaf_end.extend(p.leaf_end.iter().map(|e| e + base));
+            layer.split.extend_from_slice(&p.split);
+        }
+        layer.tile_first.push(layer.ids.len() as u32);
+        Ok(layer)
+    }
+}
+
+/// Tile coordinates (x, y in tiles, z in ball units) of world point `p` for direction `k`.
+#[inline]
+pub fn to_tile(frame: &Frame, rot: &[DVec3; 3], p: DVec3) -> DVec3 {
+    let q = p - frame.centre;
+    let s = frame.inv_radius * frame.half_tiles;
+    DVec3::new(
+        rot[0].dot(q) * s + frame.half_tiles,
+        rot[1].dot(q) * s + frame.half_tiles,
+        rot[2].dot(q) * frame.inv_radius,
+    )
+}
+
+fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, settings: &VlfSettings) -> Part {
+    let n = settings.tiles;
+    let tiles = (n * n) as usize;
+    let rot = frame.directions.rotation(k);
+    let e = EPS * frame.half_tiles;
+    let proj: Vec<[DVec3; 3]> = subset
+        .iter()
+        .map(|&t| world[t as usize].map(|p| to_tile(frame, &rot, p)))
+        .collect();
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(subset.len() * 4);
+    for (i, p) in proj.iter().enumerate() {
+        for_each_tile([p[0].truncate(), p[1].truncate(), p[2].truncate()], n, e, |tx, ty| {
+            pairs.push((ty * n + tx, i as u32))
+        });
+    }
+    let mut start = vec![0u32; tiles + 1];
+    for &(t, _) in &pairs {
+        start[t as usize + 1] += 1;
+    }
+    for t in 0..tiles {
+        start[t + 1] += start[t];
+    }
+    let mut fill = start.clone();
+    let mut sorted = vec![0u32; pairs.len()];
+    for &(t, i) in &pairs {
+        sorted[fill[t as usize] as usize] = i;
+        fill[t as usize] += 1;
+    }
+    drop(pairs);
+    let mut part = Part {
+        tile_first: Vec::with_capacity(tiles),
+        ids: Vec::with_capacity(sorted.len()),
+        leaf_end: Vec::new(),
+        split: Vec::new(),
+    };
+    let (mut items, mut scratch) = (Vec::new(), Vec::new());
+    let mut records = 0u32;
+    for t in 0..tiles {
+        let list = &sorted[start[t] as usize..start[t + 1] as usize];
+        let at = part.ids.len() as u32;
+        if settings.depth > 0 && list.len() > settings.leaf_size as usize {
+            let (tx, ty) = (t as u32 % n, t as u32 / n);
+            items.clear();
+            items.extend(list.iter().map(|&i| {
+                let (lo, hi) = clipped_z_range(&proj[i as usize], tx, ty, e);
+                (subset[i as usize], lo - EPS, hi + EPS)
+            }));
+            part.ids.push(records);
+            if bsp::build(
+                &items,
+                settings.split,
+                settings.depth,
+                &mut part.split,
+                &mut part.ids,
+                &mut part.leaf_end,
+                &mut scratch,
+            ) {
+                part.tile_first.push(at | SPLIT);
+                records += 1;
+                continue;
+            }
+            part.ids.pop();
+        }
+        part.tile_first.push(at);
+        part.ids.extend(list.iter().map(|&i| subset[i as usize]));
+    }
+    part
+}

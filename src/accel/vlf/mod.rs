@@ -1,0 +1,264 @@
+//! A visibility field (VLF-RT: Mortensen, Khanna, Yu, Slater 2007; summary in
+//! `shared/papers/visibility-field-ray-tracing.md`): for each of a fixed set of directions
+//! (lines), the scene seen along that direction through `n x n` parallel beams (a parallel
+//! subfield), each beam listing the triangles it meets, partitioned along the beam by a 1-D tile
+//! BSP. A query picks the nearest stored direction in constant time, walks the few tiles its
+//! segment crosses and tests the triangles of the leaves between its ends, near to far.
+//!
+//! Trades memory and build time for traversal with no tree descent. Answers are exactly brute
+//! force's: candidates are tested with [`crate::accel::intersect`] on the original world-space
+//! triangles, and every bound is widened (by [`EPS`] of the ball radius) so the candidate set
+//! is a superset.
+//!
+//! # Spaces
+//! The scene is normalised into the unit ball: `p_ball = (p - centre) / radius` ([`Frame`]; the
+//! ball's radius is the farthest vertex from the bounding-box centre). Direction `k`'s rotation
+//! rows `a, b, w` ([`directions::Directions::rows`]) take it to canonical space, where the beams
+//! run along `+z` and tile `(tx, ty)` of `n` covers `x_ball, y_ball` in
+//! `[-1 + 2 tx / n, -1 + 2 (tx + 1) / n]` (and likewise y). A ray along `-w` uses `w`'s tiles
+//! and walks its leaves in reverse.
+//!
+//! # Flat arrays (for the WGSL traversal to come)
+//! All u32/f32/f64 `Vec`s, addressable with u32 indices:
+//! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
+//! - per layer ([`layer::Layer`], layout in its module doc): `tile_first` (u32, `D n^2 + 1`, bit
+//!   31 = split), `ids` (u32), `leaf_end` (u32, `2^depth` per split tile), `split` (f32: `z0,
+//!   scale` per split tile for uniform splits, `2^depth - 1` planes for median splits);
+//! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
+//!
+//! The base layer indexes every triangle; a second, small layer holds objects inserted or moved
+//! since the build ([`dynamic`]), and removed triangles' ids are overwritten with [`DEAD`].
+
+pub mod bsp;
+pub mod directions;
+pub mod dynamic;
+pub mod layer;
+pub mod query;
+pub mod raster;
+
+pub use bsp::Split;
+
+use super::{Accelerator, BuildStats, GpuStructure, TriHit};
+use crate::geometry::LocalFrame;
+use crate::mesh::Triangles;
+use directions::Directions;
+use glam::DVec3;
+use layer::Layer;
+use std::time::{Duration, Instant};
+
+/// Relative widening of every bound, in ball radii (tile squares, depth ranges, the ball).
+/// Far above f64 rounding of scenes within ~1e6 radii of their origin, far below a tile.
+pub const EPS: f64 = 1e-6;
+
+/// A removed triangle's slot in a layer's `ids` (never a triangle index: those stay below it).
+pub const DEAD: u32 = u32::MAX;
+
+/// Build parameters (paper Section 6 fixes 513 directions and 128 x 128 tiles; tile-BSP depth
+/// 3-5 was best there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VlfSettings {
+    /// Direction subdivision level `L`: `2 L^2 + 1` directions (16 gives the paper's 513).
+    pub level: u32,
+    /// Tiles per side of each parallel subfield.
+    pub tiles: u32,
+    /// Tile-BSP depth: `2^depth` leaves per split tile (0: no splits).
+    pub depth: u32,
+    /// Uniform slabs or median splits.
+    pub split: Split,
+    /// Tiles with at most this many triangles stay a plain list (no leaves stored).
+    pub leaf_size: u32,
+}
+
+impl Default for VlfSettings {
+    fn default() -> Self {
+        VlfSettings {
+            level: 16,
+            tiles: 128,
+            depth: 4,
+            split: Split::Uniform,
+            leaf_size: 8,
+        }
+    }
+}
+
+impl VlfSettings {
+    /// The parameters in a few words.
+    pub fn describe(&self) -> String {
+        format!(
+            "level {} ({} dirs), {}x{} tiles, depth {} {}, leaf size {}",
+            self.level,
+            2 * self.level * self.level + 1,
+            self.tiles,
+            self.tiles,
+            self.depth,
+            self.split.name(),
+            self.leaf_size
+        )
+    }
+}
+
+/// The normalisation into the unit ball and the directions: what every layer shares.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Ball centre in world space (the triangles' bounding-box centre).
+    pub centre: DVec3,
+    /// Ball radius in world units (farthest vertex from `centre`).
+    pub radius: f64,
+    /// 1 / radius.
+    pub inv_radius: f64,
+    /// Tiles per side / 2 (tile units per ball unit).
+    pub half_tiles: f64,
+    /// The stored directions and their lookup table.
+    pub directions: Directions,
+}
+
+/// A built visibility field over a scene's triangles.
+#[derive(Clone, Debug)]
+pub struct VisibilityField {
+    /// Parameters built with.
+    pub settings: VlfSettings,
+    /// Ball and directions.
+    pub frame: Frame,
+    /// Every triangle of the build.
+    pub base: Layer,
+    /// Triangles inserted or moved since ([`dynamic`]).
+    pub overlay: Layer,
+    /// World-space triangles (f64), in input order (moved objects updated in place).
+    pub world: Vec<[DVec3; 3]>,
+    /// Owner per triangle.
+    pub object_of: Vec<u32>,
+    /// Whether the base layer still indexes triangle i (false once its object moved or was
+    /// removed).
+    pub in_base: Vec<bool>,
+    /// Triangles in the overlay.
+    pub overlay_ids: Vec<u32>,
+    /// Wall-clock time of the whole build.
+    pub build_time: Duration,
+}
+
+impl VisibilityField {
+    /// Builds the field over `triangles` (an empty list gives a field that never hits).
+    pub fn build(triangles: &Triangles, settings: VlfSettings) -> anyhow::Result<VisibilityField> {
+        let start = Instant::now();
+        anyhow::ensure!(
+            settings.tiles >= 1
+                && (settings.tiles as u64).pow(2) * (2 * settings.level as u64 * settings.level as u64 + 1)
+                    < u32::MAX as u64,
+            "visibility field: {} directions x {}^2 tiles do not fit u32 tile offsets",
+            2 * settings.level * settings.level + 1,
+            settings.tiles
+        );
+        anyhow::ensure!(
+            settings.depth <= 10,
+            "visibility field: tile-BSP depth {} above 10",
+            settings.depth
+        );
+        let world = triangles.positions.clone();
+        anyhow::ensure!(world.len() < DEAD as usize, "visibility field: too many triangles");
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in world.iter().flatten() {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
+        let radius = world
+            .iter()
+            .flatten()
+            .map(|p| p.distance(centre))
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE.sqrt());
+        let frame = Frame {
+            centre,
+            radius,
+            inv_radius: 1.0 / radius,
+            half_tiles: settings.tiles as f64 * 0.5,
+            directions: Directions::new(settings.level),
+        };
+        let all: Vec<u32> = (0..world.len() as u32).collect();
+        let base = Layer::build(&world, &all, &frame, &settings)?;
+        Ok(VisibilityField {
+            settings,
+            frame,
+            base,
+            overlay: Layer::default(),
+            in_base: vec![true; world.len()],
+            world,
+            object_of: triangles.object_of.clone(),
+            overlay_ids: Vec::new(),
+            build_time: start.elapsed(),
+        })
+    }
+
+    /// Closest triangle other than `skip` hit with 0 < t < `tmax` along unit `dir`.
+    pub fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        let ray = self.tile_ray(origin, dir, tmax)?;
+        let mut best = (f64::INFINITY, u32::MAX);
+        self.closest_in(&self.base, &ray, origin, dir, tmax, skip, &mut best);
+        if !self.overlay_ids.is_empty() {
+            self.closest_in(&self.overlay, &ray, origin, dir, tmax, skip, &mut best);
+        }
+        (best.1 != u32::MAX).then_some(TriHit {
+            t: best.0,
+            triangle: best.1,
+        })
+    }
+
+    /// Whether any triangle other than `skip` is hit with 0 < t < `tmax`; stops at the first.
+    pub fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        let Some(ray) = self.tile_ray(origin, dir, tmax) else {
+            return false;
+        };
+        self.any_in(&self.base, &ray, origin, dir, tmax, skip)
+            || (!self.overlay_ids.is_empty() && self.any_in(&self.overlay, &ray, origin, dir, tmax, skip))
+    }
+
+    /// Bytes of the structure's arrays (both layers, the table and rotations; not the
+    /// triangles, which every structure needs).
+    pub fn bytes(&self) -> usize {
+        self.base.bytes()
+            + self.overlay.bytes()
+            + 4 * self.frame.directions.table.len()
+            + 8 * self.frame.directions.rows.len()
+    }
+}
+
+impl Accelerator for VisibilityField {
+    fn name(&self) -> &'static str {
+        "vlf"
+    }
+
+    fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        VisibilityField::closest(self, origin, dir, tmax, skip)
+    }
+
+    fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        VisibilityField::any_hit(self, origin, dir, tmax, skip)
+    }
+
+    fn stats(&self) -> BuildStats {
+        let bytes = self.bytes();
+        let entries = self.base.ids.len();
+        BuildStats {
+            parameters: self.settings.describe(),
+            build_time: self.build_time,
+            gpu_bytes: bytes as u64,
+            triangles: self.world.len(),
+            description: format!(
+                "visibility field ({}): {} tile entries ({:.1} per triangle per direction), {} split tiles, built in {:.1} ms; {:.1} MB ({:.0} bytes per triangle)",
+                self.settings.describe(),
+                entries,
+                entries as f64 / (self.world.len().max(1) * self.frame.directions.len()) as f64,
+                self.base.split_tiles(),
+                self.build_time.as_secs_f64() * 1e3,
+                bytes as f64 / 1e6,
+                bytes as f64 / self.world.len().max(1) as f64
+            ),
+        }
+    }
+
+    fn gpu(&self, _frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
+        anyhow::bail!(
+            "the visibility field has no GPU traversal yet (its flat arrays are laid out for one: see accel::vlf)"
+        )
+    }
+}

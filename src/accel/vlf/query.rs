@@ -1,0 +1,266 @@
+//! Ray queries (paper Sections 3.3, 4 and 5): nearest stored direction from the table, the
+//! segment clipped to the scene's ball, both ends projected, the tiles between them walked
+//! front to back with the build's conservative rule (a thick segment: every tile whose widened
+//! square it touches), and in each tile the leaves between the entry and exit depth visited
+//! linearly, near to far. No allocation, no recursion, no dynamic dispatch.
+//!
+//! Every candidate is tested with [`crate::accel::intersect`] on the original world-space
+//! triangle, so answers are bit-identical to brute force; the structure only narrows the set.
+//! Closest-hit ties (equal t) go to the lower triangle index, as `brute_force`'s `min_by` keeps
+//! the first.
+
+use super::bsp::{median_leaf, uniform_leaf, uniform_plane, Split};
+use super::layer::{Layer, SPLIT};
+use super::{VisibilityField, EPS};
+use glam::DVec3;
+
+/// A ray in one direction's tile space: `x, y` in tiles, `z` in ball units, per unit of world t.
+#[derive(Clone, Copy, Debug)]
+pub struct TileRay {
+    /// Stored direction used.
+    pub dir: u32,
+    /// Origin.
+    pub o: DVec3,
+    /// Direction (per world unit of t).
+    pub d: DVec3,
+    /// 1 / d.z (infinite when the ray is perpendicular to the beam).
+    pub inv_dz: f64,
+    /// The segment inside the scene's ball, in world t.
+    pub t0: f64,
+    /// End of that segment.
+    pub t1: f64,
+}
+
+impl VisibilityField {
+    /// The ray in the nearest direction's tile space, clipped to the ball and to (0, tmax);
+    /// None when that leaves nothing.
+    #[inline]
+    pub fn tile_ray(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<TileRay> {
+        let f = &self.frame;
+        let oc = origin - f.centre;
+        let dd = dir.length_squared();
+        let b = dir.dot(oc) / dd;
+        let r = f.radius * (1.0 + 4.0 * EPS);
+        let disc = b * b - (oc.length_squared() - r * r) / dd;
+        if !(disc >= 0.0) {
+            return None;
+        }
+        let sq = disc.sqrt();
+        let (t0, t1) = ((-b - sq).max(0.0), (-b + sq).min(tmax));
+        if !(t0 <= t1) {
+            return None;
+        }
+        let k = f.directions.lookup(dir);
+        let rot = f.directions.rotation(k);
+        let s = f.inv_radius * f.half_tiles;
+        let o = DVec3::new(
+            rot[0].dot(oc) * s + f.half_tiles,
+            rot[1].dot(oc) * s + f.half_tiles,
+            rot[2].dot(oc) * f.inv_radius,
+        );
+        let d = DVec3::new(rot[0].dot(dir) * s, rot[1].dot(dir) * s, rot[2].dot(dir) * f.inv_radius);
+        Some(TileRay {
+            dir: k,
+            o,
+            d,
+            inv_dz: 1.0 / d.z,
+            t0,
+            t1,
+        })
+    }
+
+    /// Walks the tiles `ray` touches front to back, calling `visit(tile, t_in, t_out)` (tile
+    /// index within the direction); stops when `visit` returns true (returning true) or when
+    /// the next tiles start beyond `cutoff()`.
+    #[inline]
+    pub fn walk(
+        &self,
+        ray: &TileRay,
+        cutoff: impl Fn() -> f64,
+        mut visit: impl FnMut(usize, f64, f64) -> bool,
+    ) -> bool {
+        let n = self.settings.tiles as usize;
+        let e = EPS * self.frame.half_tiles;
+        let last = n as f64 - 1.0;
+        let (o, d) = (ray.o, ray.d);
+        let (xa, xb) = (o.x + d.x * ray.t0, o.x + d.x * ray.t1);
+        let (ya, yb) = (o.y + d.y * ray.t0, o.y + d.y * ray.t1);
+        let cell = |v: f64| v.floor().clamp(0.0, last) as usize;
+        let (x0, x1) = (cell(xa.min(xb) - e), cell(xa.max(xb) + e));
+        let (y0, y1) = (cell(ya.min(yb) - e), cell(ya.max(yb) + e));
+        if x0 == x1 && y0 == y1 {
+            return visit(y0 * n + x0, ray.t0, ray.t1);
+        }
+        // Columns along the major axis, front to back; rows within a column likewise.
+        let swap = d.y.abs() > d.x.abs();
+        let (mo, md, so, sd) = if swap {
+            (o.y, d.y, o.x, d.x)
+        } else {
+            (o.x, d.x, o.y, d.y)
+        };
+        let (c0, c1) = if swap { (y0, y1) } else { (x0, x1) };
+        let slab = |lo: f64, po: f64, pd: f64, ta: f64, tb: f64| -> (f64, f64) {
+            if pd == 0.0 {
+                return (ta, tb);
+            }
+            let (a, b) = ((lo - e - po) / pd, (lo + 1.0 + e - po) / pd);
+            (ta.max(a.min(b)), tb.min(a.max(b)))
+        };
+        let columns = c1 - c0 + 1;
+        for ci in 0..columns {
+            let c = if md >= 0.0 { c0 + ci } else { c1 - ci };
+            let (ta, tb) = slab(c as f64, mo, md, ray.t0, ray.t1);
+            if ta > tb {
+                continue;
+            }
+            if ta > cutoff() {
+                break;
+            }
+            let (sa, sb) = (so + sd * ta, so + sd * tb);
+            let (r0, r1) = (cell(sa.min(sb) - e), cell(sa.max(sb) + e));
+            for ri in 0..=(r1 - r0) {
+                let r = if sd >= 0.0 { r0 + ri } else { r1 - ri };
+                let (ua, ub) = slab(r as f64, so, sd, ta, tb);
+                if ua > ub {
+                    continue;
+                }
+                if ua > cutoff() {
+                    break;
+                }
+                let tile = if swap { c * n + r } else { r * n + c };
+                if visit(tile, ua, ub) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Visits the leaves of `tile` (of `layer`, direction `ray.dir`) that the ray's depth range
+    /// over `[ta, tb]` meets, near to far: `leaf(ids, exit_t)` with the t beyond which no hit
+    /// in a later leaf of this tile lies; stops when it returns true (returning true).
+    #[inline]
+    pub fn leaves(
+        &self,
+        layer: &Layer,
+        ray: &TileRay,
+        tile: usize,
+        ta: f64,
+        tb: f64,
+        mut leaf: impl FnMut(&[u32], f64) -> bool,
+    ) -> bool {
+        let n2 = (self.settings.tiles * self.settings.tiles) as usize;
+        let k = ray.dir as usize * n2 + tile;
+        let (first, next) = (layer.tile_first[k], layer.tile_first[k + 1]);
+        let (start, end) = ((first & !SPLIT) as usize, (next & !SPLIT) as usize);
+        if first & SPLIT == 0 {
+            return start < end && leaf(&layer.ids[start..end], f64::INFINITY);
+        }
+        let leaves = 1usize << self.settings.depth;
+        let s = layer.ids[start] as usize;
+        let ends = &layer.leaf_end[s * leaves..(s + 1) * leaves];
+        let (za, zb) = (ray.o.z + ray.d.z * ta, ray.o.z + ray.d.z * tb);
+        let (zlo, zhi) = (za.min(zb) - EPS, za.max(zb) + EPS);
+        let leaf_start = |l: usize| if l == 0 { start + 1 } else { ends[l - 1] as usize };
+        let up = ray.d.z >= 0.0;
+        match self.settings.split {
+            Split::Uniform => {
+                let (z0, scale) = (layer.split[2 * s], layer.split[2 * s + 1]);
+                let (l0, l1) = (
+                    uniform_leaf(zlo, z0, scale, leaves),
+                    uniform_leaf(zhi, z0, scale, leaves),
+                );
+                for i in 0..=(l1 - l0) {
+                    let l = if up { l0 + i } else { l1 - i };
+                    let exit = if l == (if up { l1 } else { l0 }) {
+                        f64::INFINITY
+                    } else if up {
+                        (uniform_plane(l + 1, z0, scale) - EPS - ray.o.z) * ray.inv_dz
+                    } else {
+                        (uniform_plane(l, z0, scale) + EPS - ray.o.z) * ray.inv_dz
+                    };
+                    if leaf(&layer.ids[leaf_start(l)..ends[l] as usize], exit) {
+                        return true;
+                    }
+                }
+            }
+            Split::Median => {
+                let planes = &layer.split[s * (leaves - 1)..(s + 1) * (leaves - 1)];
+                let (l0, l1) = (median_leaf(zlo, planes), median_leaf(zhi, planes));
+                for i in 0..=(l1 - l0) {
+                    let l = if up { l0 + i } else { l1 - i };
+                    let exit = if l == (if up { l1 } else { l0 }) {
+                        f64::INFINITY
+                    } else if up {
+                        (planes[l] as f64 - EPS - ray.o.z) * ray.inv_dz
+                    } else {
+                        (planes[l - 1] as f64 + EPS - ray.o.z) * ray.inv_dz
+                    };
+                    if leaf(&layer.ids[leaf_start(l)..ends[l] as usize], exit) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Any-hit over one layer.
+    #[inline]
+    pub(super) fn any_in(&self, layer: &Layer, ray: &TileRay, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
+        let world = &self.world;
+        self.walk(
+            ray,
+            || f64::INFINITY,
+            |tile, ta, tb| {
+                self.leaves(layer, ray, tile, ta, tb, |ids, _| {
+                    ids.iter().any(|&id| {
+                        id != skip
+                            && id != super::DEAD
+                            && super::super::intersect(origin, dir, &world[id as usize])
+                                .is_some_and(|t| t > 0.0 && t < tmax)
+                    })
+                })
+            },
+        )
+    }
+
+    /// Closest hit over one layer, improving on `best` (t, triangle).
+    #[inline]
+    pub(super) fn closest_in(
+        &self,
+        layer: &Layer,
+        ray: &TileRay,
+        origin: DVec3,
+        dir: DVec3,
+        tmax: f64,
+        skip: u32,
+        best: &mut (f64, u32),
+    ) {
+        let world = &self.world;
+        let cell = std::cell::Cell::new(*best);
+        self.walk(
+            ray,
+            || cell.get().0,
+            |tile, ta, tb| {
+                self.leaves(layer, ray, tile, ta, tb, |ids, exit| {
+                    let mut b = cell.get();
+                    for &id in ids {
+                        if id == skip || id == super::DEAD {
+                            continue;
+                        }
+                        if let Some(t) = super::super::intersect(origin, dir, &world[id as usize]) {
+                            if t > 0.0 && t < tmax && (t < b.0 || (t == b.0 && id < b.1)) {
+                                b = (t, id);
+                            }
+                        }
+                    }
+                    cell.set(b);
+                    b.0 < exit
+                });
+                false
+            },
+        );
+        *best = cell.get();
+    }
+}
