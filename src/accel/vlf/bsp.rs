@@ -48,10 +48,11 @@ pub fn uniform_leaf(z: f64, z0: f32, scale: f32, leaves: usize) -> usize {
     (((z - z0 as f64) * scale as f64) as usize).min(leaves - 1)
 }
 
-/// Leaf of depth `z` in a median split: the number of planes at or below `z`.
+/// Leaf of depth `z` in a median split (planes stored as f32 bits, in order): the number of
+/// planes at or below `z`.
 #[inline]
-pub fn median_leaf(z: f64, planes: &[f32]) -> usize {
-    planes.partition_point(|&p| p as f64 <= z)
+pub fn median_leaf(z: f64, planes: &[u32]) -> usize {
+    planes.partition_point(|&p| f32::from_bits(p) as f64 <= z)
 }
 
 /// Smallest depth that a uniform split maps to leaf `l` or beyond, approximately (callers widen).
@@ -60,19 +61,17 @@ pub fn uniform_plane(l: usize, z0: f32, scale: f32) -> f64 {
     z0 as f64 + l as f64 / scale as f64
 }
 
-/// Builds the split of one tile. `items` holds (triangle, z_lo, z_hi) with widened clipped
-/// depth ranges. Appends the split values to `split`, then for each leaf its triangles to
-/// `ids`, pushing each leaf's end (absolute in `ids`) to `leaf_end`. Returns false, writing
-/// nothing, when the depth range is empty (every triangle at one depth): no split helps.
-pub fn build(
-    items: &[(u32, f64, f64)],
-    kind: Split,
-    depth: u32,
-    split: &mut Vec<f32>,
-    ids: &mut Vec<u32>,
-    leaf_end: &mut Vec<u32>,
-    scratch: &mut Vec<f64>,
-) -> bool {
+/// u32 words of a split tile's header: its split values (f32 bits, [`Split::stride`]) then
+/// each leaf's end, counted from the first id after the header.
+pub fn header_len(kind: Split, leaves: usize) -> usize {
+    kind.stride(leaves) + leaves
+}
+
+/// Builds the split of one tile into `block` (appended): the header ([`header_len`]), then
+/// each leaf's triangles in leaf order. `items` holds (triangle, z_lo, z_hi) with widened
+/// clipped depth ranges. Returns false, writing nothing, when the depth range is empty (every
+/// triangle at one depth: no split helps).
+pub fn build(items: &[(u32, f64, f64)], kind: Split, depth: u32, block: &mut Vec<u32>, scratch: &mut Vec<f64>) -> bool {
     let leaves = 1usize << depth;
     let lo = items.iter().fold(f64::INFINITY, |a, it| a.min(it.1));
     let hi = items.iter().fold(f64::NEG_INFINITY, |a, it| a.max(it.2));
@@ -81,35 +80,43 @@ pub fn build(
     if z1 <= z0 {
         return false;
     }
-    let leaf_range: Box<dyn Fn(f64, f64) -> (usize, usize)> = match kind {
+    let head = block.len();
+    let mut planes = [0f32; 1024];
+    let stride = kind.stride(leaves);
+    match kind {
         Split::Uniform => {
             let scale = (leaves as f64 / (z1 as f64 - z0 as f64)) as f32;
             if !scale.is_finite() || scale <= 0.0 {
                 return false;
             }
-            split.extend([z0, scale]);
-            Box::new(move |a, b| (uniform_leaf(a, z0, scale, leaves), uniform_leaf(b, z0, scale, leaves)))
+            planes[0] = z0;
+            planes[1] = scale;
         }
         Split::Median => {
             scratch.clear();
             scratch.extend(items.iter().map(|it| 0.5 * (it.1 + it.2)));
             scratch.sort_unstable_by(f64::total_cmp);
-            let at = split.len();
             for k in 1..leaves {
-                split.push(scratch[(k * scratch.len() / leaves).min(scratch.len() - 1)] as f32);
+                planes[k - 1] = scratch[(k * scratch.len() / leaves).min(scratch.len() - 1)] as f32;
             }
-            let planes = split[at..].to_vec();
-            Box::new(move |a, b| (median_leaf(a, &planes), median_leaf(b, &planes)))
         }
+    }
+    let bits: Vec<u32> = planes[..stride].iter().map(|p| p.to_bits()).collect();
+    let leaf = |z: f64| match kind {
+        Split::Uniform => uniform_leaf(z, planes[0], planes[1], leaves),
+        Split::Median => median_leaf(z, &bits),
     };
-    let ranges: Vec<(usize, usize)> = items.iter().map(|it| leaf_range(it.1, it.2)).collect();
+    block.extend_from_slice(&bits);
+    block.resize(head + stride + leaves, 0);
+    let first = block.len();
+    let ranges: Vec<(usize, usize)> = items.iter().map(|it| (leaf(it.1), leaf(it.2))).collect();
     for l in 0..leaves {
         for (it, r) in items.iter().zip(&ranges) {
             if r.0 <= l && l <= r.1 {
-                ids.push(it.0);
+                block.push(it.0);
             }
         }
-        leaf_end.push(ids.len() as u32);
+        block[head + stride + l] = (block.len() - first) as u32;
     }
     true
 }

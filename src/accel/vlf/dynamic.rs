@@ -45,6 +45,7 @@ impl VisibilityField {
             at = end;
         }
         let (frame, world) = (&self.frame, &self.world);
+        let header = super::bsp::header_len(self.settings.split, 1 << self.settings.depth);
         slices.into_par_iter().for_each(|(k, base, ids)| {
             let rot = frame.directions.rotation(k as u32);
             for &t in tris {
@@ -55,7 +56,7 @@ impl VisibilityField {
                     let mut s = (first & !SPLIT) as usize - base;
                     let end = (next & !SPLIT) as usize - base;
                     if first & SPLIT != 0 {
-                        s += 1; // the split-record index, not a triangle
+                        s += header; // split values and leaf ends, not triangles
                     }
                     for id in &mut ids[s..end] {
                         if *id == t {
@@ -114,6 +115,7 @@ impl VisibilityField {
             "visibility field: too many triangles"
         );
         self.world.extend_from_slice(positions);
+        self.tri.extend(positions.iter().flat_map(super::query::pack));
         self.object_of.extend(std::iter::repeat_n(object, positions.len()));
         self.in_base.extend(std::iter::repeat_n(false, positions.len()));
         let last = self.world.len() as u32;
@@ -131,6 +133,7 @@ impl VisibilityField {
         self.kill_in_base(&in_base);
         for (&t, p) in live.iter().zip(moved) {
             self.world[t as usize] = p;
+            self.tri[9 * t as usize..9 * t as usize + 9].copy_from_slice(&super::query::pack(&p));
         }
         self.overlay_ids.extend(in_base);
         self.rebuild_overlay()?;

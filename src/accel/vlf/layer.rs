@@ -6,9 +6,12 @@
 //! - `tile_first[k * n^2 + ty * n + tx]` (`D n^2 + 1` entries): start of the tile's block in
 //!   `ids`; the block ends where the next tile's starts (mask [`SPLIT`] off both). An empty tile
 //!   costs this one offset.
-//! - Bit 31 ([`SPLIT`]) set: the tile is split. `ids[start]` is its split record `s`; leaf `l`
-//!   holds `ids[leaf_end[s L + l - 1] .. leaf_end[s L + l]]` (leaf 0 starts at `start + 1`),
-//!   `L = 2^depth`; its split values are `split[s * stride ..]` ([`Split::stride`]).
+//! - Bit 31 ([`SPLIT`]) set: the tile is split, and its block starts with a header of
+//!   [`bsp::header_len`] words, so that one tile's lookup touches one region of memory: the
+//!   split values as f32 bits (`z0, scale` for uniform slabs, the `L - 1` planes for median
+//!   splits; [`Split::stride`]), then for each of the `L = 2^depth` leaves its end `E_l`,
+//!   counted from the first word after the header `h`: leaf `l` is `ids[h + E_{l-1} .. h + E_l]`
+//!   (`E_{-1} = 0`).
 //! - Otherwise `ids[start .. end]` are the tile's triangles, in increasing index order.
 
 use super::bsp;
@@ -25,12 +28,8 @@ pub const SPLIT: u32 = 1 << 31;
 pub struct Layer {
     /// Per tile, start in `ids` (bit 31: split); one more entry closes the last tile.
     pub tile_first: Vec<u32>,
-    /// Triangle ids, and one split-record index at the head of each split tile.
+    /// Triangle ids, and the header at the head of each split tile's block.
     pub ids: Vec<u32>,
-    /// Per split record, the end of each leaf in `ids`.
-    pub leaf_end: Vec<u32>,
-    /// Per split record, its split values.
-    pub split: Vec<f32>,
     /// Triangles indexed (distinct).
     pub triangles: usize,
 }
@@ -39,14 +38,12 @@ pub struct Layer {
 struct Part {
     tile_first: Vec<u32>,
     ids: Vec<u32>,
-    leaf_end: Vec<u32>,
-    split: Vec<f32>,
 }
 
 impl Layer {
     /// Bytes the arrays occupy.
     pub fn bytes(&self) -> usize {
-        4 * (self.tile_first.len() + self.ids.len() + self.leaf_end.len() + self.split.len())
+        4 * (self.tile_first.len() + self.ids.len())
     }
 
     /// Split tiles.
@@ -66,26 +63,15 @@ impl Layer {
             total_ids < SPLIT as usize,
             "visibility field: {total_ids} tile entries exceed the 2^31 a u32 offset with a flag bit addresses; use fewer directions or tiles"
         );
-        let leaves = 1usize << settings.depth;
         let mut layer = Layer {
             tile_first: Vec::with_capacity(parts.iter().map(|p| p.tile_first.len()).sum::<usize>() + 1),
             ids: Vec::with_capacity(total_ids),
-            leaf_end: Vec::with_capacity(parts.iter().map(|p| p.leaf_end.len()).sum()),
-            split: Vec::with_capacity(parts.iter().map(|p| p.split.len()).sum()),
             triangles: subset.len(),
         };
         for p in parts {
-            let (base, records) = (layer.ids.len() as u32, (layer.leaf_end.len() / leaves) as u32);
+            let base = layer.ids.len() as u32;
             layer.tile_first.extend(p.tile_first.iter().map(|f| f + base));
-            let at = layer.ids.len();
             layer.ids.extend_from_slice(&p.ids);
-            for f in &p.tile_first {
-                if f & SPLIT != 0 {
-                    layer.ids[at + (f & !SPLIT) as usize] += records;
-                }
-            }
-            layer.leaf_end.extend(p.leaf_end.iter().map(|e| e + base));
-            layer.split.extend_from_slice(&p.split);
         }
         layer.tile_first.push(layer.ids.len() as u32);
         Ok(layer)
@@ -136,11 +122,8 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
     let mut part = Part {
         tile_first: Vec::with_capacity(tiles),
         ids: Vec::with_capacity(sorted.len()),
-        leaf_end: Vec::new(),
-        split: Vec::new(),
     };
     let (mut items, mut scratch) = (Vec::new(), Vec::new());
-    let mut records = 0u32;
     for t in 0..tiles {
         let list = &sorted[start[t] as usize..start[t + 1] as usize];
         let at = part.ids.len() as u32;
@@ -151,21 +134,10 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
                 let (lo, hi) = clipped_z_range(&proj[i as usize], tx, ty, e);
                 (subset[i as usize], lo - EPS, hi + EPS)
             }));
-            part.ids.push(records);
-            if bsp::build(
-                &items,
-                settings.split,
-                settings.depth,
-                &mut part.split,
-                &mut part.ids,
-                &mut part.leaf_end,
-                &mut scratch,
-            ) {
+            if bsp::build(&items, settings.split, settings.depth, &mut part.ids, &mut scratch) {
                 part.tile_first.push(at | SPLIT);
-                records += 1;
                 continue;
             }
-            part.ids.pop();
         }
         part.tile_first.push(at);
         part.ids.extend(list.iter().map(|&i| subset[i as usize]));

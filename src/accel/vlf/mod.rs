@@ -22,8 +22,8 @@
 //! All u32/f32/f64 `Vec`s, addressable with u32 indices:
 //! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
 //! - per layer ([`layer::Layer`], layout in its module doc): `tile_first` (u32, `D n^2 + 1`, bit
-//!   31 = split), `ids` (u32), `leaf_end` (u32, `2^depth` per split tile), `split` (f32: `z0,
-//!   scale` per split tile for uniform splits, `2^depth - 1` planes for median splits);
+//!   31 = split), `ids` (u32: triangle ids; a split tile's block starts with its split values
+//!   as f32 bits and its leaf ends);
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
 //! The base layer indexes every triangle; a second, small layer holds objects inserted or moved
@@ -125,6 +125,8 @@ pub struct VisibilityField {
     pub overlay: Layer,
     /// World-space triangles (f64), in input order (moved objects updated in place).
     pub world: Vec<[DVec3; 3]>,
+    /// `world` packed for the exact test ([`query::pack`]): 9 f64 per triangle.
+    pub tri: Vec<f64>,
     /// Owner per triangle.
     pub object_of: Vec<u32>,
     /// Whether the base layer still indexes triangle i (false once its object moved or was
@@ -182,6 +184,7 @@ impl VisibilityField {
             base,
             overlay: Layer::default(),
             in_base: vec![true; world.len()],
+            tri: world.iter().flat_map(query::pack).collect(),
             world,
             object_of: triangles.object_of.clone(),
             overlay_ids: Vec::new(),

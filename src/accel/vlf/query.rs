@@ -31,6 +31,36 @@ pub struct TileRay {
     pub t1: f64,
 }
 
+/// A triangle as the exact test reads it: corner 0 and the edges to corners 1 and 2, exactly
+/// as [`crate::accel::intersect`] computes them (9 f64).
+pub fn pack(t: &[DVec3; 3]) -> [f64; 9] {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    [t[0].x, t[0].y, t[0].z, e1.x, e1.y, e1.z, e2.x, e2.y, e2.z]
+}
+
+/// [`crate::accel::intersect`] on a packed triangle, with the same operations in the same order
+/// (so the same t, bit for bit) but no early returns: the t of a hit, NaN otherwise. A zero
+/// determinant makes `u` infinite or NaN, which fails the same test `intersect` returns early on.
+#[inline(always)]
+pub fn exact_t(origin: DVec3, dir: DVec3, k: &[f64]) -> f64 {
+    let v0 = DVec3::new(k[0], k[1], k[2]);
+    let e1 = DVec3::new(k[3], k[4], k[5]);
+    let e2 = DVec3::new(k[6], k[7], k[8]);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    let inv = 1.0 / det;
+    let s = origin - v0;
+    let u = s.dot(p) * inv;
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    let miss = !(0.0..=1.0).contains(&u) | (v < 0.0) | (u + v > 1.0);
+    if miss {
+        f64::NAN
+    } else {
+        e2.dot(q) * inv
+    }
+}
+
 impl VisibilityField {
     /// The ray in the nearest direction's tile space, clipped to the ball and to (0, tmax);
     /// None when that leaves nothing.
@@ -157,15 +187,21 @@ impl VisibilityField {
             return start < end && leaf(&layer.ids[start..end], f64::INFINITY);
         }
         let leaves = 1usize << self.settings.depth;
-        let s = layer.ids[start] as usize;
-        let ends = &layer.leaf_end[s * leaves..(s + 1) * leaves];
+        let kind = self.settings.split;
+        let stride = kind.stride(leaves);
+        let head = &layer.ids[start..start + stride + leaves];
+        let ends = &head[stride..];
+        let h = start + stride + leaves;
         let (za, zb) = (ray.o.z + ray.d.z * ta, ray.o.z + ray.d.z * tb);
         let (zlo, zhi) = (za.min(zb) - EPS, za.max(zb) + EPS);
-        let leaf_start = |l: usize| if l == 0 { start + 1 } else { ends[l - 1] as usize };
+        let leaf_ids = |l: usize| {
+            let a = if l == 0 { 0 } else { ends[l - 1] as usize };
+            &layer.ids[h + a..h + ends[l] as usize]
+        };
         let up = ray.d.z >= 0.0;
-        match self.settings.split {
+        match kind {
             Split::Uniform => {
-                let (z0, scale) = (layer.split[2 * s], layer.split[2 * s + 1]);
+                let (z0, scale) = (f32::from_bits(head[0]), f32::from_bits(head[1]));
                 let (l0, l1) = (
                     uniform_leaf(zlo, z0, scale, leaves),
                     uniform_leaf(zhi, z0, scale, leaves),
@@ -179,24 +215,24 @@ impl VisibilityField {
                     } else {
                         (uniform_plane(l, z0, scale) + EPS - ray.o.z) * ray.inv_dz
                     };
-                    if leaf(&layer.ids[leaf_start(l)..ends[l] as usize], exit) {
+                    if leaf(leaf_ids(l), exit) {
                         return true;
                     }
                 }
             }
             Split::Median => {
-                let planes = &layer.split[s * (leaves - 1)..(s + 1) * (leaves - 1)];
+                let planes = &head[..stride];
                 let (l0, l1) = (median_leaf(zlo, planes), median_leaf(zhi, planes));
                 for i in 0..=(l1 - l0) {
                     let l = if up { l0 + i } else { l1 - i };
                     let exit = if l == (if up { l1 } else { l0 }) {
                         f64::INFINITY
                     } else if up {
-                        (planes[l] as f64 - EPS - ray.o.z) * ray.inv_dz
+                        (f32::from_bits(planes[l]) as f64 - EPS - ray.o.z) * ray.inv_dz
                     } else {
-                        (planes[l - 1] as f64 + EPS - ray.o.z) * ray.inv_dz
+                        (f32::from_bits(planes[l - 1]) as f64 + EPS - ray.o.z) * ray.inv_dz
                     };
-                    if leaf(&layer.ids[leaf_start(l)..ends[l] as usize], exit) {
+                    if leaf(leaf_ids(l), exit) {
                         return true;
                     }
                 }
@@ -208,17 +244,18 @@ impl VisibilityField {
     /// Any-hit over one layer.
     #[inline]
     pub(super) fn any_in(&self, layer: &Layer, ray: &TileRay, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
-        let world = &self.world;
+        let tri = &self.tri;
         self.walk(
             ray,
             || f64::INFINITY,
             |tile, ta, tb| {
                 self.leaves(layer, ray, tile, ta, tb, |ids, _| {
                     ids.iter().any(|&id| {
-                        id != skip
-                            && id != super::DEAD
-                            && super::super::intersect(origin, dir, &world[id as usize])
-                                .is_some_and(|t| t > 0.0 && t < tmax)
+                        if id == skip || id == super::DEAD {
+                            return false;
+                        }
+                        let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
+                        t > 0.0 && t < tmax
                     })
                 })
             },
@@ -237,7 +274,7 @@ impl VisibilityField {
         skip: u32,
         best: &mut (f64, u32),
     ) {
-        let world = &self.world;
+        let tri = &self.tri;
         let cell = std::cell::Cell::new(*best);
         self.walk(
             ray,
@@ -249,10 +286,9 @@ impl VisibilityField {
                         if id == skip || id == super::DEAD {
                             continue;
                         }
-                        if let Some(t) = super::super::intersect(origin, dir, &world[id as usize]) {
-                            if t > 0.0 && t < tmax && (t < b.0 || (t == b.0 && id < b.1)) {
-                                b = (t, id);
-                            }
+                        let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
+                        if t > 0.0 && t < tmax && (t < b.0 || (t == b.0 && id < b.1)) {
+                            b = (t, id);
                         }
                     }
                     cell.set(b);

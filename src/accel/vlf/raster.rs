@@ -61,11 +61,15 @@ pub fn for_each_tile(p: [DVec2; 3], n: u32, e: f64, mut f: impl FnMut(u32, u32))
 /// widened by `e`: Sutherland-Hodgman against the four sides. Falls back to the whole
 /// triangle's range if rounding leaves nothing (the rasteriser said the two meet).
 pub fn clipped_z_range(p: &[DVec3; 3], tx: u32, ty: u32, e: f64) -> (f64, f64) {
+    let (x0, x1) = (tx as f64 - e, tx as f64 + 1.0 + e);
+    let (y0, y1) = (ty as f64 - e, ty as f64 + 1.0 + e);
+    if p.iter().all(|q| q.x >= x0 && q.x <= x1 && q.y >= y0 && q.y <= y1) {
+        // Inside the tile: nothing to clip (the common case for small triangles).
+        return (p[0].z.min(p[1].z).min(p[2].z), p[0].z.max(p[1].z).max(p[2].z));
+    }
     let mut poly: [DVec3; 9] = [DVec3::ZERO; 9];
     let mut len = 3;
     poly[..3].copy_from_slice(p);
-    let (x0, x1) = (tx as f64 - e, tx as f64 + 1.0 + e);
-    let (y0, y1) = (ty as f64 - e, ty as f64 + 1.0 + e);
     // Each side as (axis, bound, keep-if-greater).
     for (axis, bound, greater) in [(0, x0, true), (0, x1, false), (1, y0, true), (1, y1, false)] {
         let mut out: [DVec3; 9] = [DVec3::ZERO; 9];
