@@ -45,6 +45,7 @@ impl VisibilityField {
             at = end;
         }
         let (frame, world) = (&self.frame, &self.world);
+        let mask = super::bsp::id_mask(self.settings.depth);
         let header = super::bsp::header_len(self.settings.split, 1 << self.settings.depth);
         slices.into_par_iter().for_each(|(k, base, ids)| {
             let rot = frame.directions.rotation(k as u32);
@@ -59,7 +60,7 @@ impl VisibilityField {
                         s += header; // split values and leaf ends, not triangles
                     }
                     for id in &mut ids[s..end] {
-                        if *id == t {
+                        if *id & mask == t {
                             *id = DEAD;
                         }
                     }

@@ -50,7 +50,8 @@ use std::time::{Duration, Instant};
 /// Far above f64 rounding of scenes within ~1e6 radii of their origin, far below a tile.
 pub const EPS: f64 = 1e-6;
 
-/// A removed triangle's slot in a layer's `ids` (never a triangle index: those stay below it).
+/// A removed triangle's slot in a layer's `ids` (its index bits are all ones, never a triangle:
+/// indices stay below [`bsp::id_mask`]).
 pub const DEAD: u32 = u32::MAX;
 
 /// Build parameters (paper Section 6 fixes 513 directions and 128 x 128 tiles; tile-BSP depth

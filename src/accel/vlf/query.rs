@@ -9,7 +9,7 @@
 //! Closest-hit ties (equal t) go to the lower triangle index, as `brute_force`'s `min_by` keeps
 //! the first.
 
-use super::bsp::{median_leaf, uniform_leaf, uniform_plane, Split};
+use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
 use super::layer::{Layer, SPLIT};
 use super::{VisibilityField, EPS};
 use glam::DVec3;
@@ -58,6 +58,39 @@ pub fn exact_t(origin: DVec3, dir: DVec3, k: &[f64]) -> f64 {
         f64::NAN
     } else {
         e2.dot(q) * inv
+    }
+}
+
+/// One leaf's entries as a walk visits them.
+#[derive(Clone, Copy, Debug)]
+pub struct Leaf<'a> {
+    /// Entries (triangle index in the low [`bsp::id_bits`], leaf range above).
+    pub ids: &'a [u32],
+    /// The t beyond which no hit in a later leaf of this tile lies.
+    pub exit: f64,
+    /// Shift of the entry's key (first leaf, or `L - 1 -` last leaf walking down).
+    pub shift: u32,
+    /// Mask of the key after the shift (`2^depth - 1`; 0 in an unsplit tile).
+    pub key_mask: u32,
+    /// Entries whose key is below this were tested in an earlier leaf of this walk.
+    pub lim: u32,
+}
+
+impl Leaf<'_> {
+    /// Calls `f` with each triangle index not yet tested in this tile (nor dead); stops when
+    /// it returns true (returning true).
+    #[inline(always)]
+    pub fn each(&self, mask: u32, mut f: impl FnMut(u32) -> bool) -> bool {
+        for &e in self.ids {
+            let id = e & mask;
+            if id == mask || ((e >> self.shift) & self.key_mask) < self.lim {
+                continue;
+            }
+            if f(id) {
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -177,14 +210,21 @@ impl VisibilityField {
         tile: usize,
         ta: f64,
         tb: f64,
-        mut leaf: impl FnMut(&[u32], f64) -> bool,
+        mut leaf: impl FnMut(Leaf) -> bool,
     ) -> bool {
         let n2 = (self.settings.tiles * self.settings.tiles) as usize;
         let k = ray.dir as usize * n2 + tile;
         let (first, next) = (layer.tile_first[k], layer.tile_first[k + 1]);
         let (start, end) = ((first & !SPLIT) as usize, (next & !SPLIT) as usize);
         if first & SPLIT == 0 {
-            return start < end && leaf(&layer.ids[start..end], f64::INFINITY);
+            return start < end
+                && leaf(Leaf {
+                    ids: &layer.ids[start..end],
+                    exit: f64::INFINITY,
+                    shift: 0,
+                    key_mask: 0,
+                    lim: 0,
+                });
         }
         let leaves = 1usize << self.settings.depth;
         let kind = self.settings.split;
@@ -199,6 +239,23 @@ impl VisibilityField {
             &layer.ids[h + a..h + ends[l] as usize]
         };
         let up = ray.d.z >= 0.0;
+        let depth = self.settings.depth;
+        let lmask = (leaves - 1) as u32;
+        // Entries whose range began in a leaf already visited are skipped (see bsp::entry).
+        let shift = bsp::id_bits(depth) + if up { 0 } else { depth };
+        let lim = |l: usize, l0: usize, l1: usize| -> u32 {
+            if up {
+                if l == l0 {
+                    0
+                } else {
+                    l as u32
+                }
+            } else if l == l1 {
+                0
+            } else {
+                lmask - l as u32
+            }
+        };
         match kind {
             Split::Uniform => {
                 let (z0, scale) = (f32::from_bits(head[0]), f32::from_bits(head[1]));
@@ -215,7 +272,13 @@ impl VisibilityField {
                     } else {
                         (uniform_plane(l, z0, scale) + EPS - ray.o.z) * ray.inv_dz
                     };
-                    if leaf(leaf_ids(l), exit) {
+                    if leaf(Leaf {
+                        ids: leaf_ids(l),
+                        exit,
+                        shift,
+                        key_mask: lmask,
+                        lim: lim(l, l0, l1),
+                    }) {
                         return true;
                     }
                 }
@@ -232,7 +295,13 @@ impl VisibilityField {
                     } else {
                         (f32::from_bits(planes[l - 1]) as f64 + EPS - ray.o.z) * ray.inv_dz
                     };
-                    if leaf(leaf_ids(l), exit) {
+                    if leaf(Leaf {
+                        ids: leaf_ids(l),
+                        exit,
+                        shift,
+                        key_mask: lmask,
+                        lim: lim(l, l0, l1),
+                    }) {
                         return true;
                     }
                 }
@@ -245,13 +314,14 @@ impl VisibilityField {
     #[inline]
     pub(super) fn any_in(&self, layer: &Layer, ray: &TileRay, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
         let tri = &self.tri;
+        let mask = bsp::id_mask(self.settings.depth);
         self.walk(
             ray,
             || f64::INFINITY,
             |tile, ta, tb| {
-                self.leaves(layer, ray, tile, ta, tb, |ids, _| {
-                    ids.iter().any(|&id| {
-                        if id == skip || id == super::DEAD {
+                self.leaves(layer, ray, tile, ta, tb, |leaf| {
+                    leaf.each(mask, |id| {
+                        if id == skip {
                             return false;
                         }
                         let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
@@ -275,24 +345,26 @@ impl VisibilityField {
         best: &mut (f64, u32),
     ) {
         let tri = &self.tri;
+        let mask = bsp::id_mask(self.settings.depth);
         let cell = std::cell::Cell::new(*best);
         self.walk(
             ray,
             || cell.get().0,
             |tile, ta, tb| {
-                self.leaves(layer, ray, tile, ta, tb, |ids, exit| {
+                self.leaves(layer, ray, tile, ta, tb, |leaf| {
                     let mut b = cell.get();
-                    for &id in ids {
-                        if id == skip || id == super::DEAD {
-                            continue;
+                    leaf.each(mask, |id| {
+                        if id == skip {
+                            return false;
                         }
                         let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
                         if t > 0.0 && t < tmax && (t < b.0 || (t == b.0 && id < b.1)) {
                             b = (t, id);
                         }
-                    }
+                        false
+                    });
                     cell.set(b);
-                    b.0 < exit
+                    b.0 < leaf.exit
                 });
                 false
             },
