@@ -111,5 +111,41 @@ fn build(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, traverse, build);
+/// Dynamic updates on the body: a 512-triangle object (a folded sheet beside the figure) moved
+/// back and forth, and removed and inserted again, against the full build timed above.
+fn dynamic(c: &mut Criterion) {
+    let scene = body();
+    let mut field = VisibilityField::build(&scene.triangles, settings(Split::Uniform)).unwrap();
+    let c0 = field.frame.centre + DVec3::new(0.25, -0.1, 0.0) * field.frame.radius;
+    let h = 0.1 * field.frame.radius / 16.0;
+    let mut sheet = Vec::new();
+    for i in 0..16 {
+        for j in 0..16 {
+            let p = |a: f64, b: f64| c0 + DVec3::new(a * h, b * h, 0.3 * h * (a * 0.7).sin());
+            let (a, b) = (i as f64, j as f64);
+            sheet.push([p(a, b), p(a + 1.0, b), p(a + 1.0, b + 1.0)]);
+            sheet.push([p(a, b), p(a + 1.0, b + 1.0), p(a, b + 1.0)]);
+        }
+    }
+    field.insert_object(1000, &sheet).unwrap();
+    let mut g = c.benchmark_group("vlf_dynamic");
+    g.sample_size(10);
+    let mut sign = 1.0;
+    g.bench_function("move_512", |b| {
+        b.iter(|| {
+            sign = -sign;
+            field
+                .move_object(1000, |p| p + DVec3::new(0.0, 0.0, sign * 1e-3))
+                .unwrap()
+        })
+    });
+    g.bench_function("remove_insert_512", |b| {
+        b.iter(|| {
+            field.remove_object(1000).unwrap();
+            field.insert_object(1000, &sheet).unwrap()
+        })
+    });
+}
+
+criterion_group!(benches, traverse, build, dynamic);
 criterion_main!(benches);

@@ -105,12 +105,12 @@ impl VisibilityField {
         let b = dir.dot(oc) / dd;
         let r = f.radius * (1.0 + 4.0 * EPS);
         let disc = b * b - (oc.length_squared() - r * r) / dd;
-        if !(disc >= 0.0) {
+        if disc.is_nan() || disc < 0.0 {
             return None;
         }
         let sq = disc.sqrt();
         let (t0, t1) = ((-b - sq).max(0.0), (-b + sq).min(tmax));
-        if !(t0 <= t1) {
+        if t0.is_nan() || t1.is_nan() || t0 > t1 {
             return None;
         }
         let k = f.directions.lookup(dir);
@@ -334,6 +334,7 @@ impl VisibilityField {
 
     /// Closest hit over one layer, improving on `best` (t, triangle).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn closest_in(
         &self,
         layer: &Layer,
