@@ -40,6 +40,32 @@ struct Part {
     ids: Vec<u32>,
 }
 
+/// Asks the kernel to back `v`'s (not yet touched) capacity with transparent huge pages: a
+/// query touches two random places of arrays of hundreds of MB, and with 4 KiB pages each costs
+/// a TLB miss on top of the cache miss (measured: the tile lookup was a third of a query). A
+/// no-op off Linux, or where the kernel declines.
+fn huge_pages<T>(v: &Vec<T>) {
+    #[cfg(target_os = "linux")]
+    {
+        const PAGE: usize = 4096;
+        let bytes = v.capacity() * std::mem::size_of::<T>();
+        if bytes < (4 << 20) {
+            return;
+        }
+        let start = (v.as_ptr() as usize).div_ceil(PAGE) * PAGE;
+        let end = (v.as_ptr() as usize + bytes) / PAGE * PAGE;
+        if end > start {
+            // SAFETY: the range lies inside `v`'s own allocation; MADV_HUGEPAGE only changes
+            // how the kernel backs those pages, never their contents.
+            unsafe {
+                libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE);
+            }
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = v;
+}
+
 impl Layer {
     /// Bytes the arrays occupy.
     pub fn bytes(&self) -> usize {
@@ -68,6 +94,8 @@ impl Layer {
             ids: Vec::with_capacity(total_ids),
             triangles: subset.len(),
         };
+        huge_pages(&layer.tile_first);
+        huge_pages(&layer.ids);
         for p in parts {
             let base = layer.ids.len() as u32;
             layer.tile_first.extend(p.tile_first.iter().map(|f| f + base));
