@@ -91,10 +91,17 @@ pub fn header_len(kind: Split, leaves: usize) -> usize {
 }
 
 /// Builds the split of one tile into `block` (appended): the header ([`header_len`]), then
-/// each leaf's triangles in leaf order. `items` holds (triangle, z_lo, z_hi) with widened
-/// clipped depth ranges. Returns false, writing nothing, when the depth range is empty (every
+/// each leaf's triangles in leaf order; `boxes` gets each entry's footprint box (0 for header
+/// words). `items` holds (triangle, z_lo, z_hi, box) with widened clipped depth ranges. Returns false, writing nothing, when the depth range is empty (every
 /// triangle at one depth: no split helps).
-pub fn build(items: &[(u32, f64, f64)], kind: Split, depth: u32, block: &mut Vec<u32>, scratch: &mut Vec<f64>) -> bool {
+pub fn build(
+    items: &[(u32, f64, f64, u16)],
+    kind: Split,
+    depth: u32,
+    block: &mut Vec<u32>,
+    boxes: &mut Vec<u16>,
+    scratch: &mut Vec<f64>,
+) -> bool {
     let leaves = 1usize << depth;
     let lo = items.iter().fold(f64::INFINITY, |a, it| a.min(it.1));
     let hi = items.iter().fold(f64::NEG_INFINITY, |a, it| a.max(it.2));
@@ -131,12 +138,14 @@ pub fn build(items: &[(u32, f64, f64)], kind: Split, depth: u32, block: &mut Vec
     };
     block.extend_from_slice(&bits);
     block.resize(head + stride + leaves, 0);
+    boxes.resize(block.len(), 0);
     let first = block.len();
     let ranges: Vec<(usize, usize)> = items.iter().map(|it| (leaf(it.1), leaf(it.2))).collect();
     for l in 0..leaves {
         for (it, r) in items.iter().zip(&ranges) {
             if r.0 <= l && l <= r.1 {
                 block.push(entry(it.0, r.0, r.1, depth));
+                boxes.push(it.3);
             }
         }
         block[head + stride + l] = (block.len() - first) as u32;

@@ -13,9 +13,14 @@
 //!   counted from the first word after the header `h`: leaf `l` is `ids[h + E_{l-1} .. h + E_l]`
 //!   (`E_{-1} = 0`).
 //! - Otherwise `ids[start .. end]` are the tile's triangles, in increasing index order.
+//! - `boxes[i]` (u16) is the footprint of `ids[i]`'s triangle within its tile on a 16 x 16
+//!   sub-grid ([`super::raster::sub_box`]); 0 for header words. Not in the paper: the tiles'
+//!   lateral resolution is what bounds the candidates (the beam through a surface seen at a
+//!   grazing angle holds many triangles), and this refines it per entry for two bytes
+//!   (measured on the body: 68 exact tests per AO ray without it, 9.5 with it).
 
 use super::bsp;
-use super::raster::{clipped_z_range, for_each_tile};
+use super::raster::{clipped_z_range, for_each_tile, sub_box};
 use super::{Frame, VlfSettings, EPS};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -30,6 +35,9 @@ pub struct Layer {
     pub tile_first: Vec<u32>,
     /// Triangle ids, and the header at the head of each split tile's block.
     pub ids: Vec<u32>,
+    /// Per entry of `ids`, the footprint box of the triangle in its tile
+    /// ([`super::raster::sub_box`]; 0 for header words).
+    pub boxes: Vec<u16>,
     /// Triangles indexed (distinct).
     pub triangles: usize,
 }
@@ -38,6 +46,7 @@ pub struct Layer {
 struct Part {
     tile_first: Vec<u32>,
     ids: Vec<u32>,
+    boxes: Vec<u16>,
 }
 
 /// Asks the kernel to back `v`'s (not yet touched) capacity with transparent huge pages: a
@@ -69,7 +78,7 @@ fn huge_pages<T>(v: &Vec<T>) {
 impl Layer {
     /// Bytes the arrays occupy.
     pub fn bytes(&self) -> usize {
-        4 * (self.tile_first.len() + self.ids.len())
+        4 * (self.tile_first.len() + self.ids.len()) + 2 * self.boxes.len()
     }
 
     /// Split tiles.
@@ -92,14 +101,17 @@ impl Layer {
         let mut layer = Layer {
             tile_first: Vec::with_capacity(parts.iter().map(|p| p.tile_first.len()).sum::<usize>() + 1),
             ids: Vec::with_capacity(total_ids),
+            boxes: Vec::with_capacity(total_ids),
             triangles: subset.len(),
         };
         huge_pages(&layer.tile_first);
         huge_pages(&layer.ids);
+        huge_pages(&layer.boxes);
         for p in parts {
             let base = layer.ids.len() as u32;
             layer.tile_first.extend(p.tile_first.iter().map(|f| f + base));
             layer.ids.extend_from_slice(&p.ids);
+            layer.boxes.extend_from_slice(&p.boxes);
         }
         layer.tile_first.push(layer.ids.len() as u32);
         Ok(layer)
@@ -150,6 +162,7 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
     let mut part = Part {
         tile_first: Vec::with_capacity(tiles),
         ids: Vec::with_capacity(sorted.len()),
+        boxes: Vec::with_capacity(sorted.len()),
     };
     let (mut items, mut scratch) = (Vec::new(), Vec::new());
     for t in 0..tiles {
@@ -160,15 +173,30 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
             items.clear();
             items.extend(list.iter().map(|&i| {
                 let (lo, hi) = clipped_z_range(&proj[i as usize], tx, ty, e);
-                (subset[i as usize], lo - EPS, hi + EPS)
+                (
+                    subset[i as usize],
+                    lo - EPS,
+                    hi + EPS,
+                    sub_box(&proj[i as usize], tx, ty, e),
+                )
             }));
-            if bsp::build(&items, settings.split, settings.depth, &mut part.ids, &mut scratch) {
+            if bsp::build(
+                &items,
+                settings.split,
+                settings.depth,
+                &mut part.ids,
+                &mut part.boxes,
+                &mut scratch,
+            ) {
                 part.tile_first.push(at | SPLIT);
                 continue;
             }
         }
         part.tile_first.push(at);
+        let (tx, ty) = (t as u32 % n, t as u32 / n);
         part.ids.extend(list.iter().map(|&i| subset[i as usize]));
+        part.boxes
+            .extend(list.iter().map(|&i| sub_box(&proj[i as usize], tx, ty, e)));
     }
     part
 }

@@ -23,7 +23,8 @@
 //! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
 //! - per layer ([`layer::Layer`], layout in its module doc): `tile_first` (u32, `D n^2 + 1`, bit
 //!   31 = split), `ids` (u32: triangle ids; a split tile's block starts with its split values
-//!   as f32 bits and its leaf ends);
+//!   as f32 bits and its leaf ends), `boxes` (u16 per `ids` word: the triangle's footprint in
+//!   its tile on a 16 x 16 sub-grid, so most candidates are dropped with four compares);
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
 //! The base layer indexes every triangle; a second, small layer holds objects inserted or moved

@@ -11,6 +11,7 @@
 
 use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
 use super::layer::{Layer, SPLIT};
+use super::raster::sub_range;
 use super::{VisibilityField, EPS};
 use glam::DVec3;
 
@@ -66,6 +67,10 @@ pub fn exact_t(origin: DVec3, dir: DVec3, k: &[f64]) -> f64 {
 pub struct Leaf<'a> {
     /// Entries (triangle index in the low [`bsp::id_bits`], leaf range above).
     pub ids: &'a [u32],
+    /// Their footprint boxes ([`super::raster::sub_box`]).
+    pub boxes: &'a [u16],
+    /// The ray's own sub-cell box over the tile, packed the same way.
+    pub ray_box: [u32; 4],
     /// The t beyond which no hit in a later leaf of this tile lies.
     pub exit: f64,
     /// Shift of the entry's key (first leaf, or `L - 1 -` last leaf walking down).
@@ -81,9 +86,12 @@ impl Leaf<'_> {
     /// it returns true (returning true).
     #[inline(always)]
     pub fn each(&self, mask: u32, mut f: impl FnMut(u32) -> bool) -> bool {
-        for &e in self.ids {
+        let [rx0, rx1, ry0, ry1] = self.ray_box;
+        for (&e, &b) in self.ids.iter().zip(self.boxes) {
             let id = e & mask;
-            if id == mask || ((e >> self.shift) & self.key_mask) < self.lim {
+            let b = b as u32;
+            let apart = (b & 15 > rx1) | ((b >> 4) & 15 < rx0) | ((b >> 8) & 15 > ry1) | (b >> 12 < ry0);
+            if apart || id == mask || ((e >> self.shift) & self.key_mask) < self.lim {
                 continue;
             }
             if f(id) {
@@ -144,11 +152,11 @@ impl VisibilityField {
     ) -> bool {
         let n = self.settings.tiles as usize;
         let e = EPS * self.frame.half_tiles;
-        let last = n as f64 - 1.0;
         let (o, d) = (ray.o, ray.d);
         let (xa, xb) = (o.x + d.x * ray.t0, o.x + d.x * ray.t1);
         let (ya, yb) = (o.y + d.y * ray.t0, o.y + d.y * ray.t1);
-        let cell = |v: f64| v.floor().clamp(0.0, last) as usize;
+        // floor for v >= 0 is truncation (`as` saturates; NaN gives 0): no libm call.
+        let cell = |v: f64| (v.max(0.0) as usize).min(n - 1);
         let (x0, x1) = (cell(xa.min(xb) - e), cell(xa.max(xb) + e));
         let (y0, y1) = (cell(ya.min(yb) - e), cell(ya.max(yb) + e));
         if x0 == x1 && y0 == y1 {
@@ -216,10 +224,20 @@ impl VisibilityField {
         let k = ray.dir as usize * n2 + tile;
         let (first, next) = (layer.tile_first[k], layer.tile_first[k + 1]);
         let (start, end) = ((first & !SPLIT) as usize, (next & !SPLIT) as usize);
+        let e = EPS * self.frame.half_tiles;
+        let n = self.settings.tiles as usize;
+        let (tx, ty) = ((tile % n) as f64, (tile / n) as f64);
+        let (xa, xb) = (ray.o.x + ray.d.x * ta - tx, ray.o.x + ray.d.x * tb - tx);
+        let (ya, yb) = (ray.o.y + ray.d.y * ta - ty, ray.o.y + ray.d.y * tb - ty);
+        let (rx0, rx1) = sub_range(xa.min(xb), xa.max(xb), e);
+        let (ry0, ry1) = sub_range(ya.min(yb), ya.max(yb), e);
+        let ray_box = [rx0, rx1, ry0, ry1];
         if first & SPLIT == 0 {
             return start < end
                 && leaf(Leaf {
                     ids: &layer.ids[start..end],
+                    boxes: &layer.boxes[start..end],
+                    ray_box,
                     exit: f64::INFINITY,
                     shift: 0,
                     key_mask: 0,
@@ -234,9 +252,9 @@ impl VisibilityField {
         let h = start + stride + leaves;
         let (za, zb) = (ray.o.z + ray.d.z * ta, ray.o.z + ray.d.z * tb);
         let (zlo, zhi) = (za.min(zb) - EPS, za.max(zb) + EPS);
-        let leaf_ids = |l: usize| {
+        let leaf_range = |l: usize| {
             let a = if l == 0 { 0 } else { ends[l - 1] as usize };
-            &layer.ids[h + a..h + ends[l] as usize]
+            h + a..h + ends[l] as usize
         };
         let up = ray.d.z >= 0.0;
         let depth = self.settings.depth;
@@ -273,7 +291,9 @@ impl VisibilityField {
                         (uniform_plane(l, z0, scale) + EPS - ray.o.z) * ray.inv_dz
                     };
                     if leaf(Leaf {
-                        ids: leaf_ids(l),
+                        ids: &layer.ids[leaf_range(l)],
+                        boxes: &layer.boxes[leaf_range(l)],
+                        ray_box,
                         exit,
                         shift,
                         key_mask: lmask,
@@ -296,7 +316,9 @@ impl VisibilityField {
                         (f32::from_bits(planes[l - 1]) as f64 + EPS - ray.o.z) * ray.inv_dz
                     };
                     if leaf(Leaf {
-                        ids: leaf_ids(l),
+                        ids: &layer.ids[leaf_range(l)],
+                        boxes: &layer.boxes[leaf_range(l)],
+                        ray_box,
                         exit,
                         shift,
                         key_mask: lmask,

@@ -99,3 +99,26 @@ pub fn clipped_z_range(p: &[DVec3; 3], tx: u32, ty: u32, e: f64) -> (f64, f64) {
         (lo.min(q.z), hi.max(q.z))
     })
 }
+
+/// Sub-cells per tile side in an entry's footprint box ([`sub_box`]).
+pub const SUB: f64 = 16.0;
+
+/// The part of a tile a triangle's projection can occupy, as a box of 16 x 16 sub-cells packed
+/// `x0 | x1 << 4 | y0 << 8 | y1 << 12` (inclusive, rounded outwards by `e`): a query whose own
+/// sub-cell range misses it skips the triangle without the exact test (the tiles' lateral
+/// resolution, refined 16 times per entry at two bytes).
+pub fn sub_box(p: &[DVec3; 3], tx: u32, ty: u32, e: f64) -> u16 {
+    let lo = p[0].min(p[1]).min(p[2]);
+    let hi = p[0].max(p[1]).max(p[2]);
+    let (x0, x1) = sub_range(lo.x - tx as f64, hi.x - tx as f64, e);
+    let (y0, y1) = sub_range(lo.y - ty as f64, hi.y - ty as f64, e);
+    (x0 | x1 << 4 | y0 << 8 | y1 << 12) as u16
+}
+
+/// Sub-cells `[a, b]` (tile-relative, any order-preserving pair) covers, widened by `e`, clamped.
+#[inline]
+pub fn sub_range(a: f64, b: f64, e: f64) -> (u32, u32) {
+    // floor for v >= 0 is truncation (`as` saturates; NaN gives 0): no libm call.
+    let c = |v: f64| ((v * SUB).max(0.0) as u32).min(SUB as u32 - 1);
+    (c(a - e), c(b + e))
+}
