@@ -54,9 +54,20 @@ fn settings(split: Split) -> VlfSettings {
 fn traverse(c: &mut Criterion) {
     let scene = body();
     let bvh = Bvh::build(&scene.triangles, Preset::Medium);
-    for split in [Split::Uniform, Split::Median] {
+    let configs = [
+        ("uniform_d4", settings(Split::Uniform)),
+        ("median_d4", settings(Split::Median)),
+        (
+            "uniform_d2",
+            VlfSettings {
+                depth: 2,
+                ..settings(Split::Uniform)
+            },
+        ),
+    ];
+    for (k, (name, config)) in configs.into_iter().enumerate() {
         let start = Instant::now();
-        let field = VisibilityField::build(&scene.triangles, settings(split)).unwrap();
+        let field = VisibilityField::build(&scene.triangles, config).unwrap();
         eprintln!(
             "build {:.2} s: {}",
             start.elapsed().as_secs_f64(),
@@ -69,7 +80,7 @@ fn traverse(c: &mut Criterion) {
             rays.len(),
             100.0 * hits as f64 / rays.len() as f64
         );
-        let mut g = c.benchmark_group(format!("vlf_ao_{}", split.name()));
+        let mut g = c.benchmark_group(format!("vlf_ao_{name}"));
         g.throughput(Throughput::Elements(rays.len() as u64));
         g.sample_size(10);
         g.bench_function("vlf_any", |b| {
@@ -82,7 +93,7 @@ fn traverse(c: &mut Criterion) {
                     .count()
             })
         });
-        if split == Split::Uniform {
+        if k == 0 {
             g.bench_function("bvh_any", |b| {
                 b.iter(|| rays.iter().filter(|r| bvh.any_hit(r.0, r.1, r.2, r.3)).count())
             });
