@@ -27,6 +27,14 @@
 //!   its tile on a 16 x 16 sub-grid, so most candidates are dropped with four compares);
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
+//! GPU notes: WGSL has no u16, so `boxes` binds as `array<u32>` (entry `i` is the half
+//! `i % 2` of word `i / 2`, little end first). Sizes on the body (32K triangles, 513
+//! directions, 128^2 tiles, depth 4, leaf size 32): `tile_first` 34 MB, `ids` 274 MB, `boxes`
+//! 137 MB, above wgpu's default 128 MiB storage-binding limit: bind the arrays in chunks of
+//! whole directions (a direction's block is contiguous, from `tile_first[k n^2]` to
+//! `tile_first[(k + 1) n^2]`, and its offsets are absolute, so a chunk needs its base) or raise
+//! the limit where the adapter allows.
+//!
 //! The base layer indexes every triangle; a second, small layer holds objects inserted or moved
 //! since the build ([`dynamic`]), and removed triangles' ids are overwritten with [`DEAD`].
 
