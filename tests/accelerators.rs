@@ -295,7 +295,10 @@ fn sweeping_the_structure_changes_only_its_columns() {
             };
             (
                 r.name.to_string(),
-                (r.build)(&scene("bvh").triangles, &settings).stats().parameters,
+                (r.build)(&scene("bvh").triangles, &settings)
+                    .unwrap()
+                    .stats()
+                    .parameters,
             )
         })
         .collect();
@@ -314,5 +317,41 @@ fn sweeping_the_structure_changes_only_its_columns() {
     assert!(
         stderr.contains("tiny.toml:15:") && stderr.contains("sweep.accelerators[1]") && stderr.contains("`kd`"),
         "{stderr}"
+    );
+}
+
+/// The visibility field's parameters in a scene file: out-of-range values and unknown keys are
+/// errors naming the file, line and key; valid ones reach the structure.
+#[test]
+fn visibility_field_parameters_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(dir.path().join("tri.obj"), "v 0 0 0.5\nv 1 0 0.5\nv 0 1 0.5\nf 1 2 3\n").unwrap();
+    let load = |vlf: &str| {
+        let text = format!(
+            "accelerator = \"vlf\"\n[vlf]\n{vlf}\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nwidth = 1.0\n[[meshes]]\npath = \"tri.obj\"\n{}",
+            common::plane_and_light(0.1)
+        );
+        std::fs::write(&path, text).unwrap();
+        Scene::load(&path)
+    };
+    for (vlf, key) in [
+        ("tiles = 0", "vlf.tiles"),
+        ("depth = 9", "vlf.depth"),
+        ("level = 0", "vlf.level"),
+        ("split = \"mean\"", "split"),
+        ("tile = 64", "tile"),
+    ] {
+        let e = load(vlf).unwrap_err().to_string();
+        assert!(e.contains("scene.toml:3") && e.contains(key), "{vlf}: {e}");
+    }
+    let s = load("tiles = 16\ndepth = 2\nsplit = \"median\"\nlevel = 4").unwrap();
+    let stats = s.accel.as_ref().unwrap().stats();
+    assert!(
+        stats.parameters.contains("level 4")
+            && stats.parameters.contains("16x16")
+            && stats.parameters.contains("median"),
+        "{}",
+        stats.parameters
     );
 }

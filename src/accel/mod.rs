@@ -34,6 +34,41 @@ use std::time::Duration;
 /// by every structure's module.
 pub const TRIANGLE_WGSL: &str = include_str!("triangle.wgsl");
 
+/// A triangle as the GPU reads it: corner 0 and the two edges from it in full f32 (the form
+/// `triangle_t` takes), with its input index; 48 bytes, matching the structures' WGSL structs.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Debug)]
+pub struct GpuTri {
+    /// Corner 0.
+    pub v0: [f32; 3],
+    _p0: u32,
+    /// Corner 1 - corner 0.
+    pub e1: [f32; 3],
+    /// Index in input order.
+    pub index: u32,
+    /// Corner 2 - corner 0.
+    pub e2: [f32; 3],
+    _p1: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<GpuTri>() == 48);
+
+impl GpuTri {
+    /// Triangle `index` (`world`, f64) in `frame`'s local coordinates: corners converted in f64,
+    /// edges taken before rounding to f32.
+    pub fn new(world: &[DVec3; 3], index: u32, frame: &LocalFrame) -> GpuTri {
+        let p = world.map(|c| frame.point_f64(c));
+        GpuTri {
+            v0: p[0].as_vec3().to_array(),
+            _p0: 0,
+            e1: (p[1] - p[0]).as_vec3().to_array(),
+            index,
+            e2: (p[2] - p[0]).as_vec3().to_array(),
+            _p1: 0,
+        }
+    }
+}
+
 /// A closest hit: distance along the (unit) ray and the triangle's index in input order.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriHit {
@@ -129,6 +164,8 @@ pub struct AccelSettings {
     pub name: &'static str,
     /// obvhs build preset (BVH).
     pub bvh_preset: Preset,
+    /// Visibility-field parameters.
+    pub vlf: vlf::VlfSettings,
 }
 
 impl Default for AccelSettings {
@@ -136,6 +173,7 @@ impl Default for AccelSettings {
         AccelSettings {
             name: REGISTRY[0].name,
             bvh_preset: Preset::default(),
+            vlf: vlf::VlfSettings::default(),
         }
     }
 }
@@ -148,8 +186,8 @@ pub struct Registered {
     pub wgsl: &'static str,
     /// Storage buffers its WGSL declares at `@group(2)`.
     pub gpu_buffers: u32,
-    /// Builds it over `triangles`.
-    pub build: fn(&Triangles, &AccelSettings) -> Arc<dyn Accelerator>,
+    /// Builds it over `triangles`, or says which limit the scene exceeds.
+    pub build: fn(&Triangles, &AccelSettings) -> anyhow::Result<Arc<dyn Accelerator>>,
 }
 
 /// Every acceleration structure, the default first.
@@ -158,13 +196,19 @@ pub const REGISTRY: &[Registered] = &[
         name: "bvh",
         wgsl: bvh::WGSL,
         gpu_buffers: 2,
-        build: |t, s| Arc::new(Bvh::build(t, s.bvh_preset)),
+        build: |t, s| Ok(Arc::new(Bvh::build(t, s.bvh_preset))),
     },
     Registered {
         name: "brute",
         wgsl: brute::WGSL,
         gpu_buffers: 1,
-        build: |t, _| Arc::new(brute::Brute::build(t)),
+        build: |t, _| Ok(Arc::new(brute::Brute::build(t))),
+    },
+    Registered {
+        name: "vlf",
+        wgsl: vlf::WGSL,
+        gpu_buffers: vlf::GPU_BUFFERS,
+        build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.vlf)?)),
     },
 ];
 
@@ -179,9 +223,12 @@ pub fn names() -> Vec<&'static str> {
 }
 
 /// Builds the structure `settings` names over `triangles`; `None` for no triangles.
-pub fn build(triangles: &Triangles, settings: &AccelSettings) -> Option<Arc<dyn Accelerator>> {
+pub fn build(triangles: &Triangles, settings: &AccelSettings) -> anyhow::Result<Option<Arc<dyn Accelerator>>> {
     let r = registered(settings.name).expect("settings hold a registered name");
-    (!triangles.positions.is_empty()).then(|| (r.build)(triangles, settings))
+    if triangles.positions.is_empty() {
+        return Ok(None);
+    }
+    (r.build)(triangles, settings).map(Some)
 }
 
 /// An accelerator name as written in a scene file.

@@ -27,6 +27,26 @@ pub struct SceneFile {
     /// obvhs build preset of the meshes' BVH.
     #[serde(default)]
     pub bvh_preset: crate::accel::Preset,
+    /// Visibility-field parameters (`accelerator = "vlf"`).
+    #[serde(default)]
+    pub vlf: VlfDesc,
+}
+
+/// The visibility field's parameters as written; each absent one takes
+/// [`crate::accel::vlf::VlfSettings`]' default.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VlfDesc {
+    /// Direction subdivision level (16: the paper's 513 directions).
+    pub level: Option<u32>,
+    /// Tiles per side of each parallel subfield.
+    pub tiles: Option<u32>,
+    /// Tile-BSP depth.
+    pub depth: Option<u32>,
+    /// `"uniform"` slabs or `"median"` splits.
+    pub split: Option<crate::accel::vlf::Split>,
+    /// Tiles with at most this many triangles stay unsplit.
+    pub leaf_size: Option<u32>,
 }
 
 /// A mesh as written: an OBJ file (relative to the scene file), some of its groups, and a

@@ -2,8 +2,9 @@
 //! error located by file, line and key.
 
 use super::camera::{Camera, Projection};
-use super::description::{LightDesc, ProjectionDesc, SceneFile};
+use super::description::{LightDesc, ProjectionDesc, SceneFile, VlfDesc};
 use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
+use crate::accel::vlf::VlfSettings;
 use crate::accel::{self, AccelSettings};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
@@ -76,6 +77,7 @@ impl Scene {
                 })?
                 .name,
             bvh_preset: file.bvh_preset,
+            vlf: vlf_settings(&file.vlf, source)?,
         };
         for (i, s) in file.spheres.iter().enumerate() {
             spheres.push(Sphere {
@@ -152,9 +154,10 @@ impl Scene {
             });
             triangles.positions.extend(kept);
         }
-        Ok(Scene::analytic(spheres, planes, lights)
+        Scene::analytic(spheres, planes, lights)
             .with_cameras(cameras)
-            .with_meshes(meshes, triangles, settings))
+            .try_with_meshes(meshes, triangles, settings)
+            .map_err(|e| source.error(&key_path!["accelerator"], format!("{e:#}")))
     }
 }
 
@@ -212,4 +215,25 @@ impl Validator<'_> {
                 .error(at, format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}")))
         }
     }
+}
+
+/// The visibility field's parameters from the scene's `[vlf]` table, each checked against the
+/// range the structure supports.
+fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError> {
+    let defaults = VlfSettings::default();
+    let check = |key: &str, value: Option<u32>, default: u32, lo: u32, hi: u32| -> Result<u32, ConfigError> {
+        match value {
+            Some(v) if !(lo..=hi).contains(&v) => {
+                Err(source.error(&key_path!["vlf", key], format!("must lie in {lo}..={hi}, got {v}")))
+            }
+            v => Ok(v.unwrap_or(default)),
+        }
+    };
+    Ok(VlfSettings {
+        level: check("level", d.level, defaults.level, 1, 64)?,
+        tiles: check("tiles", d.tiles, defaults.tiles, 1, 1024)?,
+        depth: check("depth", d.depth, defaults.depth, 0, 6)?,
+        split: d.split.unwrap_or(defaults.split),
+        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, 0, u32::MAX)?,
+    })
 }

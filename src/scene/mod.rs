@@ -116,7 +116,18 @@ impl Scene {
 
     /// Adds triangle meshes, whose world-space `triangles` name their mesh by its index in
     /// `meshes`, and indexes every triangle with the structure `settings` names.
-    pub fn with_meshes(mut self, meshes: Vec<Mesh>, mut triangles: Triangles, settings: AccelSettings) -> Scene {
+    pub fn with_meshes(self, meshes: Vec<Mesh>, triangles: Triangles, settings: AccelSettings) -> Scene {
+        self.try_with_meshes(meshes, triangles, settings)
+            .expect("the structure builds over these meshes (use try_with_meshes for untrusted input)")
+    }
+
+    /// [`Scene::with_meshes`], or the error of a structure that cannot index them.
+    pub fn try_with_meshes(
+        mut self,
+        meshes: Vec<Mesh>,
+        mut triangles: Triangles,
+        settings: AccelSettings,
+    ) -> anyhow::Result<Scene> {
         assert_eq!(
             triangles.object_of.len(),
             triangles.positions.len(),
@@ -131,14 +142,21 @@ impl Scene {
         self.shapes.extend(meshes.into_iter().map(Shape::Mesh));
         self.triangles.positions.extend(triangles.positions);
         self.triangles.object_of.extend(triangles.object_of);
-        self.with_accelerator(settings)
+        self.try_with_accelerator(settings)
     }
 
     /// The same scene with its triangles indexed by the structure `settings` names.
-    pub fn with_accelerator(mut self, settings: AccelSettings) -> Scene {
-        self.accel = accel::build(&self.triangles, &settings);
+    pub fn with_accelerator(self, settings: AccelSettings) -> Scene {
+        self.try_with_accelerator(settings)
+            .expect("the structure builds over this scene (use try_with_accelerator for untrusted input)")
+    }
+
+    /// [`Scene::with_accelerator`], or the error of a structure that cannot index this scene
+    /// (a limit it exceeds).
+    pub fn try_with_accelerator(mut self, settings: AccelSettings) -> anyhow::Result<Scene> {
+        self.accel = accel::build(&self.triangles, &settings)?;
         self.accel_settings = settings;
-        self
+        Ok(self)
     }
 
     /// The spheres, in id order.

@@ -2,10 +2,9 @@
 //! no tree, nothing to get wrong: the independent path other structures are checked against
 //! (select it with `accelerator = "brute"`; it costs O(triangles) per ray).
 
-use super::{brute_force, intersect, Accelerator, BuildStats, GpuStructure, TriHit};
+use super::{brute_force, intersect, Accelerator, BuildStats, GpuStructure, GpuTri, TriHit};
 use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
-use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use std::time::Duration;
 
@@ -17,20 +16,6 @@ pub const WGSL: &str = include_str!("brute.wgsl");
 pub struct Brute {
     triangles: Triangles,
 }
-
-/// A triangle as vertex + two edges in full f32 (the same form as the BVH's leaves).
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable, Debug)]
-struct GpuTri {
-    v0: [f32; 3],
-    _p0: u32,
-    e1: [f32; 3],
-    _p1: u32,
-    e2: [f32; 3],
-    _p2: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<GpuTri>() == 48);
 
 impl Brute {
     /// Keeps a copy of `triangles`.
@@ -86,15 +71,8 @@ impl Accelerator for Brute {
             .triangles
             .positions
             .iter()
-            .map(|t| {
-                let p = t.map(|c| frame.point_f64(c));
-                GpuTri {
-                    v0: p[0].as_vec3().to_array(),
-                    e1: (p[1] - p[0]).as_vec3().to_array(),
-                    e2: (p[2] - p[0]).as_vec3().to_array(),
-                    ..Zeroable::zeroed()
-                }
-            })
+            .enumerate()
+            .map(|(i, t)| GpuTri::new(t, i as u32, frame))
             .collect();
         Ok(GpuStructure {
             buffers: vec![("brute-force triangle buffer", bytemuck::cast_slice(&tris).to_vec())],

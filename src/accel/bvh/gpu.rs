@@ -2,7 +2,7 @@
 //! coordinates, `#[repr(C)]` and Pod with sizes pinned to the WGSL structs in `traverse.wgsl`.
 
 use super::Bvh;
-use crate::accel::GpuStructure;
+use crate::accel::{GpuStructure, GpuTri};
 use crate::geometry::LocalFrame;
 use bytemuck::{Pod, Zeroable};
 
@@ -24,20 +24,7 @@ pub struct GpuNode {
     pub first_index: u32,
 }
 
-/// A triangle as vertex + two edges in full f32, with its input index.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable, Debug)]
-pub struct GpuTri {
-    pub v0: [f32; 3],
-    pub _p0: u32,
-    pub e1: [f32; 3],
-    pub index: u32,
-    pub e2: [f32; 3],
-    pub _p1: u32,
-}
-
 const _: () = assert!(std::mem::size_of::<GpuNode>() == 32);
-const _: () = assert!(std::mem::size_of::<GpuTri>() == 48);
 
 /// Node bounds converted through f64 and widened by a few f32 ulps so that no triangle pokes out
 /// of its node after rounding; triangles laid out in leaf order (obvhs' `primitive_indices`), so
@@ -73,17 +60,7 @@ pub(super) fn structure(bvh: &Bvh, frame: &LocalFrame) -> anyhow::Result<GpuStru
         .tree
         .primitive_indices
         .iter()
-        .map(|&i| {
-            let p = bvh.world[i as usize].map(|c| frame.point_f64(c));
-            GpuTri {
-                v0: p[0].as_vec3().to_array(),
-                _p0: 0,
-                e1: (p[1] - p[0]).as_vec3().to_array(),
-                index: i,
-                e2: (p[2] - p[0]).as_vec3().to_array(),
-                _p1: 0,
-            }
-        })
+        .map(|&i| GpuTri::new(&bvh.world[i as usize], i, frame))
         .collect();
     Ok(GpuStructure {
         buffers: vec![

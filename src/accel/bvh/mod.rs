@@ -242,7 +242,7 @@ impl Bvh {
     /// Bytes of the GPU form: 32-byte nodes and 48-byte full-f32 triangles in leaf order.
     pub fn gpu_bytes(&self) -> u64 {
         (self.node_count() * std::mem::size_of::<gpu::GpuNode>()
-            + self.tree.primitive_indices.len() * std::mem::size_of::<gpu::GpuTri>()) as u64
+            + self.tree.primitive_indices.len() * std::mem::size_of::<super::GpuTri>()) as u64
     }
 }
 

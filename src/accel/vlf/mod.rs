@@ -18,7 +18,7 @@
 //! `[-1 + 2 tx / n, -1 + 2 (tx + 1) / n]` (and likewise y). A ray along `-w` uses `w`'s tiles
 //! and walks its leaves in reverse.
 //!
-//! # Flat arrays (for the WGSL traversal to come)
+//! # Flat arrays
 //! All u32/f32/f64 `Vec`s, addressable with u32 indices:
 //! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
 //! - per layer ([`layer::Layer`], layout in its module doc): `tile_first` (u32, `D n^2 + 1`, bit
@@ -27,13 +27,10 @@
 //!   its tile on a 16 x 16 sub-grid, so most candidates are dropped with four compares);
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
-//! GPU notes: WGSL has no u16, so `boxes` binds as `array<u32>` (entry `i` is the half
-//! `i % 2` of word `i / 2`, little end first). Sizes on the body (32K triangles, 513
-//! directions, 128^2 tiles, depth 4, leaf size 32): `tile_first` 34 MB, `ids` 274 MB, `boxes`
-//! 137 MB, above wgpu's default 128 MiB storage-binding limit: bind the arrays in chunks of
-//! whole directions (a direction's block is contiguous, from `tile_first[k n^2]` to
-//! `tile_first[(k + 1) n^2]`, and its offsets are absolute, so a chunk needs its base) or raise
-//! the limit where the adapter allows.
+//! On the GPU (`gpu.rs`, `vlf.wgsl`) the same arrays are read but for `boxes`. Sizes on the body
+//! (32K triangles, 513 directions, 128^2 tiles, depth 4, leaf size 32): `tile_first` 34 MB,
+//! `ids` 274 MB, `boxes` 137 MB; `ids` is bound in chunks of whole directions under wgpu's
+//! portable 128 MiB storage-binding size.
 //!
 //! The base layer indexes every triangle; a second, small layer holds objects inserted or moved
 //! since the build ([`dynamic`]), and removed triangles' ids are overwritten with [`DEAD`].
@@ -41,11 +38,16 @@
 pub mod bsp;
 pub mod directions;
 pub mod dynamic;
+mod gpu;
 pub mod layer;
 pub mod query;
 pub mod raster;
 
 pub use bsp::Split;
+pub use gpu::GPU_BUFFERS;
+
+/// Its WGSL: `accel_closest` and `accel_any` as one tile walk ([`gpu`] lays out the buffers).
+pub const WGSL: &str = include_str!("vlf.wgsl");
 
 use super::{Accelerator, BuildStats, GpuStructure, TriHit};
 use crate::geometry::LocalFrame;
@@ -272,9 +274,7 @@ impl Accelerator for VisibilityField {
         }
     }
 
-    fn gpu(&self, _frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
-        anyhow::bail!(
-            "the visibility field has no GPU traversal yet (its flat arrays are laid out for one: see accel::vlf)"
-        )
+    fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
+        gpu::structure(self, frame)
     }
 }

@@ -205,7 +205,10 @@ impl Spec {
             let built = if settings == scene.accel_settings {
                 scene.clone()
             } else {
-                scene.clone().with_accelerator(settings)
+                scene
+                    .clone()
+                    .try_with_accelerator(settings)
+                    .map_err(|e| err(&key_path!["sweep", "accelerators", i], format!("{e:#}")))?
             };
             structures.insert(name.clone(), built.accel);
         }
