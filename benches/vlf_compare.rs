@@ -19,7 +19,8 @@
 //! The obvhs columns are not exact: f32 tests, and on `ao-grid` obvhs' CWBVH reports fewer hits
 //! (cow 19.8 % against 22.4 % for every other structure): about a quarter of the 513 stored
 //! directions have an exactly zero component (the octahedron's edges lie in coordinate planes)
-//! and its quantised child-box test drops hits for such rays, so it also stops early less often
+//! and its quantised child-box test most likely drops hits for such rays (not yet isolated; on
+//! `ao-random` all four agree), so it also stops early less often
 //! than it should. Its BVH2 traversal agrees with the f64 structures.
 //!
 //! `cargo bench --bench vlf_compare`: criterion, small samples (about 5 minutes on 2 cores).
