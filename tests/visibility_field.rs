@@ -6,77 +6,18 @@
 //! than one, geometry touching the ball, an empty scene, one triangle, both split kinds and
 //! several levels and tile counts; and after removing, inserting and moving objects.
 //!
-//! The ray generators take any `Triangles`, so a mesh (the body here; OFF meshes later) plugs in.
+//! The ray generators (`common::rays`) take any `Triangles`; the shipped OFF meshes are checked
+//! with them in `visibility_field_meshes.rs`.
 
 mod common;
 
+use common::rays::*;
 use glam::DVec3;
 use penumbra::accel::brute::Brute;
 use penumbra::accel::vlf::directions::Directions;
 use penumbra::accel::vlf::{Split, VisibilityField, VlfSettings};
 use penumbra::accel::{Accelerator, TriHit};
 use penumbra::mesh::Triangles;
-use penumbra::sampling::rng::pcg;
-
-/// A seeded stream of uniform numbers in [0, 1).
-struct Rng(u32);
-
-impl Rng {
-    fn f(&mut self) -> f64 {
-        self.0 = pcg(self.0);
-        let hi = pcg(self.0 ^ 0x9e37_79b9);
-        (self.0 as f64 + hi as f64 / 4_294_967_296.0) / 4_294_967_296.0
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-    fn index(&mut self, n: usize) -> usize {
-        ((self.f() * n as f64) as usize).min(n - 1)
-    }
-    fn unit(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(self.range(-1., 1.), self.range(-1., 1.), self.range(-1., 1.));
-            let l = v.length();
-            if l > 1e-3 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
-
-/// A query: origin, unit direction, tmax, skip.
-type Ray = (DVec3, DVec3, f64, u32);
-
-fn v(x: f64, y: f64, z: f64) -> DVec3 {
-    DVec3::new(x, y, z)
-}
-
-fn tris(positions: Vec<[DVec3; 3]>) -> Triangles {
-    let n = positions.len();
-    Triangles {
-        positions,
-        object_of: (0..n as u32).map(|i| i % 4).collect(),
-    }
-}
-
-fn bounds(t: &Triangles) -> (DVec3, DVec3) {
-    t.positions.iter().flatten().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    )
-}
-
-fn point_on(t: &[DVec3; 3], r: &mut Rng) -> DVec3 {
-    let (mut a, mut b) = (r.f(), r.f());
-    if a + b > 1.0 {
-        (a, b) = (1.0 - a, 1.0 - b);
-    }
-    t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b
-}
-
-fn normal(t: &[DVec3; 3]) -> DVec3 {
-    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or(DVec3::Z)
-}
 
 /// Compares the field with brute force on every ray: (closest mismatches, any-hit mismatches),
 /// printing the first few.
@@ -112,123 +53,6 @@ fn check(field: &VisibilityField, t: &Triangles, rays: &[Ray], label: &str) {
         (0, 0),
         "{label}: {c} closest and {a} any-hit answers differ from brute force"
     );
-}
-
-/// Random segments between points of the (20 % enlarged) bounding box.
-fn random_segments(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let (c, h) = (0.5 * (lo + hi), 0.6 * (hi - lo) + DVec3::splat(1e-3));
-    (0..n)
-        .map(|_| {
-            let p = |r: &mut Rng| c + h * v(r.range(-1., 1.), r.range(-1., 1.), r.range(-1., 1.));
-            let (a, b) = (p(r), p(r));
-            let d = (b - a).normalize_or(DVec3::X);
-            (a, d, (b - a).length(), u32::MAX)
-        })
-        .collect()
-}
-
-/// AO rays from points on triangles along stored directions (both orientations, the one into
-/// the triangle's front and its opposite), length 4 ball radii, skipping the start triangle.
-fn ao_grid(t: &Triangles, dirs: &Directions, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let len = 2.0 * (hi - lo).length();
-    (0..n)
-        .map(|k| {
-            let i = r.index(t.positions.len());
-            let w = dirs.direction(r.index(dirs.len()) as u32);
-            let d = if (k % 2 == 0) == (w.dot(normal(&t.positions[i])) >= 0.0) {
-                w
-            } else {
-                -w
-            };
-            (point_on(&t.positions[i], r), d, len, i as u32)
-        })
-        .collect()
-}
-
-/// AO rays in uniformly random directions of each point's normal hemisphere.
-fn ao_random(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let len = 2.0 * (hi - lo).length();
-    (0..n)
-        .map(|_| {
-            let i = r.index(t.positions.len());
-            let d = r.unit();
-            let d = if d.dot(normal(&t.positions[i])) < 0.0 { -d } else { d };
-            (point_on(&t.positions[i], r), d, len, i as u32)
-        })
-        .collect()
-}
-
-/// Shadow rays from points on triangles to a 4 cm disk light above the scene (tmax: the light).
-fn shadow_rays(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let centre = v(
-        0.5 * (lo.x + hi.x) + 0.3 * (hi.x - lo.x),
-        0.5 * (lo.y + hi.y),
-        hi.z + 0.5 * (hi - lo).length(),
-    );
-    (0..n)
-        .map(|_| {
-            let i = r.index(t.positions.len());
-            let p = point_on(&t.positions[i], r);
-            let (rad, ang) = (0.02 * r.f().sqrt(), r.range(0., std::f64::consts::TAU));
-            let q = centre + v(rad * ang.cos(), rad * ang.sin(), 0.0);
-            ((p), (q - p).normalize(), (q - p).length(), i as u32)
-        })
-        .collect()
-}
-
-/// Camera rays from a point outside the scene through random points of its box (tmax infinite).
-fn camera_rays(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let eye = 0.5 * (lo + hi) + v(0.3, -2.0, 0.8) * (hi - lo).length();
-    (0..n)
-        .map(|_| {
-            let target = lo + (hi - lo) * v(r.f(), r.f(), r.f());
-            (eye, (target - eye).normalize(), f64::INFINITY, u32::MAX)
-        })
-        .collect()
-}
-
-/// Rays aimed at vertices and edge midpoints from outside, and rays starting or ending exactly
-/// on a triangle (no skip), and grazing rays nearly in a triangle's plane.
-fn touching_rays(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
-    let (lo, hi) = bounds(t);
-    let size = (hi - lo).length().max(1e-9);
-    let mut out = Vec::new();
-    for k in 0..n {
-        let i = r.index(t.positions.len());
-        let tri = &t.positions[i];
-        let p = match k % 3 {
-            0 => tri[k % 3],
-            1 => 0.5 * (tri[0] + tri[1]),
-            _ => point_on(tri, r),
-        };
-        let d = r.unit();
-        out.push((p - d * size * r.range(0.1, 2.0), d, f64::INFINITY, u32::MAX));
-        out.push((p, d, f64::INFINITY, u32::MAX));
-        out.push((p - d * size * 0.5, d, size * 0.5, u32::MAX));
-        let nrm = normal(tri);
-        let inplane = (tri[1] - tri[0]).normalize_or(DVec3::X);
-        let g = (inplane + nrm * 10f64.powf(r.range(-9., -2.))).normalize();
-        out.push((p - g * size * 0.3, g, f64::INFINITY, u32::MAX));
-    }
-    out
-}
-
-/// Every kind of ray, `n` of each.
-fn all_rays(t: &Triangles, dirs: &Directions, n: usize, seed: u32) -> Vec<(&'static str, Vec<Ray>)> {
-    let mut r = Rng(seed);
-    vec![
-        ("segments", random_segments(t, n, &mut r)),
-        ("ao-grid", ao_grid(t, dirs, n, &mut r)),
-        ("ao-random", ao_random(t, n, &mut r)),
-        ("shadow", shadow_rays(t, n, &mut r)),
-        ("camera", camera_rays(t, n, &mut r)),
-        ("touching", touching_rays(t, n / 4, &mut r)),
-    ]
 }
 
 fn check_all(t: &Triangles, settings: VlfSettings, n: usize, seed: u32, label: &str) -> VisibilityField {

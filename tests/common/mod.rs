@@ -1,9 +1,12 @@
-//! Shared test fixtures: the GPU backend (opened once per test binary) and scene paths.
+//! Shared test fixtures: the GPU backend (opened once per test binary), scene paths, and the
+//! seeded ray generators of the visibility-field tests ([`rays`]).
 #![allow(dead_code)]
 
 use penumbra::render::gpu::GpuBackend;
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
+
+pub mod rays;
 
 /// The GPU backend, or `None` with a note when no adapter exists. Where the environment sets
 /// `PENUMBRA_REQUIRE_GPU=1` (CI installs lavapipe and does), a missing adapter fails the test.

@@ -1,0 +1,432 @@
+//! The visibility field (`accel::vlf`, default settings) side by side with obvhs on cow, bull,
+//! man (assets/meshes) and the dressed body (experiments/scenes/body.toml), each scaled into the
+//! unit ball (the VLF's normalisation: bounding-box centre, farthest vertex at radius 1):
+//!
+//! - `vlf`: the visibility field's f64 queries;
+//! - `bvh`: the project's `accel::Bvh` (obvhs BVH2, `very-slow` preset, its best tree), its f64
+//!   exact-test queries;
+//! - `bvh2-obvhs`: the same BVH2 traversed by obvhs itself with its f32 triangle test;
+//! - `cwbvh-obvhs`: obvhs' CWBVH (`very_slow_build`) traversed by obvhs with its f32 test (the
+//!   known-facts figure: about 5.2 Mrays/s single-thread on the cow for 513-direction AO).
+//!
+//! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
+//! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
+//! skipped: the paper's Section 7 set-up), `ao-random` (513 uniform hemisphere directions per
+//! point), `shadow` (to a uniform point of a disk of radius 0.02 above the scene) any-hit, and
+//! `camera` (a 181 x 181 pinhole image framing the ball) closest-hit. Single thread (`1t`) and
+//! rayon over all cores (`mt`).
+//!
+//! The obvhs columns are not exact: f32 tests, and on `ao-grid` obvhs' CWBVH reports fewer hits
+//! (cow 19.8 % against 22.4 % for every other structure): about a quarter of the 513 stored
+//! directions have an exactly zero component (the octahedron's edges lie in coordinate planes)
+//! and its quantised child-box test most likely drops hits for such rays (not yet isolated; on
+//! `ao-random` all four agree), so it also stops early less often
+//! than it should. Its BVH2 traversal agrees with the f64 structures.
+//!
+//! `cargo bench --bench vlf_compare`: criterion, small samples (about 5 minutes on 2 cores).
+//! `cargo bench --bench vlf_compare -- --table`: one table of medians (Mrays/s), build times
+//! and memory (structure bytes: the VLF's arrays, the BVHs' nodes and index lists; not the
+//! triangles every structure keeps). `-- --counters`: the VLF's work per any-hit ray (tiles,
+//! leaves, entries scanned, exact tests) beside the CWBVH's triangle tests.
+//! `VLF_PROFILE_SECS=20 perf record ... vlf_compare-*`: loops the VLF's single-thread any-hit on
+//! the cow's grid-direction AO rays, for a profile.
+
+use criterion::{Criterion, SamplingMode, Throughput};
+use glam::{DVec3, Vec3A};
+use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::cwbvh::CwBvh;
+use obvhs::ray::{Ray, RayHit};
+use obvhs::BvhBuildParams;
+use penumbra::accel::vlf::{VisibilityField, VlfSettings};
+use penumbra::accel::{Bvh, Preset};
+use penumbra::mesh::Triangles;
+use penumbra::sampling::rng::pcg;
+use rayon::prelude::*;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// A query: origin, unit direction, tmax, skip.
+type Q = (DVec3, DVec3, f64, u32);
+
+const KINDS: [&str; 4] = ["ao-grid", "ao-random", "shadow", "camera"];
+const STRUCTURES: [&str; 4] = ["vlf", "bvh", "bvh2-obvhs", "cwbvh-obvhs"];
+const POINTS: u32 = 64;
+
+struct Mesh {
+    tris: Triangles,
+    vlf: VisibilityField,
+    bvh: Bvh,
+    cw: CwBvh,
+    cw_time: Duration,
+}
+
+fn repo(p: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+/// The mesh's triangles scaled into the unit ball.
+fn load(name: &str) -> Triangles {
+    let positions: Vec<[DVec3; 3]> = if name == "body" {
+        penumbra::scene::Scene::load(&repo("experiments/scenes/body.toml"))
+            .expect("body scene")
+            .triangles
+            .positions
+    } else {
+        let file = penumbra::mesh::load(&repo(&format!("assets/meshes/{name}.off"))).expect("mesh");
+        penumbra::mesh::clean(file.triangles, &glam::DMat4::IDENTITY).0
+    };
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in positions.iter().flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let c = 0.5 * (lo + hi);
+    let r = positions.iter().flatten().map(|p| p.distance(c)).fold(0.0, f64::max);
+    let positions: Vec<[DVec3; 3]> = positions.iter().map(|t| t.map(|p| (p - c) / r)).collect();
+    Triangles {
+        object_of: vec![0; positions.len()],
+        positions,
+    }
+}
+
+fn build(name: &'static str) -> Mesh {
+    let tris = load(name);
+    let vlf = VisibilityField::build(&tris, VlfSettings::default()).unwrap();
+    let bvh = Bvh::build(&tris, Preset::VerySlow);
+    let start = Instant::now();
+    let mut core = Duration::ZERO;
+    let cw = build_cwbvh_from_tris(&bvh.local, BvhBuildParams::very_slow_build(), &mut core);
+    Mesh {
+        tris,
+        vlf,
+        bvh,
+        cw,
+        cw_time: start.elapsed(),
+    }
+}
+
+struct Rng(u32);
+impl Rng {
+    fn f(&mut self) -> f64 {
+        self.0 = pcg(self.0);
+        self.0 as f64 / 4_294_967_296.0
+    }
+    fn unit(&mut self) -> DVec3 {
+        loop {
+            let v = DVec3::new(self.f(), self.f(), self.f()) * 2.0 - 1.0;
+            let l = v.length();
+            if l > 1e-3 && l <= 1.0 {
+                return v / l;
+            }
+        }
+    }
+}
+
+/// A seeded point on the mesh: (point, normal, triangle).
+fn point(t: &Triangles, r: &mut Rng) -> (DVec3, DVec3, u32) {
+    let i = ((r.f() * t.positions.len() as f64) as usize).min(t.positions.len() - 1);
+    let p = &t.positions[i];
+    let (mut a, mut b) = (r.f(), r.f());
+    if a + b > 1.0 {
+        (a, b) = (1.0 - a, 1.0 - b);
+    }
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    (p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b, n, i as u32)
+}
+
+fn rays(m: &Mesh, kind: &str) -> Vec<Q> {
+    let mut r = Rng(0x5eed ^ (kind.len() as u32 * 7717));
+    let dirs = &m.vlf.frame.directions;
+    let n = dirs.len();
+    let mut out = Vec::with_capacity(POINTS as usize * n);
+    if kind == "camera" {
+        let side = ((POINTS as f64 * n as f64).sqrt()) as usize;
+        let eye = DVec3::new(0.3, -2.0, 0.8).normalize() * 3.0;
+        let w = -eye.normalize();
+        let u = w.cross(DVec3::Z).normalize();
+        let v = u.cross(w);
+        let half = 0.36;
+        for y in 0..side {
+            for x in 0..side {
+                let (sx, sy) = (
+                    (2.0 * (x as f64 + 0.5) / side as f64 - 1.0) * half,
+                    (2.0 * (y as f64 + 0.5) / side as f64 - 1.0) * half,
+                );
+                out.push((eye, (w + u * sx + v * sy).normalize(), f64::INFINITY, u32::MAX));
+            }
+        }
+        return out;
+    }
+    let light = DVec3::new(0.3, 0.0, 1.5);
+    for _ in 0..POINTS {
+        let (p, nrm, i) = point(&m.tris, &mut r);
+        for j in 0..n {
+            let d = match kind {
+                "ao-grid" => dirs.direction(j as u32),
+                "ao-random" => r.unit(),
+                _ => {
+                    let (rad, ang) = (0.02 * r.f().sqrt(), r.f() * std::f64::consts::TAU);
+                    let q = light + DVec3::new(rad * ang.cos(), rad * ang.sin(), 0.0);
+                    out.push((p, (q - p).normalize(), (q - p).length(), i));
+                    continue;
+                }
+            };
+            out.push((p, if d.dot(nrm) >= 0.0 { d } else { -d }, 4.0, i));
+        }
+    }
+    out
+}
+
+/// One query with structure `s`; closest-hit for camera rays, any-hit otherwise. Returns hit.
+#[inline]
+fn trace(m: &Mesh, s: usize, closest: bool, &(o, d, tmax, skip): &Q) -> bool {
+    match s {
+        0 if closest => m.vlf.closest(o, d, tmax, skip).is_some(),
+        0 => m.vlf.any_hit(o, d, tmax, skip),
+        1 if closest => m.bvh.closest(o, d, tmax, skip).is_some(),
+        1 => m.bvh.any_hit(o, d, tmax, skip),
+        _ => {
+            let ray = Ray::new(
+                Vec3A::from((o - m.bvh.centre).as_vec3()),
+                Vec3A::from(d.as_vec3()),
+                0.0,
+                tmax as f32,
+            );
+            let (indices, local) = (
+                if s == 2 {
+                    &m.bvh.tree.primitive_indices
+                } else {
+                    &m.cw.primitive_indices
+                },
+                &m.bvh.local,
+            );
+            let test = |r: &Ray, id: usize| {
+                let tri = indices[id];
+                if tri == skip {
+                    f32::INFINITY
+                } else {
+                    local[tri as usize].intersect(r)
+                }
+            };
+            match (s, closest) {
+                (2, false) => !m.bvh.tree.ray_traverse_miss(ray, test),
+                (2, true) => m.bvh.tree.ray_traverse(ray, &mut RayHit::none(), test),
+                (_, false) => !m.cw.ray_traverse_miss(ray, test),
+                (_, true) => m.cw.ray_traverse(ray, &mut RayHit::none(), test),
+            }
+        }
+    }
+}
+
+fn run(m: &Mesh, s: usize, closest: bool, rays: &[Q], parallel: bool) -> usize {
+    if parallel {
+        rays.par_chunks(256)
+            .map(|c| c.iter().filter(|r| trace(m, s, closest, r)).count())
+            .sum()
+    } else {
+        rays.iter().filter(|r| trace(m, s, closest, r)).count()
+    }
+}
+
+/// Structure bytes (no triangles) of each structure.
+fn bytes(m: &Mesh) -> [usize; 4] {
+    let bvh2 = std::mem::size_of_val(m.bvh.tree.nodes.as_slice()) + 4 * m.bvh.tree.primitive_indices.len();
+    let cw = std::mem::size_of_val(m.cw.nodes.as_slice()) + 4 * m.cw.primitive_indices.len();
+    [m.vlf.bytes(), bvh2, bvh2, cw]
+}
+
+const MESHES: [&str; 4] = ["cow", "bull", "man", "body"];
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn table() {
+    let threads = rayon::current_num_threads();
+    println!(
+        "vlf_compare: {} logical CPUs, rayon {threads} threads; Mrays/s, median of 7 runs of {} rays",
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        POINTS * 513
+    );
+    println!();
+    println!("| mesh | tris | structure | build s | MB | B/tri | kind | 1t Mrays/s | mt Mrays/s | hit % |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for name in MESHES {
+        let t0 = Instant::now();
+        let m = build(name);
+        eprintln!("{name}: built in {:.1} s", t0.elapsed().as_secs_f64());
+        let b = bytes(&m);
+        let builds = [
+            m.vlf.build_time.as_secs_f64(),
+            m.bvh.total_time.as_secs_f64(),
+            m.bvh.total_time.as_secs_f64(),
+            m.cw_time.as_secs_f64(),
+        ];
+        let n = m.tris.positions.len();
+        for kind in KINDS {
+            let rays = rays(&m, kind);
+            let closest = kind == "camera";
+            for s in 0..4 {
+                let mut rates = [0.0; 2];
+                let mut hits = 0;
+                for (p, rate) in rates.iter_mut().enumerate() {
+                    hits = run(&m, s, closest, &rays, p == 1);
+                    let times: Vec<f64> = (0..7)
+                        .map(|_| {
+                            let t = Instant::now();
+                            std::hint::black_box(run(&m, s, closest, &rays, p == 1));
+                            t.elapsed().as_secs_f64()
+                        })
+                        .collect();
+                    *rate = rays.len() as f64 / median(times) / 1e6;
+                }
+                println!(
+                    "| {name} | {n} | {} | {:.2} | {:.1} | {:.0} | {kind} | {:.2} | {:.2} | {:.2} |",
+                    STRUCTURES[s],
+                    builds[s],
+                    b[s] as f64 / 1e6,
+                    b[s] as f64 / n as f64,
+                    rates[0],
+                    rates[1],
+                    100.0 * hits as f64 / rays.len() as f64
+                );
+            }
+        }
+        eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.vlf).description);
+    }
+}
+
+/// Work per any-hit ray of each mesh (`--counters`).
+fn count_table() {
+    println!(
+        "Work per any-hit ray: VLF tiles visited, leaves visited, entries scanned, exact tests; CWBVH triangle tests"
+    );
+    println!();
+    println!("| mesh | kind | VLF tiles | VLF leaves | VLF entries | VLF exact tests | CWBVH tri tests |");
+    println!("|---|---|---|---|---|---|---|");
+    for name in MESHES {
+        let m = build(name);
+        for kind in ["ao-grid", "ao-random", "shadow"] {
+            let [tiles, leaves, entries, exact, cw] = counters(&m, &rays(&m, kind));
+            println!("| {name} | {kind} | {tiles:.1} | {leaves:.1} | {entries:.1} | {exact:.1} | {cw:.1} |");
+        }
+    }
+}
+
+/// The VLF's any-hit walk (`VisibilityField::any_hit` on the base layer, rebuilt from its public
+/// pieces) with counters, and the CWBVH's triangle tests: per ray (tiles, leaves, entries
+/// scanned, exact tests, CWBVH triangle tests). Checks the hits agree with `any_hit`.
+fn counters(m: &Mesh, rays: &[Q]) -> [f64; 5] {
+    use penumbra::accel::vlf::query::exact_t;
+    let f = &m.vlf;
+    let mask = if f.settings.depth == 0 {
+        u32::MAX
+    } else {
+        (1 << (32 - 2 * f.settings.depth)) - 1
+    };
+    let mut c = [0usize; 5];
+    for &(o, d, tmax, skip) in rays {
+        let hit = f.tile_ray(o, d, tmax).is_some_and(|ray| {
+            f.walk(
+                &ray,
+                || f64::INFINITY,
+                |tile, ta, tb| {
+                    c[0] += 1;
+                    f.leaves(&f.base, &ray, tile, ta, tb, |leaf| {
+                        c[1] += 1;
+                        c[2] += leaf.ids.len();
+                        leaf.each(mask, |id| {
+                            if id == skip {
+                                return false;
+                            }
+                            c[3] += 1;
+                            let t = exact_t(o, d, &f.tri[9 * id as usize..9 * id as usize + 9]);
+                            t > 0.0 && t < tmax
+                        })
+                    })
+                },
+            )
+        });
+        assert_eq!(hit, f.any_hit(o, d, tmax, skip));
+        let ray = Ray::new(
+            Vec3A::from((o - m.bvh.centre).as_vec3()),
+            Vec3A::from(d.as_vec3()),
+            0.0,
+            tmax as f32,
+        );
+        m.cw.ray_traverse_miss(ray, |r, id| {
+            c[4] += 1;
+            let tri = m.cw.primitive_indices[id];
+            if tri == skip {
+                f32::INFINITY
+            } else {
+                m.bvh.local[tri as usize].intersect(r)
+            }
+        });
+    }
+    c.map(|x| x as f64 / rays.len() as f64)
+}
+
+fn criterion_benches(c: &mut Criterion) {
+    for name in MESHES {
+        let m = build(name);
+        for kind in KINDS {
+            let rays = rays(&m, kind);
+            let closest = kind == "camera";
+            let mut g = c.benchmark_group(format!("{name}/{kind}"));
+            g.sample_size(10)
+                .sampling_mode(SamplingMode::Flat)
+                .warm_up_time(Duration::from_millis(300))
+                .measurement_time(Duration::from_millis(700))
+                .throughput(Throughput::Elements(rays.len() as u64));
+            for (s, label) in STRUCTURES.iter().enumerate() {
+                for (p, mode) in ["1t", "mt"].iter().enumerate() {
+                    g.bench_function(format!("{label}_{mode}"), |b| {
+                        b.iter(|| run(&m, s, closest, &rays, p == 1))
+                    });
+                }
+            }
+            g.finish();
+        }
+    }
+    let m = load("cow");
+    let mut g = c.benchmark_group("cow/build");
+    g.sample_size(10).sampling_mode(SamplingMode::Flat);
+    g.bench_function("vlf", |b| {
+        b.iter(|| VisibilityField::build(&m, VlfSettings::default()).unwrap())
+    });
+    g.bench_function("bvh", |b| b.iter(|| Bvh::build(&m, Preset::VerySlow)));
+    let local = Bvh::build(&m, Preset::VerySlow).local;
+    g.bench_function("cwbvh-obvhs", |b| {
+        b.iter(|| build_cwbvh_from_tris(&local, BvhBuildParams::very_slow_build(), &mut Duration::default()))
+    });
+    g.finish();
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--table") {
+        table();
+        return;
+    }
+    if std::env::args().any(|a| a == "--counters") {
+        count_table();
+        return;
+    }
+    if let Some(secs) = std::env::var("VLF_PROFILE_SECS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
+        // For `perf record`: the VLF's any-hit on the cow's grid-direction AO rays, one thread.
+        let m = build("cow");
+        let rays = rays(&m, "ao-grid");
+        let t = Instant::now();
+        while t.elapsed().as_secs_f64() < secs {
+            std::hint::black_box(run(&m, 0, false, &rays, false));
+        }
+        return;
+    }
+    let mut c = Criterion::default().configure_from_args();
+    criterion_benches(&mut c);
+    c.final_summary();
+}
