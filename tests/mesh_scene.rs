@@ -282,3 +282,46 @@ fn long_shadow_loops_run_to_the_end() {
         .fold(0.0, f32::max);
     assert!(worst <= 4.0 / 1024.0, "max |dV| = {worst}");
 }
+
+/// `accelerator = "vlf"` renders the body scene exactly as the BVH does, on each backend: the
+/// same object in every pixel, the same visibility of both lights and the same ray counts, for
+/// the measuring and the perspective camera.
+#[test]
+fn the_visibility_field_renders_the_body_as_the_bvh_does() {
+    let bvh = body();
+    let vlf = bvh.clone().with_accelerator(penumbra::accel::AccelSettings {
+        name: "vlf",
+        ..bvh.accel_settings.clone()
+    });
+    let mut backends: Vec<(&str, Box<dyn FnMut(&Scene, View, Sampling) -> penumbra::render::Frame>)> = vec![(
+        "cpu",
+        Box::new(|s, v, smp| CpuBackend::default().render(s, v, smp).unwrap()),
+    )];
+    let gpu = common::gpu();
+    if let Some(mut g) = gpu {
+        backends.push(("gpu", Box::new(move |s, v, smp| g.render(s, v, smp).unwrap())));
+    }
+    for (backend, render) in &mut backends {
+        for camera in ["measure", "picture"] {
+            let view = View {
+                camera: &bvh.cameras[camera],
+                width: 48,
+                height: 36,
+            };
+            let sampling = Sampling {
+                scheme: DiskScheme::Paper,
+                pattern: Pattern::PerPixel,
+                seed: 5,
+            };
+            let (a, b) = (render(&bvh, view, sampling), render(&vlf, view, sampling));
+            let shadowed = a.visibility.iter().flatten().filter(|&&v| v < 1.0).count();
+            assert!(
+                shadowed > 50,
+                "{backend} {camera}: the body's shadow is in view ({shadowed} pixels)"
+            );
+            assert_eq!(a.hit, b.hit, "{backend} {camera}: objects hit");
+            assert_eq!(a.visibility, b.visibility, "{backend} {camera}: visibility");
+            assert_eq!(a.rays, b.rays, "{backend} {camera}: rays");
+        }
+    }
+}
