@@ -293,15 +293,13 @@ fn the_visibility_field_renders_the_body_as_the_bvh_does() {
         name: "vlf",
         ..bvh.accel_settings.clone()
     });
-    let mut backends: Vec<(&str, Box<dyn FnMut(&Scene, View, Sampling) -> penumbra::render::Frame>)> = vec![(
-        "cpu",
-        Box::new(|s, v, smp| CpuBackend::default().render(s, v, smp).unwrap()),
-    )];
-    let gpu = common::gpu();
-    if let Some(mut g) = gpu {
-        backends.push(("gpu", Box::new(move |s, v, smp| g.render(s, v, smp).unwrap())));
+    let mut cpu = CpuBackend::default();
+    let mut gpu = common::gpu();
+    let mut backends: Vec<(&str, &mut dyn Backend)> = vec![("cpu", &mut cpu)];
+    if let Some(g) = gpu.as_mut() {
+        backends.push(("gpu", &mut **g));
     }
-    for (backend, render) in &mut backends {
+    for (backend, b) in backends {
         for camera in ["measure", "picture"] {
             let view = View {
                 camera: &bvh.cameras[camera],
@@ -313,7 +311,10 @@ fn the_visibility_field_renders_the_body_as_the_bvh_does() {
                 pattern: Pattern::PerPixel,
                 seed: 5,
             };
-            let (a, b) = (render(&bvh, view, sampling), render(&vlf, view, sampling));
+            let (a, b) = (
+                b.render(&bvh, view, sampling).unwrap(),
+                b.render(&vlf, view, sampling).unwrap(),
+            );
             let shadowed = a.visibility.iter().flatten().filter(|&&v| v < 1.0).count();
             assert!(
                 shadowed > 50,
