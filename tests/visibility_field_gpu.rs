@@ -1,10 +1,9 @@
 //! The visibility field's WGSL walk against the BVH's WGSL walk on the same GPU, over the shipped
 //! meshes: both test the same f32 triangles with the same `triangle_t`, so any ray on which
-//! they disagree (hit or miss, triangle, t) is a candidate the field's walk dropped. Ray kinds as
-//! the issue lists them: random segments, AO rays along the field's own grid directions and in
-//! random directions, shadow rays to a 4 cm disk light, camera rays; 100K rays of each kind on every
-//! shipped mesh and the body. About 80 s on lavapipe
-//! (2 cores), most of it the three fields' builds.
+//! they disagree (hit or miss, triangle, t) is a candidate the field's walk dropped. Ray kinds:
+//! random segments, AO rays along the field's own grid directions and in random directions,
+//! shadow rays to a 4 cm disk light, camera rays; 100K of each on every shipped mesh and on the
+//! body. About 80 s on lavapipe (2 cores), the fields' builds included.
 
 #![cfg(feature = "test-hooks")]
 
