@@ -111,9 +111,13 @@ impl VisibilityField {
     pub fn insert_object(&mut self, object: u32, positions: &[[DVec3; 3]]) -> anyhow::Result<std::ops::Range<u32>> {
         self.check_inside(positions)?;
         let first = self.world.len() as u32;
+        let mask = super::bsp::id_mask(self.settings.depth);
         anyhow::ensure!(
-            (first as usize + positions.len()) < DEAD as usize,
-            "visibility field: too many triangles"
+            (first as usize + positions.len()) < mask as usize,
+            "visibility field: {} triangles do not fit the index bits a tile-BSP depth of {} leaves in an entry (at most {}); rebuild with a smaller depth",
+            first as usize + positions.len(),
+            self.settings.depth,
+            mask - 1
         );
         self.world.extend_from_slice(positions);
         self.tri.extend(positions.iter().flat_map(super::query::pack));

@@ -36,6 +36,21 @@ const GPU_EPS: f64 = 1e-4;
 /// stored direction visits one tile; long walks across the grid stay in the hundreds.
 const WALK_ITERATIONS: u32 = 2048;
 
+/// Bytes of the buffers [`structure`] uploads (without building them).
+pub(super) fn bytes(field: &VisibilityField) -> usize {
+    let dirs = field.frame.directions.len();
+    let overlay = if field.overlay_ids.is_empty() {
+        (0, 1)
+    } else {
+        (field.overlay.tile_first.len(), field.overlay.ids.len().max(1))
+    };
+    std::mem::size_of::<GpuTri>() * field.world.len().max(1)
+        + 4 * (HEADER + 10 * dirs)
+        + 4 * field.frame.directions.table.len()
+        + 4 * (field.base.tile_first.len() + overlay.0)
+        + 4 * (field.base.ids.len().max(1) + overlay.1)
+}
+
 /// The buffers `vlf.wgsl` binds at group 2, in binding order, or an error naming the array that
 /// does not fit.
 pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {

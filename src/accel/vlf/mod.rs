@@ -171,7 +171,14 @@ impl VisibilityField {
             settings.depth
         );
         let world = triangles.positions.clone();
-        anyhow::ensure!(world.len() < DEAD as usize, "visibility field: too many triangles");
+        anyhow::ensure!(
+            world.len() < bsp::id_mask(settings.depth) as usize,
+            "visibility field: {} triangles do not fit the {} index bits a tile-BSP depth of {} leaves in an entry (at most {}); use a smaller depth",
+            world.len(),
+            bsp::id_bits(settings.depth).min(32),
+            settings.depth,
+            bsp::id_mask(settings.depth) - 1
+        );
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for p in world.iter().flatten() {
             lo = lo.min(*p);
@@ -259,7 +266,7 @@ impl Accelerator for VisibilityField {
         BuildStats {
             parameters: self.settings.describe(),
             build_time: self.build_time,
-            gpu_bytes: bytes as u64,
+            gpu_bytes: gpu::bytes(self) as u64,
             triangles: self.world.len(),
             description: format!(
                 "visibility field ({}): {} tile entries ({:.1} per triangle per direction), {} split tiles, built in {:.1} ms; {:.1} MB ({:.0} bytes per triangle)",

@@ -112,7 +112,9 @@ impl VisibilityField {
         let dd = dir.length_squared();
         let b = dir.dot(oc) / dd;
         let r = f.radius * (1.0 + 4.0 * EPS);
-        let disc = b * b - (oc.length_squared() - r * r) / dd;
+        // r^2 less the squared distance from the centre to the line, over |dir|^2: not
+        // b^2 - (|oc|^2 - r^2) / dd, which cancels catastrophically when the origin is far.
+        let disc = (r * r - (oc - dir * b).length_squared()) / dd;
         if disc.is_nan() || disc < 0.0 {
             return None;
         }

@@ -96,7 +96,10 @@ fn vlf_ray(o: vec3<f32>, d: vec3<f32>, tmax: f32) -> VlfRay {
     let oc = o - vlf_vec(VLF_H_CENTRE);
     let b = dot(d, oc);
     let r = radius * 1.001;
-    let disc = b * b - (dot(oc, oc) - r * r);
+    // r^2 less the squared distance from the centre to the line (not b^2 - (|oc|^2 - r^2),
+    // which cancels in f32 once the origin is a few hundred radii away).
+    let f = oc - b * d;
+    let disc = r * r - dot(f, f);
     var ray = VlfRay(0u, vec3<f32>(0.0), vec3<f32>(0.0), 1.0, 0.0, 0.0, 0.0);
     if (!(disc >= 0.0)) {
         return ray;
@@ -164,7 +167,7 @@ fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, be
         }
         let tri = vlf_tris[id];
         let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
-        if (t > 0.0 && (t < best.t || (t == best.t && id < best.triangle))) {
+        if (t > 0.0 && (t < best.t || (t == best.t && id < best.triangle && best.triangle != NO_HIT))) {
             best = AccelHit(t, id);
         }
     }
