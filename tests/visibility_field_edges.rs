@@ -56,7 +56,12 @@ fn deep_tile_bsp_with_many_triangles_is_exact_or_refused() {
         };
         let rays = random_segments(&t, 2000, &mut r);
         let bad = mismatches(&field, &t, &rays);
-        assert_eq!(bad, 0, "{split:?}: {bad} of {} rays differ from brute force", rays.len());
+        assert_eq!(
+            bad,
+            0,
+            "{split:?}: {bad} of {} rays differ from brute force",
+            rays.len()
+        );
     }
 }
 
@@ -98,11 +103,25 @@ fn gpu_bytes_are_the_uploaded_buffers() {
         out.push([c, c + r.unit() * 0.1, c + r.unit() * 0.1]);
     }
     let t = tris(out);
-    let field = VisibilityField::build(&t, VlfSettings { level: 4, tiles: 16, ..Default::default() }).unwrap();
-    let frame = penumbra::geometry::LocalFrame { origin: DVec3::ZERO, scale: 1.0 };
+    let field = VisibilityField::build(
+        &t,
+        VlfSettings {
+            level: 4,
+            tiles: 16,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let frame = penumbra::geometry::LocalFrame {
+        origin: DVec3::ZERO,
+        scale: 1.0,
+    };
     let uploaded: usize = field.gpu(&frame).unwrap().buffers.iter().map(|(_, b)| b.len()).sum();
     let reported = field.stats().gpu_bytes as usize;
-    eprintln!("reported {reported}, uploaded {uploaded}, boxes {}", 2 * field.base.boxes.len());
+    eprintln!(
+        "reported {reported}, uploaded {uploaded}, boxes {}",
+        2 * field.base.boxes.len()
+    );
     assert!(
         (reported as f64 - uploaded as f64).abs() < 0.01 * uploaded as f64,
         "reported {reported} bytes, uploads {uploaded}"

@@ -12,11 +12,10 @@ mod common;
 use glam::DVec3;
 use penumbra::accel::vlf::directions::Directions;
 use penumbra::accel::vlf::VlfSettings;
-use penumbra::accel::AccelSettings;
 use penumbra::mesh::{self, Triangles};
 use penumbra::render::gpu::ProbeHit;
 use penumbra::sampling::Stream;
-use penumbra::scene::{Mesh, Scene};
+use penumbra::scene::Scene;
 
 /// Rays per kind per mesh.
 const RAYS: u32 = 100_000;
@@ -28,27 +27,6 @@ fn off_triangles(name: &str) -> Triangles {
         object_of: vec![0; positions.len()],
         positions,
     }
-}
-
-fn scene(triangles: &Triangles, name: &'static str) -> Scene {
-    let mesh = Mesh {
-        source: "test".into(),
-        file_fnv1a: 0,
-        albedo: 0.5,
-        triangles: triangles.positions.len(),
-        skipped: Default::default(),
-    };
-    Scene::analytic(vec![], vec![], vec![]).with_meshes(
-        vec![mesh],
-        Triangles {
-            positions: triangles.positions.clone(),
-            object_of: vec![0; triangles.positions.len()],
-        },
-        AccelSettings {
-            name,
-            ..Default::default()
-        },
-    )
 }
 
 /// Seeded rays of the five kinds over `t`: (kind, origin, unit direction, tmax).
@@ -103,8 +81,8 @@ fn check(name: &str, t: &Triangles) {
     let Some(mut gpu) = common::gpu() else { return };
     let rays = rays(t);
     let probes: Vec<_> = rays.iter().map(|&(_, o, d, tmax)| (o, d, tmax)).collect();
-    let bvh: Vec<ProbeHit> = gpu.probe(&scene(t, "bvh"), &probes).unwrap();
-    let vlf: Vec<ProbeHit> = gpu.probe(&scene(t, "vlf"), &probes).unwrap();
+    let bvh: Vec<ProbeHit> = gpu.probe(&common::triangles_scene(t, "bvh"), &probes).unwrap();
+    let vlf: Vec<ProbeHit> = gpu.probe(&common::triangles_scene(t, "vlf"), &probes).unwrap();
     let mut hits = std::collections::BTreeMap::<&str, (u32, u32)>::new();
     for ((kind, ..), (b, v)) in rays.iter().zip(bvh.iter().zip(&vlf)) {
         let entry = hits.entry(kind).or_default();
@@ -181,8 +159,8 @@ fn corners_on_the_ball_on_the_gpu_match_brute_force() {
             probes.push((*target - d * 3.0, d, f64::INFINITY));
         }
     }
-    let brute = gpu.probe(&scene(&t, "brute"), &probes).unwrap();
-    let vlf = gpu.probe(&scene(&t, "vlf"), &probes).unwrap();
+    let brute = gpu.probe(&common::triangles_scene(&t, "brute"), &probes).unwrap();
+    let vlf = gpu.probe(&common::triangles_scene(&t, "vlf"), &probes).unwrap();
     let hits = brute.iter().filter(|h| h.any).count();
     assert!(hits > probes.len() / 2, "{hits} of {} rays hit", probes.len());
     for (i, (b, v)) in brute.iter().zip(&vlf).enumerate() {

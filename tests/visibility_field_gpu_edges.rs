@@ -6,34 +6,22 @@
 mod common;
 
 use glam::DVec3;
-use penumbra::accel::AccelSettings;
 use penumbra::mesh::Triangles;
-use penumbra::scene::{Mesh, Scene};
-
-fn scene(triangles: &Triangles, name: &'static str) -> Scene {
-    let mesh = Mesh {
-        source: "test".into(),
-        file_fnv1a: 0,
-        albedo: 0.5,
-        triangles: triangles.positions.len(),
-        skipped: Default::default(),
-    };
-    Scene::analytic(vec![], vec![], vec![]).with_meshes(
-        vec![mesh],
-        triangles.clone(),
-        AccelSettings {
-            name,
-            ..Default::default()
-        },
-    )
-}
 
 #[test]
 fn a_hit_at_tmax_is_not_a_hit_on_the_gpu() {
     let Some(mut gpu) = common::gpu() else { return };
     let positions = vec![
-        [DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, -1.0, 0.0), DVec3::new(0.0, 1.0, 0.0)],
-        [DVec3::new(-1.0, -1.0, 0.5), DVec3::new(1.0, -1.0, 0.5), DVec3::new(0.0, 1.0, 0.5)],
+        [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.0, -1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ],
+        [
+            DVec3::new(-1.0, -1.0, 0.5),
+            DVec3::new(1.0, -1.0, 0.5),
+            DVec3::new(0.0, 1.0, 0.5),
+        ],
     ];
     let t = Triangles {
         object_of: vec![0; positions.len()],
@@ -47,8 +35,8 @@ fn a_hit_at_tmax_is_not_a_hit_on_the_gpu() {
         let z = if i % 2 == 0 { 0.25 } else { 1.0 };
         probes.push((DVec3::new(x, y, z), DVec3::NEG_Z, z));
     }
-    let brute = gpu.probe(&scene(&t, "brute"), &probes).unwrap();
-    let vlf = gpu.probe(&scene(&t, "vlf"), &probes).unwrap();
+    let brute = gpu.probe(&common::triangles_scene(&t, "brute"), &probes).unwrap();
+    let vlf = gpu.probe(&common::triangles_scene(&t, "vlf"), &probes).unwrap();
     let mut bad = 0;
     for (i, (b, v)) in brute.iter().zip(&vlf).enumerate() {
         if b.any != v.any || b.closest != v.closest {
@@ -87,8 +75,8 @@ fn far_origins_on_the_gpu_match_brute_force() {
             probes.push((target - d * dist, d, f64::INFINITY));
         }
     }
-    let brute = gpu.probe(&scene(&t, "brute"), &probes).unwrap();
-    let vlf = gpu.probe(&scene(&t, "vlf"), &probes).unwrap();
+    let brute = gpu.probe(&common::triangles_scene(&t, "brute"), &probes).unwrap();
+    let vlf = gpu.probe(&common::triangles_scene(&t, "vlf"), &probes).unwrap();
     let mut bad = 0;
     for (i, (b, v)) in brute.iter().zip(&vlf).enumerate() {
         if b.any != v.any || b.closest != v.closest {

@@ -113,3 +113,26 @@ albedo = 0.7
 "#
     ) + &plane_and_light(light_radius)
 }
+
+/// A scene of `triangles` alone (one mesh, every triangle its own), indexed by structure
+/// `name`: what the structure tests probe.
+pub fn triangles_scene(triangles: &penumbra::mesh::Triangles, name: &'static str) -> penumbra::scene::Scene {
+    let mesh = penumbra::scene::Mesh {
+        source: "test".into(),
+        file_fnv1a: 0,
+        albedo: 0.5,
+        triangles: triangles.positions.len(),
+        skipped: Default::default(),
+    };
+    penumbra::scene::Scene::analytic(vec![], vec![], vec![]).with_meshes(
+        vec![mesh],
+        penumbra::mesh::Triangles {
+            positions: triangles.positions.clone(),
+            object_of: vec![0; triangles.positions.len()],
+        },
+        penumbra::accel::AccelSettings {
+            name,
+            ..Default::default()
+        },
+    )
+}
