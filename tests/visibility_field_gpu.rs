@@ -121,6 +121,46 @@ fn body_on_the_gpu_matches_the_bvh() {
     check("body", &body.triangles);
 }
 
+/// An octahedron of unit corners: its corners are its farthest points, so the field's ball
+/// passes through them.
+fn octahedron() -> Triangles {
+    let c = [DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y];
+    let mut positions = Vec::new();
+    for i in 0..4 {
+        positions.push([c[i], c[(i + 1) % 4], DVec3::Z]);
+        positions.push([c[(i + 1) % 4], c[i], -DVec3::Z]);
+    }
+    Triangles {
+        object_of: vec![0; positions.len()],
+        positions,
+    }
+}
+
+/// The field's WGSL answers on `probes` equal brute force's WGSL answers (any-hit, closest
+/// triangle and t); returns how many rays hit.
+fn assert_matches_brute_force(t: &Triangles, probes: &[(DVec3, DVec3, f64)]) -> usize {
+    let Some(mut gpu) = common::gpu() else {
+        return usize::MAX;
+    };
+    let brute = gpu.probe(&common::triangles_scene(t, "brute"), probes).unwrap();
+    let vlf = gpu.probe(&common::triangles_scene(t, "vlf"), probes).unwrap();
+    let bad: Vec<_> = brute
+        .iter()
+        .zip(&vlf)
+        .enumerate()
+        .filter(|(_, (b, v))| b.any != v.any || b.closest != v.closest)
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "{} of {} rays differ, first: {:?} at {:?}",
+        bad.len(),
+        probes.len(),
+        bad[0],
+        probes[bad[0].0]
+    );
+    brute.iter().filter(|h| h.any).count()
+}
+
 /// Geometry touching the ball: an octahedron's corners are its farthest points, so the ball
 /// passes through them; rays aimed at corners and edge midpoints from every side (and along
 /// the grid's own directions) hit there, at the ball's rim. The reference is brute force's WGSL
@@ -129,17 +169,7 @@ fn body_on_the_gpu_matches_the_bvh() {
 /// 1235 the BVH reports triangle 3 at t = 2.9999974 where triangle 4 is hit at 2.9999962).
 #[test]
 fn corners_on_the_ball_on_the_gpu_match_brute_force() {
-    let Some(mut gpu) = common::gpu() else { return };
-    let c = [DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y];
-    let mut positions = Vec::new();
-    for i in 0..4 {
-        positions.push([c[i], c[(i + 1) % 4], DVec3::Z]);
-        positions.push([c[(i + 1) % 4], c[i], -DVec3::Z]);
-    }
-    let t = Triangles {
-        object_of: vec![0; positions.len()],
-        positions,
-    };
+    let t = octahedron();
     let targets: Vec<DVec3> = [DVec3::X, DVec3::Y, DVec3::Z, -DVec3::X, -DVec3::Y, -DVec3::Z]
         .into_iter()
         .chain(t.positions.iter().map(|p| 0.5 * (p[0] + p[1])))
@@ -159,12 +189,53 @@ fn corners_on_the_ball_on_the_gpu_match_brute_force() {
             probes.push((*target - d * 3.0, d, f64::INFINITY));
         }
     }
-    let brute = gpu.probe(&common::triangles_scene(&t, "brute"), &probes).unwrap();
-    let vlf = gpu.probe(&common::triangles_scene(&t, "vlf"), &probes).unwrap();
-    let hits = brute.iter().filter(|h| h.any).count();
+    let hits = assert_matches_brute_force(&t, &probes);
     assert!(hits > probes.len() / 2, "{hits} of {} rays hit", probes.len());
-    for (i, (b, v)) in brute.iter().zip(&vlf).enumerate() {
-        assert_eq!(v.any, b.any, "ray {i}: any-hit differs");
-        assert_eq!(v.closest, b.closest, "ray {i} {:?}: closest differs", probes[i]);
+}
+
+/// A triangle exactly at the end of a segment is not hit (0 < t < tmax), as brute force's WGSL
+/// and the CPU answer: rays down the z axis ending on the lower of two stacked triangles.
+#[test]
+fn a_hit_at_tmax_is_not_a_hit_on_the_gpu() {
+    let corners = |z: f64| {
+        [
+            DVec3::new(-1.0, -1.0, z),
+            DVec3::new(1.0, -1.0, z),
+            DVec3::new(0.0, 1.0, z),
+        ]
+    };
+    let t = Triangles {
+        positions: vec![corners(0.0), corners(0.5)],
+        object_of: vec![0, 0],
+    };
+    let probes: Vec<_> = (0..64)
+        .map(|i| {
+            let (x, y) = ((i % 8) as f64 / 32.0 - 0.1, (i / 8) as f64 / 32.0 - 0.1);
+            // Ends exactly on the lower triangle; passes the upper one only for i odd.
+            let z = if i % 2 == 0 { 0.25 } else { 1.0 };
+            (DVec3::new(x, y, z), DVec3::NEG_Z, z)
+        })
+        .collect();
+    let hits = assert_matches_brute_force(&t, &probes);
+    assert!(hits == 32 || hits == usize::MAX, "{hits} rays hit the upper triangle");
+}
+
+/// Geometry touching the ball seen from 30 to 3000 radii away: f32 rounding of the ray's
+/// segment inside the ball must not drop its ends.
+#[test]
+fn far_origins_on_the_gpu_match_brute_force() {
+    let t = octahedron();
+    let s = Stream::new(11, 0, None);
+    let mut probes = Vec::new();
+    for (j, dist) in [30.0, 300.0, 3000.0].into_iter().enumerate() {
+        for i in 0..2000u32 {
+            let i = i + 2000 * j as u32;
+            let u = |k: u32| s.unit(4 * i + k);
+            let d = DVec3::new(u(0) - 0.5, u(1) - 0.5, u(2) - 0.5).normalize();
+            let corner = [DVec3::X, DVec3::Y, DVec3::Z, -DVec3::X, -DVec3::Y, -DVec3::Z][i as usize % 6];
+            probes.push((corner * (0.99 + 0.01 * u(3)) - d * dist, d, f64::INFINITY));
+        }
     }
+    let hits = assert_matches_brute_force(&t, &probes);
+    assert!(hits > probes.len() / 2, "{hits} of {} rays hit", probes.len());
 }

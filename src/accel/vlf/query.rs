@@ -276,59 +276,37 @@ impl VisibilityField {
                 lmask - l as u32
             }
         };
-        match kind {
-            Split::Uniform => {
-                let (z0, scale) = (f32::from_bits(head[0]), f32::from_bits(head[1]));
-                let (l0, l1) = (
-                    uniform_leaf(zlo, z0, scale, leaves),
-                    uniform_leaf(zhi, z0, scale, leaves),
-                );
-                for i in 0..=(l1 - l0) {
-                    let l = if up { l0 + i } else { l1 - i };
-                    let exit = if l == (if up { l1 } else { l0 }) {
-                        f64::INFINITY
-                    } else if up {
-                        (uniform_plane(l + 1, z0, scale) - EPS - ray.o.z) * ray.inv_dz
-                    } else {
-                        (uniform_plane(l, z0, scale) + EPS - ray.o.z) * ray.inv_dz
-                    };
-                    if leaf(Leaf {
-                        ids: &layer.ids[leaf_range(l)],
-                        boxes: &layer.boxes[leaf_range(l)],
-                        ray_box,
-                        exit,
-                        shift,
-                        key_mask: lmask,
-                        lim: lim(l, l0, l1),
-                    }) {
-                        return true;
-                    }
-                }
+        // Depth of the boundary between leaves b - 1 and b.
+        let boundary = |b: usize| -> f64 {
+            match kind {
+                Split::Uniform => uniform_plane(b, f32::from_bits(head[0]), f32::from_bits(head[1])),
+                Split::Median => f32::from_bits(head[b - 1]) as f64,
             }
-            Split::Median => {
-                let planes = &head[..stride];
-                let (l0, l1) = (median_leaf(zlo, planes), median_leaf(zhi, planes));
-                for i in 0..=(l1 - l0) {
-                    let l = if up { l0 + i } else { l1 - i };
-                    let exit = if l == (if up { l1 } else { l0 }) {
-                        f64::INFINITY
-                    } else if up {
-                        (f32::from_bits(planes[l]) as f64 - EPS - ray.o.z) * ray.inv_dz
-                    } else {
-                        (f32::from_bits(planes[l - 1]) as f64 + EPS - ray.o.z) * ray.inv_dz
-                    };
-                    if leaf(Leaf {
-                        ids: &layer.ids[leaf_range(l)],
-                        boxes: &layer.boxes[leaf_range(l)],
-                        ray_box,
-                        exit,
-                        shift,
-                        key_mask: lmask,
-                        lim: lim(l, l0, l1),
-                    }) {
-                        return true;
-                    }
-                }
+        };
+        let leaf_of = |z: f64| match kind {
+            Split::Uniform => uniform_leaf(z, f32::from_bits(head[0]), f32::from_bits(head[1]), leaves),
+            Split::Median => median_leaf(z, &head[..stride]),
+        };
+        let (l0, l1) = (leaf_of(zlo), leaf_of(zhi));
+        for i in 0..=(l1 - l0) {
+            let l = if up { l0 + i } else { l1 - i };
+            let exit = if l == (if up { l1 } else { l0 }) {
+                f64::INFINITY
+            } else if up {
+                (boundary(l + 1) - EPS - ray.o.z) * ray.inv_dz
+            } else {
+                (boundary(l) + EPS - ray.o.z) * ray.inv_dz
+            };
+            if leaf(Leaf {
+                ids: &layer.ids[leaf_range(l)],
+                boxes: &layer.boxes[leaf_range(l)],
+                ray_box,
+                exit,
+                shift,
+                key_mask: lmask,
+                lim: lim(l, l0, l1),
+            }) {
+                return true;
             }
         }
         false
