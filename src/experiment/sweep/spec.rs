@@ -203,14 +203,12 @@ impl Spec {
                 ..scene.accel_settings.clone()
             };
             let built = if settings == scene.accel_settings {
-                scene.clone()
+                scene.accel.clone()
             } else {
-                scene
-                    .clone()
-                    .try_with_accelerator(settings)
+                crate::accel::build(&scene.triangles, &settings)
                     .map_err(|e| err(&key_path!["sweep", "accelerators", i], format!("{e:#}")))?
             };
-            structures.insert(name.clone(), built.accel);
+            structures.insert(name.clone(), built);
         }
         if scene.triangles.positions.is_empty() {
             // Nothing for a structure to index: every structure would render the same frames,
