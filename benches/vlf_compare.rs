@@ -11,9 +11,11 @@
 //!
 //! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
 //! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
-//! skipped: the paper's Section 7 set-up), `ao-random` (513 uniform hemisphere directions per
-//! point), `shadow` (to a uniform point of a disk of radius 0.02 above the scene) any-hit, and
-//! `camera` (a 181 x 181 pinhole image framing the ball) closest-hit. Single thread (`1t`) and
+//! skipped: the paper's Section 7 set-up), `ao-grid-by-direction` (the same rays ordered one
+//! stored direction at a time, so consecutive rays share a parallel subfield), `ao-random` (513
+//! uniform hemisphere directions per point), `shadow` (to a uniform point of a disk of radius
+//! 0.02 above the scene) any-hit, and `camera` (a 181 x 181 pinhole image framing the ball)
+//! closest-hit. Single thread (`1t`) and
 //! rayon over all cores (`mt`).
 //!
 //! The obvhs columns are not exact: f32 tests, and on `ao-grid` obvhs' CWBVH reports fewer hits
@@ -48,7 +50,7 @@ use std::time::{Duration, Instant};
 /// A query: origin, unit direction, tmax, skip.
 type Q = (DVec3, DVec3, f64, u32);
 
-const KINDS: [&str; 4] = ["ao-grid", "ao-random", "shadow", "camera"];
+const KINDS: [&str; 5] = ["ao-grid", "ao-grid-by-direction", "ao-random", "shadow", "camera"];
 const STRUCTURES: [&str; 4] = ["vlf", "bvh", "bvh2-obvhs", "cwbvh-obvhs"];
 const POINTS: u32 = 64;
 
@@ -135,6 +137,15 @@ fn point(t: &Triangles, r: &mut Rng) -> (DVec3, DVec3, u32) {
 }
 
 fn rays(m: &Mesh, kind: &str) -> Vec<Q> {
+    if kind == "ao-grid-by-direction" {
+        // Direction-major: consecutive rays read the same subfield's arrays.
+        let point_major = rays(m, "ao-grid");
+        let n = m.vlf.frame.directions.len();
+        let points = point_major.len() / n;
+        return (0..point_major.len())
+            .map(|k| point_major[(k % points) * n + k / points])
+            .collect();
+    }
     let mut r = Rng(0x5eed ^ (kind.len() as u32 * 7717));
     let dirs = &m.vlf.frame.directions;
     let n = dirs.len();
