@@ -63,26 +63,6 @@ fn check_all(t: &Triangles, settings: VlfSettings, n: usize, seed: u32, label: &
     field
 }
 
-/// Random triangles of mixed sizes (large, tile-sized, far smaller than a tile, slivers,
-/// degenerate) in a box off the origin.
-fn soup(n: usize, seed: u32) -> Triangles {
-    let mut r = Rng(seed);
-    let offset = v(3.0, -2.0, 1.5);
-    let mut out = Vec::new();
-    for k in 0..n {
-        let c = offset + v(r.range(-1., 1.), r.range(-1., 1.), r.range(-0.5, 0.5));
-        let s = [0.5, 0.05, 0.01, 1e-5][k % 4];
-        let (a, b) = (r.unit() * s, r.unit() * s);
-        out.push(match k % 23 {
-            7 => [c, c + a, c + 2.0 * a],       // collinear
-            11 => [c, c, c],                    // a point
-            13 => [c, c + a, c + a + b * 1e-9], // sliver
-            _ => [c, c + a, c + b],
-        });
-    }
-    tris(out)
-}
-
 /// A grid of triangles whose corners lie on tile boundaries of the `+z` direction (whose tiles
 /// are aligned with world x, y) for tile counts dividing 8, two triangles touching the unit
 /// ball at the poles (fixing the ball: centre 0, radius 1), and one spanning every tile.

@@ -239,3 +239,61 @@ fn far_origins_on_the_gpu_match_brute_force() {
     let hits = assert_matches_brute_force(&t, &probes);
     assert!(hits > probes.len() / 2, "{hits} of {} rays hit", probes.len());
 }
+
+/// After dynamic updates (an object removed, one moved, one inserted) the field's WGSL walk
+/// reads the base layer with the removed ids and the overlay layer of moved and inserted
+/// triangles, and answers as brute force's WGSL over the updated triangles.
+#[test]
+fn dynamic_updates_on_the_gpu_match_brute_force() {
+    use common::rays::{all_rays, soup, v};
+    use penumbra::accel::vlf::VisibilityField;
+    let t = soup(400, 11);
+    let settings = VlfSettings {
+        level: 8,
+        tiles: 64,
+        ..VlfSettings::default()
+    };
+    let mut field = VisibilityField::build(&t, settings).unwrap();
+    let mut current = t.clone();
+    field.remove_object(1).unwrap();
+    for (p, o) in current.positions.iter_mut().zip(&current.object_of) {
+        if *o == 1 {
+            *p = [p[0]; 3];
+        }
+    }
+    let m = |p: DVec3| v(3.0, -2.0, 1.5) + (p - v(3.0, -2.0, 1.5)) * 0.8 + v(0.05, -0.1, 0.02);
+    field.move_object(2, m).unwrap();
+    for (p, o) in current.positions.iter_mut().zip(&current.object_of) {
+        if *o == 2 {
+            *p = p.map(m);
+        }
+    }
+    let new: Vec<[DVec3; 3]> = soup(30, 77)
+        .positions
+        .iter()
+        .map(|p| p.map(|c| v(3.0, -2.0, 1.5) + (c - v(3.0, -2.0, 1.5)) * 0.5))
+        .collect();
+    field.insert_object(9, &new).unwrap();
+    current.positions.extend_from_slice(&new);
+    current.object_of.extend(std::iter::repeat_n(9, new.len()));
+    assert_eq!(field.world.len(), current.positions.len());
+
+    let probes: Vec<_> = all_rays(&current, &field.frame.directions.clone(), 2000, 3)
+        .into_iter()
+        .flat_map(|(_, rays)| rays)
+        .map(|(o, d, tmax, _)| (o, d, tmax))
+        .collect();
+    let Some(mut gpu) = common::gpu() else { return };
+    let brute = gpu.probe(&common::triangles_scene(&current, "brute"), &probes).unwrap();
+    let mut updated = common::triangles_scene(&current, "vlf");
+    updated.accel = Some(std::sync::Arc::new(field));
+    let vlf = gpu.probe(&updated, &probes).unwrap();
+    let bad = brute
+        .iter()
+        .zip(&vlf)
+        .filter(|(b, v)| b.any != v.any || b.closest != v.closest)
+        .count();
+    let hits = brute.iter().filter(|h| h.any).count();
+    assert!(hits > probes.len() / 10, "{hits} of {} rays hit", probes.len());
+    assert_eq!(bad, 0, "{bad} of {} rays differ from brute force", probes.len());
+}

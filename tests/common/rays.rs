@@ -182,3 +182,23 @@ pub fn all_rays(t: &Triangles, dirs: &Directions, n: usize, seed: u32) -> Vec<(&
         ("touching", touching_rays(t, n / 4, &mut r)),
     ]
 }
+
+/// Random triangles of mixed sizes (large, tile-sized, far smaller than a tile, slivers,
+/// degenerate) in a box off the origin.
+pub fn soup(n: usize, seed: u32) -> Triangles {
+    let mut r = Rng(seed);
+    let offset = v(3.0, -2.0, 1.5);
+    let mut out = Vec::new();
+    for k in 0..n {
+        let c = offset + v(r.range(-1., 1.), r.range(-1., 1.), r.range(-0.5, 0.5));
+        let s = [0.5, 0.05, 0.01, 1e-5][k % 4];
+        let (a, b) = (r.unit() * s, r.unit() * s);
+        out.push(match k % 23 {
+            7 => [c, c + a, c + 2.0 * a],       // collinear
+            11 => [c, c, c],                    // a point
+            13 => [c, c + a, c + a + b * 1e-9], // sliver
+            _ => [c, c + a, c + b],
+        });
+    }
+    tris(out)
+}
