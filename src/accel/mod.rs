@@ -13,7 +13,8 @@
 //! over the storage buffers it declares at `@group(2)` ([`GpuStructure`]), with `AccelHit
 //! { t, triangle }` (`triangle` in input order, `NO_HIT` on a miss; `skip` is a triangle to
 //! ignore) and the flag `cut_short` set where a loop ended early. Every structure's module may
-//! call the shared ray-triangle test `triangle_t` ([`TRIANGLE_WGSL`], prepended to it). The GPU
+//! use the shared triangle struct `AccelTri` and ray-triangle test `triangle_t`
+//! ([`TRIANGLE_WGSL`], prepended to it). The GPU
 //! backend compiles each structure's module into its own pipelines, chosen by name. Adding a
 //! structure is its module, its WGSL and one line in [`REGISTRY`].
 
@@ -30,12 +31,12 @@ use serde::Deserialize;
 use std::sync::Arc;
 use std::time::Duration;
 
-/// The WGSL twin of [`intersect`], `triangle_t(o, d, v0, e1, e2) -> f32` (-1 on a miss), shared
-/// by every structure's module.
+/// The WGSL every structure's module shares: `struct AccelTri` (the twin of [`GpuTri`]) and
+/// `triangle_t(o, d, v0, e1, e2) -> f32`, the twin of [`intersect`] (-1 on a miss).
 pub const TRIANGLE_WGSL: &str = include_str!("triangle.wgsl");
 
 /// A triangle as the GPU reads it: corner 0 and the two edges from it in full f32 (the form
-/// `triangle_t` takes), with its input index; 48 bytes, matching the structures' WGSL structs.
+/// `triangle_t` takes), with its input index; 48 bytes, read in WGSL as `AccelTri`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Debug)]
 pub struct GpuTri {

@@ -1,16 +1,7 @@
 // Brute force: every triangle against every ray (mod.rs beside it). Implements the accelerator
 // interface of src/accel/mod.rs; triangle i of the buffer is input triangle i.
 
-struct BruteTri {
-    v0: vec3<f32>,
-    _p0: u32,
-    e1: vec3<f32>,
-    _p1: u32,
-    e2: vec3<f32>,
-    _p2: u32,
-}
-
-@group(2) @binding(0) var<storage, read> brute_tris: array<BruteTri>;
+@group(2) @binding(0) var<storage, read> brute_tris: array<AccelTri>;
 
 fn accel_closest(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> AccelHit {
     var best = AccelHit(tmax, NO_HIT);

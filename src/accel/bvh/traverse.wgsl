@@ -10,15 +10,6 @@ struct Node {
     first_index: u32,
 }
 
-struct Tri {
-    v0: vec3<f32>,
-    _p0: u32,
-    e1: vec3<f32>,
-    index: u32,
-    e2: vec3<f32>,
-    _p1: u32,
-}
-
 struct MeshHit {
     t: f32,
     slot: u32,
@@ -34,7 +25,7 @@ const BIG: f32 = 3.4e38;
 var<private> stack: array<u32, STACK_SIZE>;
 
 @group(2) @binding(0) var<storage, read> nodes: array<Node>;
-@group(2) @binding(1) var<storage, read> tris: array<Tri>;
+@group(2) @binding(1) var<storage, read> tris: array<AccelTri>;
 
 // Entry distance into a node's box within [0, tmax], or BIG when missed.
 fn slab(o: vec3<f32>, inv_d: vec3<f32>, tmax: f32, n: Node) -> f32 {

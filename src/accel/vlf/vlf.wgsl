@@ -8,16 +8,7 @@
 // rounding, so the candidates hold every triangle `triangle_t` hits; ties in t go to the lower
 // triangle index.
 
-struct VlfTri {
-    v0: vec3<f32>,
-    _p0: u32,
-    e1: vec3<f32>,
-    index: u32,
-    e2: vec3<f32>,
-    _p1: u32,
-}
-
-@group(2) @binding(0) var<storage, read> vlf_tris: array<VlfTri>;
+@group(2) @binding(0) var<storage, read> vlf_tris: array<AccelTri>;
 @group(2) @binding(1) var<storage, read> vlf_head: array<u32>;
 @group(2) @binding(2) var<storage, read> vlf_table: array<u32>;
 @group(2) @binding(3) var<storage, read> vlf_tile_first: array<u32>;
