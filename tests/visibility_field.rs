@@ -274,42 +274,13 @@ fn dynamic_updates_match_brute_force() {
         let mut field = VisibilityField::build(&t, settings).unwrap();
         let mut current = t.clone();
         // Remove object 1: in the reference its triangles shrink to a point (never hit).
-        assert_eq!(
-            field.remove_object(1).unwrap(),
-            t.object_of.iter().filter(|o| **o == 1).count()
-        );
-        let removed: Triangles = Triangles {
-            positions: current
-                .positions
-                .iter()
-                .zip(&current.object_of)
-                .map(|(p, o)| if *o == 1 { [p[0]; 3] } else { *p })
-                .collect(),
-            object_of: current.object_of.clone(),
-        };
-        current = removed;
+        common::updates::remove(&mut field, &mut current, 1);
         let dirs = field.frame.directions.clone();
         for (kind, rays) in all_rays(&current, &dirs, 800, 1) {
             check(&field, &current, &rays, &format!("after remove: {kind}"));
         }
-        // Move object 2 (inside the ball).
-        let m = |p: DVec3| v(3.0, -2.0, 1.5) + (p - v(3.0, -2.0, 1.5)) * 0.8 + v(0.05, -0.1, 0.02);
-        field.move_object(2, m).unwrap();
-        for (p, o) in current.positions.iter_mut().zip(&current.object_of) {
-            if *o == 2 {
-                *p = p.map(m);
-            }
-        }
-        // Insert a new object: a few triangles.
-        let new: Vec<[DVec3; 3]> = soup(30, 77)
-            .positions
-            .iter()
-            .map(|p| p.map(|c| v(3.0, -2.0, 1.5) + (c - v(3.0, -2.0, 1.5)) * 0.5))
-            .collect();
-        let range = field.insert_object(9, &new).unwrap();
-        assert_eq!(range.start as usize, current.positions.len());
-        current.positions.extend_from_slice(&new);
-        current.object_of.extend(std::iter::repeat_n(9, new.len()));
+        // Move object 2 (inside the ball), insert object 9.
+        common::updates::move_and_insert(&mut field, &mut current);
         for (kind, rays) in all_rays(&current, &dirs, 800, 2) {
             check(&field, &current, &rays, &format!("after move and insert: {kind}"));
         }

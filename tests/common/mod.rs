@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
 pub mod rays;
+pub mod updates;
 
 /// The GPU backend, or `None` with a note when no adapter exists. Where the environment sets
 /// `PENUMBRA_REQUIRE_GPU=1` (CI installs lavapipe and does), a missing adapter fails the test.
