@@ -1,5 +1,7 @@
 //! Writing results without ever leaving a half-written file: write a temporary file beside the
-//! target, flush it to disk, then rename it over the target (atomic on POSIX file systems).
+//! target, flush it to disk, then rename it over the target (atomic on POSIX file systems). The
+//! temporary file is named after the host and process, so writers on several machines sharing a
+//! folder (shards filling one ground-truth cache) never write into each other's temporary file.
 
 use anyhow::Context;
 use std::io::Write;
@@ -12,8 +14,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let tmp = temporary(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -24,6 +25,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result.with_context(|| format!("writing {}", path.display()))
+}
+
+/// This host's and process's temporary file for `path`, beside it.
+fn temporary(path: &Path) -> std::path::PathBuf {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map_or_else(|| "host".to_string(), |h| h.trim().to_string());
+    path.with_file_name(format!(".{name}.{host}.{}.tmp", std::process::id()))
 }
 
 #[cfg(test)]
@@ -50,7 +61,7 @@ mod tests {
         let p = dir.path().join("x");
         write_atomic(&p, b"kept").unwrap();
         // A directory where the temporary file should go makes the write fail.
-        std::fs::create_dir(dir.path().join(format!(".x.{}.tmp", std::process::id()))).unwrap();
+        std::fs::create_dir(temporary(&p)).unwrap();
         assert!(write_atomic(&p, b"lost").is_err());
         assert_eq!(std::fs::read(&p).unwrap(), b"kept");
     }

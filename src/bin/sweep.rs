@@ -5,9 +5,11 @@ use clap::Parser;
 use penumbra::config::ConfigError;
 use penumbra::experiment::fps::{self, FpsSpec};
 use penumbra::experiment::sweep::filter::{self, Filter};
+use penumbra::experiment::sweep::merge::{merge_shards, MergeRefused};
 use penumbra::experiment::sweep::report::{write_all, Results};
 use penumbra::experiment::sweep::run::expand;
 use penumbra::experiment::sweep::runner::{dry_run, verdict_radius};
+use penumbra::experiment::sweep::shard::{self, run_shard, Shard};
 use penumbra::experiment::sweep::{pictures::render_pictures, run_sweep, Spec};
 use penumbra::experiment::Experiment;
 use penumbra::render::{open_backend, BackendChoice};
@@ -21,9 +23,15 @@ use tracing_subscriber::EnvFilter;
 /// Exit statuses, stated in `--help`.
 const AFTER_HELP: &str = "Exit status: 0 when every run rendered and the results are written; 2 for bad \
 input (the experiment or scene file, an OBJ, a command-line value), before any work; 3 when some runs \
-failed (their rows say why; the results are written); 1 for any other error (no GPU where one was \
-required, a device lost, a file that could not be written). Logging: -v and -q raise and lower the \
-level; RUST_LOG (e.g. RUST_LOG=penumbra=debug) overrides both.";
+failed (their rows say why; the results, or the shard, are written); 4 when --merge is refused (a shard \
+missing, unfinished, duplicated or from another sweep, build or device: the message lists the runs and \
+the shards to rerun; nothing is written); 1 for any other error (no GPU where one was required, a \
+device lost, a file that could not be written). Logging: -v and -q raise and lower the level; RUST_LOG \
+(e.g. RUST_LOG=penumbra=debug) overrides both.
+
+A sweep too big for one machine: run `--shard K/N` for K = 1..N (anywhere that shares the results \
+folder, or copy the shard folders and cache/ back), then `--merge RESULTS/shards/*-of-N` on the same \
+kind of device with the same binary; scripts/slurm/sweep.sbatch and scripts/parallel.sh do both.";
 
 /// Sweep sampling scheme x pattern x shadow-ray count x light radius x seed, measure every run
 /// against a ground truth checked against the exact answer, and write CSV, plots and a report.
@@ -45,6 +53,15 @@ struct Args {
     /// Print the expanded runs and the render plan, then exit without rendering.
     #[arg(long)]
     dry_run: bool,
+    /// Run only the K-th of N deterministic shares of the runs (balanced by expected rays) into
+    /// RESULTS/shards/K-of-N/, from which a killed shard resumes; no final outputs.
+    #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+    shard: Option<Shard>,
+    /// Merge finished shards into the results, checking that every run is present exactly once:
+    /// N merges RESULTS/shards/1-of-N .. N-of-N, or name shard folders; times the configurations
+    /// and draws the figures here.
+    #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
+    merge: Vec<PathBuf>,
     /// Subset filters; the help text names the axes from the axis list.
     #[arg(long, value_name = "AXIS=VALUE", help = filter::help())]
     filter: Vec<Filter>,
@@ -79,8 +96,10 @@ fn load<T>(load: impl FnOnce() -> Result<T, ConfigError>) -> anyhow::Result<T> {
 
 /// A frame-rate experiment (`kind = "fps"`): times configurations, no sweep.
 fn run_fps_experiment(args: &Args, spec: FpsSpec, started: Instant) -> anyhow::Result<()> {
-    if !args.filter.is_empty() {
-        return Err(BadInput("--filter applies to sweeps, not to frame-rate experiments".into()).into());
+    if !args.filter.is_empty() || args.shard.is_some() || !args.merge.is_empty() {
+        return Err(
+            BadInput("--filter, --shard and --merge apply to sweeps, not to frame-rate experiments".into()).into(),
+        );
     }
     if args.dry_run {
         print!("{}", fps::runner::dry_run(&spec)?);
@@ -110,11 +129,41 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
 }
 
-/// A sweep: renders and measures every run, then writes the results folder.
+/// The shard folders `--merge` names: N alone stands for every shard of an N-way split under
+/// the results folder `out`.
+fn shard_dirs(merge: &[PathBuf], out: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
+    let count = match merge {
+        [one] if !one.exists() => one.to_str().and_then(|s| s.parse::<u32>().ok()),
+        _ => None,
+    };
+    match count {
+        Some(0) => Err(BadInput("--merge N needs N >= 1".into()).into()),
+        Some(n) => Ok((1..=n).map(|index| Shard { index, count: n }.dir(out)).collect()),
+        None => Ok(merge.to_vec()),
+    }
+}
+
+/// How to rerun one shard of this sweep, for the merge's refusal.
+fn rerun_command(args: &Args) -> String {
+    let mut cmd = format!("sweep {}", args.experiment.display());
+    if let Some(out) = &args.out {
+        cmd += &format!(" --out {}", out.display());
+    }
+    for f in &args.filter {
+        cmd += &format!(" --filter {}={}", f.axis.name(), f.value);
+    }
+    cmd + " --shard"
+}
+
+/// A sweep: renders and measures every run (or a shard's share, or merges shards), then writes
+/// the results folder.
 fn run_sweep_experiment(args: &Args, spec: Spec, started: Instant) -> anyhow::Result<()> {
     let spec = spec.filtered(&args.filter).map_err(BadInput)?;
     if args.dry_run {
-        print!("{}", dry_run(&spec)?);
+        match args.shard {
+            Some(s) => print!("{}", shard::dry_run(&spec, s)),
+            None => print!("{}", dry_run(&spec)?),
+        }
         return Ok(());
     }
     let out = args.out.clone().unwrap_or_else(|| {
@@ -134,13 +183,35 @@ fn run_sweep_experiment(args: &Args, spec: Spec, started: Instant) -> anyhow::Re
         adapter.backend,
         adapter.api
     );
-    let outcome = run_sweep(
-        &spec,
-        backend.as_mut(),
-        &out.join(".journal"),
-        &out.join("cache"),
-        args.fresh,
-    )?;
+    if let Some(s) = args.shard {
+        let done = run_shard(&spec, backend.as_mut(), s, &out, args.fresh)?;
+        let m = &done.manifest;
+        info!(
+            "shard {s}: {} runs ({} failed, {} groups resumed) in {:.1} s; wrote {}",
+            m.runs,
+            m.failed,
+            m.resumed,
+            m.seconds,
+            done.dir.display()
+        );
+        if m.failed > 0 {
+            let records = done.dir.join(shard::RECORDS);
+            return Err(RunsFailed(m.failed, records.display().to_string()).into());
+        }
+        return Ok(());
+    }
+    let outcome = if args.merge.is_empty() {
+        run_sweep(
+            &spec,
+            backend.as_mut(),
+            &out.join(".journal"),
+            &out.join("cache"),
+            args.fresh,
+        )?
+    } else {
+        let dirs = shard_dirs(&args.merge, &out)?;
+        merge_shards(&spec, backend.as_mut(), &dirs, &out, &rerun_command(args))?
+    };
     info!("render plan of a run:\n{}", outcome.plan);
     let pictures =
         render_pictures(&spec, backend.as_mut(), verdict_radius(&spec)).context("rendering the figures' pictures")?;
@@ -205,6 +276,8 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             } else if e.is::<RunsFailed>() {
                 ExitCode::from(3)
+            } else if e.is::<MergeRefused>() {
+                ExitCode::from(4)
             } else {
                 ExitCode::from(1)
             }

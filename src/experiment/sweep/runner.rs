@@ -3,7 +3,7 @@
 //! where it stopped; then time every configuration in interleaved rounds (see [`super::timing`]).
 
 use super::axes::Config;
-use super::journal::Journal;
+use super::journal::{Figure, Journal};
 use super::measure::{failed_record, measure_run};
 use super::record::{FrameTime, Record, Status};
 use super::reference::Reference;
@@ -98,9 +98,14 @@ pub fn run_sweep(
     let context = context_key(spec, backend.adapter());
     let groups = expand(spec);
     let mut journal = Journal::open(journal_dir, fresh)?;
-    let fig_n = figure_samples(spec);
-    let bar = progress(groups.iter().map(|g| g.runs.len() as u64).sum());
-    let mut out = Outcome {
+    let mut out = render_groups(spec, backend, &groups, &mut journal, cache, &context)?;
+    time_phase(spec, backend, &groups, &mut out, &context, &mut journal)?;
+    Ok(out)
+}
+
+/// An outcome with nothing in it yet but the sweep's plan.
+pub(super) fn empty_outcome(spec: &Spec) -> anyhow::Result<Outcome> {
+    Ok(Outcome {
         records: Vec::new(),
         groups: Vec::new(),
         references: Vec::new(),
@@ -110,46 +115,56 @@ pub fn run_sweep(
         timings: Timings::default(),
         failures: 0,
         resumed: 0,
-    };
-    // Lights and radius nest outermost: each pair's reference is built once.
-    let mut pairs: Vec<(u32, f64)> = Vec::new();
-    for g in &groups {
-        let pair = (g.head().lights, g.head().light_radius);
-        if !pairs.contains(&pair) {
-            pairs.push(pair);
-        }
-    }
-    for (lights, radius) in pairs {
+    })
+}
+
+/// Renders and measures `groups` (all of a sweep, or a shard's share), taking completed groups
+/// from the journal; no timing. Records come in the order of `groups`.
+pub(super) fn render_groups(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    groups: &[Group],
+    journal: &mut Journal,
+    cache: &Path,
+    context: &str,
+) -> anyhow::Result<Outcome> {
+    let fig_n = figure_samples(spec);
+    let bar = progress(groups.iter().map(|g| g.runs.len() as u64).sum());
+    let mut out = empty_outcome(spec)?;
+    for ((lights, radius), share) in by_reference(groups) {
         bar.set_message(format!("runs; reference for {lights} light(s) of radius {radius} m"));
-        let reference = Reference::build(spec, backend, lights, radius, cache, &context)?;
+        let reference = Reference::build(spec, backend, lights, radius, cache, context)?;
         for warning in reference.warnings() {
             // `println` on a hidden bar (stderr not a terminal, as in CI logs) prints nothing.
             bar.suspend(|| tracing::warn!("{warning}"));
         }
-        for group in groups
-            .iter()
-            .filter(|g| g.head().light_radius == radius && g.head().lights == lights)
-        {
-            let head = group.head();
-            let needed_for_figures = head.samples == fig_n;
-            if !needed_for_figures {
-                if let Some((records, stats)) = journal.completed(group, &context) {
-                    out.records.extend(records);
-                    out.groups.push(stats);
-                    out.resumed += 1;
-                    bar.inc(group.runs.len() as u64);
-                    continue;
+        for group in share {
+            let group_key = group.key(context);
+            let figure = (group.head().samples == fig_n).then(|| journal.figure(&group_key));
+            if let (Some((records, stats)), None | Some(Some(_))) = (journal.completed(group, context), &figure) {
+                if let Some(Some(f)) = figure {
+                    keep_figure(&mut out, &reference, group.config(), f);
                 }
+                out.records.extend(records);
+                out.groups.push(stats);
+                out.resumed += 1;
+                bar.inc(group.runs.len() as u64);
+                continue;
             }
             bar.set_message(format!("runs; {}", group.config()));
-            let (records, stats, images) = run_group(spec, backend, group, &reference, &context, &bar);
-            if needed_for_figures {
-                keep_for_figures(&mut out, &reference, group.config(), &images);
+            let (records, stats, images) = run_group(spec, backend, group, &reference, context, &bar);
+            if figure.is_some() {
+                if let Some(f) = figure_of(&reference, &images) {
+                    journal.save_figure(&group_key, &f)?;
+                    keep_figure(&mut out, &reference, group.config(), f);
+                }
             }
             let failed = records.iter().filter(|r| r.status != Status::Ok).count();
             out.failures += failed;
             if failed == 0 {
-                journal.append(&group.key(&context), &records, &stats)?;
+                journal.append(&group_key, &records, &stats)?;
+                #[cfg(feature = "test-hooks")]
+                die_after_journaled_groups();
             }
             out.records.extend(records);
             out.groups.push(stats);
@@ -157,11 +172,54 @@ pub fn run_sweep(
         out.references.push(reference);
     }
     bar.finish_and_clear();
-    if spec.timing.repeats > 0 {
-        out.timings = time_sweep(spec, backend, &groups, &out, &context, &mut journal)?;
-        fill_timing_columns(&mut out, &groups, &context);
-    }
     Ok(out)
+}
+
+/// Test hook: with `PENUMBRA_TEST_DIE_AFTER_GROUPS=n` set, the process aborts (no cleanup, as
+/// when a node kills a job) right after its n-th journaled group, so tests interrupt a sweep at a
+/// known point.
+#[cfg(feature = "test-hooks")]
+fn die_after_journaled_groups() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static JOURNALED: AtomicUsize = AtomicUsize::new(0);
+    let n = JOURNALED.fetch_add(1, Ordering::SeqCst) + 1;
+    let limit = std::env::var("PENUMBRA_TEST_DIE_AFTER_GROUPS")
+        .ok()
+        .and_then(|v| v.parse().ok());
+    if limit == Some(n) {
+        std::process::abort();
+    }
+}
+
+/// `groups` by the reference they are judged against, (lights on, light radius) pairs in order
+/// of first appearance: the order runs are rendered in and records listed.
+pub(super) fn by_reference(groups: &[Group]) -> Vec<((u32, f64), Vec<&Group>)> {
+    let mut pairs: Vec<((u32, f64), Vec<&Group>)> = Vec::new();
+    for g in groups {
+        let pair = (g.head().lights, g.head().light_radius);
+        match pairs.iter_mut().find(|(p, _)| *p == pair) {
+            Some((_, share)) => share.push(g),
+            None => pairs.push((pair, vec![g])),
+        }
+    }
+    pairs
+}
+
+/// The timing phase over every group of the sweep that rendered, when the experiment times
+/// anything; fills the records' timing columns.
+pub(super) fn time_phase(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    groups: &[Group],
+    out: &mut Outcome,
+    context: &str,
+    journal: &mut Journal,
+) -> anyhow::Result<()> {
+    if spec.timing.repeats > 0 {
+        out.timings = time_sweep(spec, backend, groups, out, context, journal)?;
+        fill_timing_columns(out, groups, context);
+    }
+    Ok(())
 }
 
 /// The timing phase: every configuration whose runs all rendered, and the noise probe, timed in
@@ -274,14 +332,27 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
     }
 }
 
-fn keep_for_figures(out: &mut Outcome, reference: &Reference, config: Config, images: &[Vec<f32>]) {
-    let Some(first) = images.first() else { return };
-    out.keep.push((config.clone(), first.clone()));
-    if reference.on_axis.is_none() {
-        return;
+/// What the figures keep of a group's images (none when every seed failed).
+fn figure_of(reference: &Reference, images: &[Vec<f32>]) -> Option<Figure> {
+    let first = images.first()?;
+    let profile_means = reference
+        .on_axis
+        .is_some()
+        .then(|| RadialProfile::mean_over(&reference.receivers, images).mean);
+    Some(Figure {
+        image: first.clone(),
+        profile_means,
+    })
+}
+
+/// Adds a group's figure to the outcome: its image, and its profile on on-axis scenes.
+pub(super) fn keep_figure(out: &mut Outcome, reference: &Reference, config: Config, figure: Figure) {
+    if let Some(means) = figure.profile_means {
+        let mut profile = RadialProfile::new(&reference.receivers, &figure.image);
+        profile.mean = means;
+        out.profiles.push((config.clone(), profile));
     }
-    out.profiles
-        .push((config, RadialProfile::mean_over(&reference.receivers, images)));
+    out.keep.push((config, figure.image));
 }
 
 /// Renders and measures every seed of a group; a failed render becomes a failed record and the

@@ -1,0 +1,252 @@
+//! A sweep split across machines: `--shard K/N` runs the K-th of N deterministic shares of the
+//! runs into its own folder (`shards/K-of-N/` under the results folder), never the final
+//! outputs; [`super::merge`] puts the shares back together.
+//!
+//! The unit of a share is a group (a configuration with all its seeds): its per-pixel
+//! bias/variance split needs every seed's image in one process. Groups are dealt by expected
+//! cost, the rays their frames trace, longest first onto the share that would finish earliest
+//! (LPT scheduling), where a share that does not yet hold a group's (lights, radius) pair is also
+//! charged that pair's ground-truth render: groups sharing a ground truth stay together exactly
+//! where that finishes sooner than spreading them. The deal depends on the experiment alone
+//! (axes and their key texts), not on the machine, so every shard and the merge compute it alike.
+//!
+//! The ground-truth cache (`cache/` under the results folder) is shared by the shards and the
+//! merge. A shard that finds no cached ground truth renders it (deterministically: same seed,
+//! same device, same bytes) and writes it atomically under a name unique to its host and
+//! process, so two shards racing for one entry both end with a whole, identical file; a cache
+//! entry is only ever read whole. Shards on machines without a shared file system each fill
+//! their own copy; the entries have the same names and contents, so copying them together is
+//! safe.
+
+use super::journal::{GroupRow, Journal};
+use super::record::{Record, Status};
+use super::run::{context_key, expand, Group};
+use super::runner;
+use super::runner::render_groups;
+use super::spec::Spec;
+use crate::fingerprint::fnv1a;
+use crate::output::table::write_rows;
+use crate::render::{Backend, RenderPlan, View};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// A finished shard's manifest, written last.
+pub const MANIFEST: &str = "shard.toml";
+/// A finished shard's records, every run of its share (failed ones included).
+pub const RECORDS: &str = "records.csv";
+/// A finished shard's bias/variance splits, one per group of its share.
+pub const GROUPS: &str = "groups.csv";
+
+/// The K-th of N shares of a sweep (1 <= K <= N), as `--shard K/N` and Slurm's array index give it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Shard {
+    /// K, from 1.
+    pub index: u32,
+    /// N.
+    pub count: u32,
+}
+
+impl FromStr for Shard {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let bad = || format!("expected K/N with 1 <= K <= N (e.g. 2/8), got `{s}`");
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (k.trim().parse::<u32>(), n.trim().parse::<u32>());
+        match (index, count) {
+            (Ok(index), Ok(count)) if (1..=count).contains(&index) => Ok(Shard { index, count }),
+            _ => Err(bad()),
+        }
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl Shard {
+    /// The shard's folder under a results folder: `shards/K-of-N`.
+    pub fn dir(&self, results: &Path) -> PathBuf {
+        results.join("shards").join(format!("{}-of-{}", self.index, self.count))
+    }
+}
+
+/// Rays one frame of `lights` lights at `samples` rays each traces at most: the unit of
+/// expected cost.
+fn frame_rays(spec: &Spec, lights: u32, samples: u32) -> f64 {
+    let scene = spec.scene_with(lights, spec.axes.light_radii[0], samples, &spec.axes.accelerators[0]);
+    let view = View {
+        camera: &scene.cameras[&spec.measure.camera],
+        width: spec.measure.width,
+        height: spec.measure.height,
+    };
+    RenderPlan::new(&scene, view).map_or(0.0, |p| p.max_rays() as f64)
+}
+
+/// The share (0-based) each group of `groups` (a sweep's canonical expansion) falls to among
+/// `count` shares; see the module documentation.
+pub fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
+    let cost: Vec<f64> = groups
+        .iter()
+        .map(|g| g.runs.len() as f64 * frame_rays(spec, g.head().lights, g.head().samples))
+        .collect();
+    let pair = |g: &Group| (g.head().lights, g.head().light_radius.to_bits());
+    let mut order: Vec<usize> = (0..groups.len()).collect();
+    order.sort_by(|&a, &b| {
+        cost[b]
+            .total_cmp(&cost[a])
+            .then_with(|| groups[a].head().key_text().cmp(&groups[b].head().key_text()))
+    });
+    let mut load = vec![0.0f64; count as usize];
+    let mut holds: Vec<Vec<(u32, u64)>> = vec![Vec::new(); count as usize];
+    let mut share = vec![0u32; groups.len()];
+    for i in order {
+        let p = pair(&groups[i]);
+        let reference = frame_rays(spec, p.0, spec.ground_truth.samples);
+        let finish = |s: usize| load[s] + cost[i] + if holds[s].contains(&p) { 0.0 } else { reference };
+        let best = (0..count as usize)
+            .min_by(|&a, &b| finish(a).total_cmp(&finish(b)))
+            .expect("at least one share");
+        load[best] = finish(best);
+        if !holds[best].contains(&p) {
+            holds[best].push(p);
+        }
+        share[i] = best as u32;
+    }
+    share
+}
+
+/// The groups of the sweep that fall to `shard`, in canonical order.
+pub fn share(spec: &Spec, shard: Shard) -> Vec<Group> {
+    let groups = expand(spec);
+    let shares = assign(spec, &groups, shard.count);
+    groups
+        .into_iter()
+        .zip(shares)
+        .filter(|(_, s)| *s == shard.index - 1)
+        .map(|(g, _)| g)
+        .collect()
+}
+
+/// What a finished shard writes last (`shard.toml`): the merge takes a shard only with it, and
+/// only if it ran the same sweep under the same context.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ShardManifest {
+    /// `K/N`.
+    pub shard: String,
+    /// The experiment file it ran (for people; [`Self::sweep`] is what is compared).
+    pub experiment: String,
+    /// Hash of every run key of the whole (filtered) sweep and the figures' ray count.
+    pub sweep: String,
+    /// The run keys' context ([`context_key`]): inputs, device and build.
+    pub context: String,
+    /// Runs in the share.
+    pub runs: usize,
+    /// Runs that failed (their rows say why).
+    pub failed: usize,
+    /// Groups taken from the shard's journal rather than rendered.
+    pub resumed: usize,
+    /// Seconds the shard ran.
+    pub seconds: f64,
+}
+
+/// Identity of a sweep's work: every run key (so the axes, seeds and context) and the figures'
+/// ray count (which groups keep figures).
+pub fn sweep_identity(spec: &Spec, context: &str) -> String {
+    let keys: Vec<String> = expand(spec)
+        .iter()
+        .flat_map(|g| g.runs.iter().map(|r| r.key(context)))
+        .collect();
+    let text = format!("{};figures={}", keys.join(","), runner::figure_samples(spec));
+    format!("{:016x}", fnv1a(text.as_bytes()))
+}
+
+/// What a shard hands back.
+pub struct ShardOutcome {
+    /// The shard's manifest, as written.
+    pub manifest: ShardManifest,
+    /// Where it was written.
+    pub dir: PathBuf,
+}
+
+/// Runs `shard`'s share of the sweep into `shard.dir(results)`: its journal (`.journal/`, from
+/// which a killed shard resumes), then `records.csv`, `groups.csv` and, last, `shard.toml`.
+/// The ground-truth cache is `results/cache`. No final output is written.
+pub fn run_shard(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    shard: Shard,
+    results: &Path,
+    fresh: bool,
+) -> anyhow::Result<ShardOutcome> {
+    let started = std::time::Instant::now();
+    let dir = shard.dir(results);
+    let manifest_path = dir.join(MANIFEST);
+    // A manifest left by an earlier run would vouch for files this run is about to replace.
+    if manifest_path.exists() {
+        std::fs::remove_file(&manifest_path)?;
+    }
+    let context = context_key(spec, backend.adapter());
+    let groups = share(spec, shard);
+    let mut journal = Journal::open(&dir.join(".journal"), fresh)?;
+    let out = render_groups(spec, backend, &groups, &mut journal, &results.join("cache"), &context)?;
+    write_rows(&dir.join(RECORDS), &out.records)?;
+    let rows = out.groups.iter().map(|stats| {
+        let group = groups
+            .iter()
+            .find(|g| g.head().key(&context) == stats.key)
+            .expect("a split per group");
+        GroupRow::new(&group.key(&context), &stats.split)
+    });
+    write_rows(&dir.join(GROUPS), rows)?;
+    let manifest = ShardManifest {
+        shard: shard.to_string(),
+        experiment: spec.path.display().to_string(),
+        sweep: sweep_identity(spec, &context),
+        context,
+        runs: out.records.len(),
+        failed: out.records.iter().filter(|r: &&Record| r.status != Status::Ok).count(),
+        resumed: out.resumed,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    crate::files::write_atomic(&manifest_path, toml::to_string(&manifest)?.as_bytes())?;
+    Ok(ShardOutcome { manifest, dir })
+}
+
+/// What `--dry-run --shard K/N` prints: the share's configurations and its expected rays.
+pub fn dry_run(spec: &Spec, shard: Shard) -> String {
+    let groups = expand(spec);
+    let shares = assign(spec, &groups, shard.count);
+    let mut rays = vec![0.0; shard.count as usize];
+    for (g, &s) in groups.iter().zip(&shares) {
+        rays[s as usize] += g.runs.len() as f64 * frame_rays(spec, g.head().lights, g.head().samples);
+    }
+    let mine: Vec<&Group> = groups
+        .iter()
+        .zip(&shares)
+        .filter(|(_, &s)| s == shard.index - 1)
+        .map(|(g, _)| g)
+        .collect();
+    let runs: usize = mine.iter().map(|g| g.runs.len()).sum();
+    let total: f64 = rays.iter().sum();
+    let mut out = format!(
+        "{}: shard {shard}: {runs} runs in {} configurations, {:.1} % of the sweep's rays \
+         (shares: {}; ground truths aside)\n",
+        spec.name,
+        mine.len(),
+        100.0 * rays[shard.index as usize - 1] / total.max(1.0),
+        rays.iter()
+            .map(|r| format!("{:.1} %", 100.0 * r / total.max(1.0)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for g in mine {
+        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
+        out += &format!("  {} seeds=[{}]\n", g.config(), seeds.join(", "));
+    }
+    out
+}
