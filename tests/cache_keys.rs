@@ -70,9 +70,9 @@ fn experiment_dir() -> tempfile::TempDir {
 fn editing_an_obj_invalidates_the_journal_and_the_ground_truth_cache() {
     let dir = experiment_dir();
     let d = dir.path();
-    // The group at the figure ray count (16) is always re-rendered; the one at 4 resumes.
+    // Both groups resume, the one at the figures' ray count (16) with its journaled figure.
     assert_eq!(resumed(d, "cpu"), 0);
-    assert_eq!(resumed(d, "cpu"), 1);
+    assert_eq!(resumed(d, "cpu"), 2);
     assert_eq!(cached_ground_truths(d), 1);
     // Same scene file, same OBJ name, different geometry.
     std::fs::write(d.join("square.obj"), square(0.6)).unwrap();
@@ -82,7 +82,7 @@ fn editing_an_obj_invalidates_the_journal_and_the_ground_truth_cache() {
         2,
         "an edited OBJ must not reuse the cached ground truth"
     );
-    assert_eq!(resumed(d, "cpu"), 1);
+    assert_eq!(resumed(d, "cpu"), 2);
 }
 
 #[test]
@@ -97,8 +97,8 @@ fn one_backend_never_resumes_another_backends_rows() {
     let runs = std::fs::read_to_string(d.join("out/runs.csv")).unwrap();
     assert!(runs.lines().skip(1).all(|l| l.contains(",cpu,")), "{runs}");
     // Both backends' rows stay journaled side by side.
-    assert_eq!(resumed(d, "gpu"), 1);
-    assert_eq!(resumed(d, "cpu"), 1);
+    assert_eq!(resumed(d, "gpu"), 2);
+    assert_eq!(resumed(d, "cpu"), 2);
 }
 
 /// Another seed list gives another bias/variance split: a group journaled with seeds [1, 2] is
@@ -117,7 +117,7 @@ fn another_seed_list_renders_the_group_again() {
     for row in rows.records() {
         assert_eq!(&row.unwrap()[seeds], "3");
     }
-    assert_eq!(resumed(d, "cpu"), 1);
+    assert_eq!(resumed(d, "cpu"), 2);
     std::fs::write(d.join("keys.toml"), EXPERIMENT).unwrap();
-    assert_eq!(resumed(d, "cpu"), 1, "both seed lists stay journaled");
+    assert_eq!(resumed(d, "cpu"), 2, "both seed lists stay journaled");
 }
