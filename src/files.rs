@@ -1,6 +1,6 @@
 //! Writing results without ever leaving a half-written file: write a temporary file beside the
 //! target, flush it to disk, then rename it over the target (atomic on POSIX file systems). The
-//! temporary file is named after the host and process, so writers on several machines sharing a
+//! temporary file is named after the host, process and its start, so writers on several machines sharing a
 //! folder (shards filling one ground-truth cache) never write into each other's temporary file.
 
 use anyhow::Context;
@@ -34,7 +34,14 @@ fn temporary(path: &Path) -> std::path::PathBuf {
         .ok()
         .or_else(|| std::env::var("HOSTNAME").ok())
         .map_or_else(|| "host".to_string(), |h| h.trim().to_string());
-    path.with_file_name(format!(".{name}.{host}.{}.tmp", std::process::id()))
+    // The process's start time tells apart processes of one host name and id (containers).
+    static STARTED: std::sync::OnceLock<u128> = std::sync::OnceLock::new();
+    let started = STARTED.get_or_init(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos())
+    });
+    path.with_file_name(format!(".{name}.{host}.{}.{started:x}.tmp", std::process::id()))
 }
 
 #[cfg(test)]

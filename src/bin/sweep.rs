@@ -1,11 +1,11 @@
 //! `sweep EXPERIMENT.toml`: runs an experiment's sweep and writes its results folder.
 
 use anyhow::Context;
-use clap::Parser;
+use clap::{Parser, ValueEnum};
 use penumbra::config::ConfigError;
 use penumbra::experiment::fps::{self, FpsSpec};
 use penumbra::experiment::sweep::filter::{self, Filter};
-use penumbra::experiment::sweep::merge::{merge_shards, MergeRefused};
+use penumbra::experiment::sweep::merge::{merge_shards, MergePlan, MergeRefused};
 use penumbra::experiment::sweep::report::{write_all, Results};
 use penumbra::experiment::sweep::run::expand;
 use penumbra::experiment::sweep::runner::{dry_run, verdict_radius};
@@ -129,30 +129,48 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
 }
 
-/// The shard folders `--merge` names: N alone stands for every shard of an N-way split under
-/// the results folder `out`.
-fn shard_dirs(merge: &[PathBuf], out: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
+/// The shard folders `--merge` names, and N where it was given: a number alone stands for
+/// every shard of an N-way split under the results folder `out`.
+fn shard_dirs(merge: &[PathBuf], out: &std::path::Path) -> anyhow::Result<(Vec<PathBuf>, Option<u32>)> {
     let count = match merge {
-        [one] if !one.exists() => one.to_str().and_then(|s| s.parse::<u32>().ok()),
+        [one] => one.to_str().and_then(|s| s.parse::<u32>().ok()),
         _ => None,
     };
     match count {
         Some(0) => Err(BadInput("--merge N needs N >= 1".into()).into()),
-        Some(n) => Ok((1..=n).map(|index| Shard { index, count: n }.dir(out)).collect()),
-        None => Ok(merge.to_vec()),
+        Some(n) => Ok((
+            (1..=n).map(|index| Shard { index, count: n }.dir(out)).collect(),
+            Some(n),
+        )),
+        None => Ok((merge.to_vec(), None)),
+    }
+}
+
+/// `text` as one shell word.
+fn shell_word(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-=,:+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
     }
 }
 
 /// How to rerun one shard of this sweep, for the merge's refusal.
 fn rerun_command(args: &Args) -> String {
-    let mut cmd = format!("sweep {}", args.experiment.display());
+    let mut words = vec!["sweep".to_string(), args.experiment.display().to_string()];
     if let Some(out) = &args.out {
-        cmd += &format!(" --out {}", out.display());
+        words.extend(["--out".into(), out.display().to_string()]);
+    }
+    if let Some(b) = args.backend {
+        let name = b.to_possible_value().expect("a named value").get_name().to_string();
+        words.extend(["--backend".into(), name]);
     }
     for f in &args.filter {
-        cmd += &format!(" --filter {}={}", f.axis.name(), f.value);
+        words.extend(["--filter".into(), format!("{}={}", f.axis.name(), f.value)]);
     }
-    cmd + " --shard"
+    words.push("--shard".into());
+    words.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" ")
 }
 
 /// A sweep: renders and measures every run (or a shard's share, or merges shards), then writes
@@ -209,8 +227,14 @@ fn run_sweep_experiment(args: &Args, spec: Spec, started: Instant) -> anyhow::Re
             args.fresh,
         )?
     } else {
-        let dirs = shard_dirs(&args.merge, &out)?;
-        merge_shards(&spec, backend.as_mut(), &dirs, &out, &rerun_command(args))?
+        let (dirs, split) = shard_dirs(&args.merge, &out)?;
+        let plan = MergePlan {
+            dirs: &dirs,
+            split,
+            rerun: &rerun_command(args),
+            fresh: args.fresh,
+        };
+        merge_shards(&spec, backend.as_mut(), &plan, &out)?
     };
     info!("render plan of a run:\n{}", outcome.plan);
     let pictures =

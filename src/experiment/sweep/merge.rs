@@ -12,6 +12,7 @@ use super::run::{context_key, expand, GroupStats};
 use super::runner::{by_reference, empty_outcome, figure_samples, keep_figure, time_phase, Outcome};
 use super::shard::{assign, sweep_identity, Shard, ShardManifest, GROUPS, MANIFEST, RECORDS};
 use super::spec::Spec;
+use crate::fingerprint::fnv1a;
 use crate::output::table::read_rows;
 use crate::render::Backend;
 use std::collections::HashMap;
@@ -84,6 +85,17 @@ fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<ShardFiles, S
             manifest.experiment
         ));
     }
+    for (file, want) in [(RECORDS, &manifest.records_fnv1a), (GROUPS, &manifest.groups_fnv1a)] {
+        let got = std::fs::read(dir.join(file))
+            .ok()
+            .map(|b| format!("{:016x}", fnv1a(&b)));
+        if got.as_ref() != Some(want) {
+            return Err(format!(
+                "{}: {file} is not the file shard {shard} wrote (missing or changed since)",
+                dir.display()
+            ));
+        }
+    }
     let records: Vec<Record> = read_rows(&dir.join(RECORDS));
     let groups: HashMap<String, GroupRow> = read_rows::<GroupRow>(&dir.join(GROUPS))
         .into_iter()
@@ -120,16 +132,34 @@ fn list_runs(out: &mut String, runs: &[String]) {
     }
 }
 
-/// Merges the finished shards in `dirs` into the outcome of the whole sweep; `results` is the
+/// What to merge: the shard folders, and the split they are expected to form.
+pub struct MergePlan<'a> {
+    /// Shard folders (`RESULTS/shards/K-of-N`).
+    pub dirs: &'a [PathBuf],
+    /// N, where the caller knows it (`--merge N`); otherwise read from the shards' manifests,
+    /// or their folder names.
+    pub split: Option<u32>,
+    /// How a shard is rerun, for the refusal's message (e.g. `sweep EXP --shard`).
+    pub rerun: &'a str,
+    /// Discard the merge's own timing journal first.
+    pub fresh: bool,
+}
+
+/// N of a folder named `K-of-N`.
+fn split_of_name(dir: &Path) -> Option<u32> {
+    let name = dir.file_name()?.to_str()?;
+    name.split_once("-of-")?.1.parse().ok()
+}
+
+/// Merges the finished shards of `plan` into the outcome of the whole sweep; `results` is the
 /// results folder (its `cache/` holds the ground truths, its `.journal/` the merge's timing).
-/// `rerun` is how a shard is rerun, for the refusal's message (e.g. `sweep EXP --shard`).
 pub fn merge_shards(
     spec: &Spec,
     backend: &mut dyn Backend,
-    dirs: &[PathBuf],
+    plan: &MergePlan,
     results: &Path,
-    rerun: &str,
 ) -> anyhow::Result<Outcome> {
+    let (dirs, rerun) = (plan.dirs, plan.rerun);
     let context = context_key(spec, backend.adapter());
     let identity = sweep_identity(spec, &context);
     let mut problems = String::new();
@@ -143,14 +173,22 @@ pub fn merge_shards(
         }
     }
     let counts: Vec<u32> = shards.iter().map(|s| s.shard.count).collect();
-    if counts.iter().any(|&n| n != counts[0]) {
+    let count = plan
+        .split
+        .or(counts.first().copied())
+        .or_else(|| dirs.iter().find_map(|d| split_of_name(d)))
+        .unwrap_or(1);
+    if counts.iter().any(|&n| n != count) {
         let listed: Vec<String> = shards
             .iter()
             .map(|s| format!("{} ({})", s.shard, s.dir.display()))
             .collect();
-        let _ = writeln!(problems, "shards of different splits: {}", listed.join(", "));
+        let _ = writeln!(
+            problems,
+            "shards of different splits (merging {count}): {}",
+            listed.join(", ")
+        );
     }
-    let count = counts.first().copied().unwrap_or(1);
     let groups = expand(spec);
     let owner = assign(spec, &groups, count);
 
@@ -226,9 +264,13 @@ pub fn merge_shards(
             let shard = Shard { index: own + 1, count };
             let lines: Vec<String> = missing[own].iter().map(|(_, l)| l.clone()).collect();
             let runs: usize = missing[own].iter().map(|(n, _)| n).sum();
+            let what = match missing[own].iter().filter(|(n, _)| *n == 0).count() {
+                0 => format!("{runs} runs missing"),
+                f => format!("{runs} runs and {f} group files (`.journal/figures`, {GROUPS}) missing"),
+            };
             let _ = writeln!(
                 problems,
-                "shard {shard} is incomplete ({runs} runs missing); rerun it: {rerun} {shard}"
+                "shard {shard} is incomplete ({what}); rerun it: {rerun} {shard}"
             );
             list_runs(&mut problems, &lines);
         }
@@ -263,7 +305,7 @@ pub fn merge_shards(
         }
         out.references.push(reference);
     }
-    let mut journal = Journal::open(&results.join(".journal"), false)?;
+    let mut journal = Journal::open(&results.join(".journal"), plan.fresh)?;
     time_phase(spec, backend, &groups, &mut out, &context, &mut journal)?;
     Ok(out)
 }

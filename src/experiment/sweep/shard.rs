@@ -90,6 +90,11 @@ fn frame_rays(spec: &Spec, lights: u32, samples: u32) -> f64 {
 /// The share (0-based) each group of `groups` (a sweep's canonical expansion) falls to among
 /// `count` shares; see the module documentation.
 pub fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
+    deal(spec, groups, count).0
+}
+
+/// [`assign`]'s shares, and each share's expected rays (ground truths it renders included).
+pub fn deal(spec: &Spec, groups: &[Group], count: u32) -> (Vec<u32>, Vec<f64>) {
     let cost: Vec<f64> = groups
         .iter()
         .map(|g| g.runs.len() as f64 * frame_rays(spec, g.head().lights, g.head().samples))
@@ -117,7 +122,7 @@ pub fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
         }
         share[i] = best as u32;
     }
-    share
+    (share, load)
 }
 
 /// The groups of the sweep that fall to `shard`, in canonical order.
@@ -150,6 +155,10 @@ pub struct ShardManifest {
     pub failed: usize,
     /// Groups taken from the shard's journal rather than rendered.
     pub resumed: usize,
+    /// FNV-1a of [`RECORDS`] as written: the merge takes no file changed since.
+    pub records_fnv1a: String,
+    /// FNV-1a of [`GROUPS`] as written.
+    pub groups_fnv1a: String,
     /// Seconds the shard ran.
     pub seconds: f64,
 }
@@ -194,6 +203,8 @@ pub fn run_shard(
     let groups = share(spec, shard);
     let mut journal = Journal::open(&dir.join(".journal"), fresh)?;
     let out = render_groups(spec, backend, &groups, &mut journal, &results.join("cache"), &context)?;
+    let hash =
+        |file: &str| -> anyhow::Result<String> { Ok(format!("{:016x}", fnv1a(&std::fs::read(dir.join(file))?))) };
     write_rows(&dir.join(RECORDS), &out.records)?;
     let rows = out.groups.iter().map(|stats| {
         let group = groups
@@ -211,6 +222,8 @@ pub fn run_shard(
         runs: out.records.len(),
         failed: out.records.iter().filter(|r: &&Record| r.status != Status::Ok).count(),
         resumed: out.resumed,
+        records_fnv1a: hash(RECORDS)?,
+        groups_fnv1a: hash(GROUPS)?,
         seconds: started.elapsed().as_secs_f64(),
     };
     crate::files::write_atomic(&manifest_path, toml::to_string(&manifest)?.as_bytes())?;
@@ -220,11 +233,7 @@ pub fn run_shard(
 /// What `--dry-run --shard K/N` prints: the share's configurations and its expected rays.
 pub fn dry_run(spec: &Spec, shard: Shard) -> String {
     let groups = expand(spec);
-    let shares = assign(spec, &groups, shard.count);
-    let mut rays = vec![0.0; shard.count as usize];
-    for (g, &s) in groups.iter().zip(&shares) {
-        rays[s as usize] += g.runs.len() as f64 * frame_rays(spec, g.head().lights, g.head().samples);
-    }
+    let (shares, rays) = deal(spec, &groups, shard.count);
     let mine: Vec<&Group> = groups
         .iter()
         .zip(&shares)
@@ -234,8 +243,8 @@ pub fn dry_run(spec: &Spec, shard: Shard) -> String {
     let runs: usize = mine.iter().map(|g| g.runs.len()).sum();
     let total: f64 = rays.iter().sum();
     let mut out = format!(
-        "{}: shard {shard}: {runs} runs in {} configurations, {:.1} % of the sweep's rays \
-         (shares: {}; ground truths aside)\n",
+        "{}: shard {shard}: {runs} runs in {} configurations, {:.1} % of the rays the shards \
+         trace, ground truths included (shares: {})\n",
         spec.name,
         mine.len(),
         100.0 * rays[shard.index as usize - 1] / total.max(1.0),
