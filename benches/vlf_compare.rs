@@ -7,7 +7,11 @@
 //!   exact-test queries;
 //! - `bvh2-obvhs`: the same BVH2 traversed by obvhs itself with its f32 triangle test;
 //! - `cwbvh-obvhs`: obvhs' CWBVH (`very_slow_build`) traversed by obvhs with its f32 test (the
-//!   known-facts figure: about 5.2 Mrays/s single-thread on the cow for 513-direction AO).
+//!   known-facts figure: about 5.2 Mrays/s single-thread on the cow for 513-direction AO);
+//! - `kdtree`: the paper's baseline, a CRT-like kd-tree (`accel::kdtree`: spatial-median
+//!   splits, explicit-stack front-to-back walk, f64 exact tests) at its default depth and leaf
+//!   size; `-- --tune-kdtree` times it on `ao-grid` over a grid of depths and leaf sizes, as the
+//!   paper tuned its CRT.
 //!
 //! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
 //! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
@@ -39,6 +43,7 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::BvhBuildParams;
+use penumbra::accel::kdtree::{KdSettings, KdTree};
 use penumbra::accel::vlf::{VisibilityField, VlfSettings};
 use penumbra::accel::{Bvh, Preset};
 use penumbra::mesh::Triangles;
@@ -51,7 +56,7 @@ use std::time::{Duration, Instant};
 type Q = (DVec3, DVec3, f64, u32);
 
 const KINDS: [&str; 5] = ["ao-grid", "ao-grid-by-direction", "ao-random", "shadow", "camera"];
-const STRUCTURES: [&str; 4] = ["vlf", "bvh", "bvh2-obvhs", "cwbvh-obvhs"];
+const STRUCTURES: [&str; 5] = ["vlf", "bvh", "bvh2-obvhs", "cwbvh-obvhs", "kdtree"];
 const POINTS: u32 = 64;
 
 struct Mesh {
@@ -60,6 +65,7 @@ struct Mesh {
     bvh: Bvh,
     cw: CwBvh,
     cw_time: Duration,
+    kd: KdTree,
 }
 
 fn repo(p: &str) -> std::path::PathBuf {
@@ -98,12 +104,15 @@ fn build(name: &'static str) -> Mesh {
     let start = Instant::now();
     let mut core = Duration::ZERO;
     let cw = build_cwbvh_from_tris(&bvh.local, BvhBuildParams::very_slow_build(), &mut core);
+    let cw_time = start.elapsed();
+    let kd = KdTree::build(&tris, KdSettings::default());
     Mesh {
         tris,
         vlf,
         bvh,
         cw,
-        cw_time: start.elapsed(),
+        cw_time,
+        kd,
     }
 }
 
@@ -196,6 +205,8 @@ fn trace(m: &Mesh, s: usize, closest: bool, &(o, d, tmax, skip): &Q) -> bool {
         0 => m.vlf.any_hit(o, d, tmax, skip),
         1 if closest => m.bvh.closest(o, d, tmax, skip).is_some(),
         1 => m.bvh.any_hit(o, d, tmax, skip),
+        4 if closest => penumbra::accel::Accelerator::closest(&m.kd, o, d, tmax, skip).is_some(),
+        4 => penumbra::accel::Accelerator::any_hit(&m.kd, o, d, tmax, skip),
         _ => {
             let ray = Ray::new(
                 Vec3A::from((o - m.bvh.centre).as_vec3()),
@@ -240,10 +251,10 @@ fn run(m: &Mesh, s: usize, closest: bool, rays: &[Q], parallel: bool) -> usize {
 }
 
 /// Structure bytes (no triangles) of each structure.
-fn bytes(m: &Mesh) -> [usize; 4] {
+fn bytes(m: &Mesh) -> [usize; 5] {
     let bvh2 = std::mem::size_of_val(m.bvh.tree.nodes.as_slice()) + 4 * m.bvh.tree.primitive_indices.len();
     let cw = std::mem::size_of_val(m.cw.nodes.as_slice()) + 4 * m.cw.primitive_indices.len();
-    [m.vlf.bytes(), bvh2, bvh2, cw]
+    [m.vlf.bytes(), bvh2, bvh2, cw, m.kd.bytes()]
 }
 
 const MESHES: [&str; 4] = ["cow", "bull", "man", "body"];
@@ -273,12 +284,13 @@ fn table() {
             m.bvh.total_time.as_secs_f64(),
             m.bvh.total_time.as_secs_f64(),
             m.cw_time.as_secs_f64(),
+            penumbra::accel::Accelerator::stats(&m.kd).build_time.as_secs_f64(),
         ];
         let n = m.tris.positions.len();
         for kind in KINDS {
             let rays = rays(&m, kind);
             let closest = kind == "camera";
-            for s in 0..4 {
+            for s in 0..STRUCTURES.len() {
                 let mut rates = [0.0; 2];
                 let mut hits = 0;
                 for (p, rate) in rates.iter_mut().enumerate() {
@@ -415,7 +427,51 @@ fn criterion_benches(c: &mut Criterion) {
     g.finish();
 }
 
+/// The kd-tree on `ao-grid` rays over depths and leaf sizes (`--tune-kdtree`), one thread, as the
+/// paper tuned its CRT baseline: median of 5 runs each, with memory and build time.
+fn tune_kdtree() {
+    println!(
+        "kd-tree on ao-grid any-hit rays, one thread, median of 5 runs of {} rays",
+        POINTS * 513
+    );
+    println!();
+    println!("| mesh | depth | leaf | build ms | MB | Mrays/s |");
+    println!("|---|---|---|---|---|---|");
+    for name in MESHES {
+        let mut m = build(name);
+        let rays = rays(&m, "ao-grid");
+        let mut best = (0.0, 0, 0);
+        for max_depth in [16, 18, 20, 22, 24, 26, 28, 30] {
+            for leaf_size in [2, 4, 8, 16, 32] {
+                m.kd = KdTree::build(&m.tris, KdSettings { max_depth, leaf_size });
+                let times: Vec<f64> = (0..5)
+                    .map(|_| {
+                        let t = Instant::now();
+                        std::hint::black_box(run(&m, 4, false, &rays, false));
+                        t.elapsed().as_secs_f64()
+                    })
+                    .collect();
+                let rate = rays.len() as f64 / median(times) / 1e6;
+                let stats = penumbra::accel::Accelerator::stats(&m.kd);
+                println!(
+                    "| {name} | {max_depth} | {leaf_size} | {:.0} | {:.1} | {rate:.2} |",
+                    stats.build_time.as_secs_f64() * 1e3,
+                    m.kd.bytes() as f64 / 1e6
+                );
+                if rate > best.0 {
+                    best = (rate, max_depth, leaf_size);
+                }
+            }
+        }
+        eprintln!("{name}: best depth {} leaf {} at {:.2} Mrays/s", best.1, best.2, best.0);
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--tune-kdtree") {
+        tune_kdtree();
+        return;
+    }
     if std::env::args().any(|a| a == "--table") {
         table();
         return;

@@ -355,3 +355,31 @@ fn visibility_field_parameters_are_checked() {
         stats.parameters
     );
 }
+
+/// The kd-tree's parameters in a scene file: out-of-range values and unknown keys are errors
+/// naming the file, line and key; valid ones reach the structure.
+#[test]
+fn kd_tree_parameters_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(dir.path().join("tri.obj"), "v 0 0 0.5\nv 1 0 0.5\nv 0 1 0.5\nf 1 2 3\n").unwrap();
+    let load = |kd: &str| {
+        let text = format!(
+            "accelerator = \"kdtree\"\n[kdtree]\n{kd}\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nwidth = 1.0\n[[meshes]]\npath = \"tri.obj\"\n{}",
+            common::plane_and_light(0.1)
+        );
+        std::fs::write(&path, text).unwrap();
+        Scene::load(&path)
+    };
+    for (kd, key) in [
+        ("max_depth = 61", "kdtree.max_depth"),
+        ("leaf_size = 70000", "kdtree.leaf_size"),
+        ("depth = 3", "depth"),
+    ] {
+        let e = load(kd).unwrap_err().to_string();
+        assert!(e.contains("scene.toml:3") && e.contains(key), "{kd}: {e}");
+    }
+    let s = load("max_depth = 7\nleaf_size = 1").unwrap();
+    let stats = s.accel.as_ref().unwrap().stats();
+    assert_eq!(stats.parameters, "depth 7 leaf 1");
+}

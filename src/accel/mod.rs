@@ -20,6 +20,7 @@
 
 pub mod brute;
 pub mod bvh;
+pub mod kdtree;
 pub mod vlf;
 
 pub use bvh::{Bvh, Preset};
@@ -167,6 +168,8 @@ pub struct AccelSettings {
     pub bvh_preset: Preset,
     /// Visibility-field parameters.
     pub vlf: vlf::VlfSettings,
+    /// kd-tree parameters.
+    pub kdtree: kdtree::KdSettings,
 }
 
 impl Default for AccelSettings {
@@ -175,6 +178,7 @@ impl Default for AccelSettings {
             name: REGISTRY[0].name,
             bvh_preset: Preset::default(),
             vlf: vlf::VlfSettings::default(),
+            kdtree: kdtree::KdSettings::default(),
         }
     }
 }
@@ -210,6 +214,12 @@ pub const REGISTRY: &[Registered] = &[
         wgsl: vlf::WGSL,
         gpu_buffers: vlf::GPU_BUFFERS,
         build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.vlf)?)),
+    },
+    Registered {
+        name: "kdtree",
+        wgsl: kdtree::WGSL,
+        gpu_buffers: kdtree::GPU_BUFFERS,
+        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.kdtree))),
     },
 ];
 

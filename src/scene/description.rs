@@ -30,6 +30,20 @@ pub struct SceneFile {
     /// Visibility-field parameters (`accelerator = "vlf"`).
     #[serde(default)]
     pub vlf: VlfDesc,
+    /// kd-tree parameters (`accelerator = "kdtree"`).
+    #[serde(default)]
+    pub kdtree: KdDesc,
+}
+
+/// The kd-tree's parameters as written; each absent one takes
+/// [`crate::accel::kdtree::KdSettings`]' default.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KdDesc {
+    /// Deepest split level.
+    pub max_depth: Option<u32>,
+    /// Nodes with at most this many triangles become leaves.
+    pub leaf_size: Option<u32>,
 }
 
 /// The visibility field's parameters as written; each absent one takes

@@ -2,8 +2,9 @@
 //! error located by file, line and key.
 
 use super::camera::{Camera, Projection};
-use super::description::{LightDesc, ProjectionDesc, SceneFile, VlfDesc};
+use super::description::{KdDesc, LightDesc, ProjectionDesc, SceneFile, VlfDesc};
 use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
+use crate::accel::kdtree::{self, KdSettings};
 use crate::accel::vlf::VlfSettings;
 use crate::accel::{self, AccelSettings};
 use crate::config::{ConfigError, Seg, Source};
@@ -78,6 +79,7 @@ impl Scene {
                 .name,
             bvh_preset: file.bvh_preset,
             vlf: vlf_settings(&file.vlf, source)?,
+            kdtree: kd_settings(&file.kdtree, source)?,
         };
         for (i, s) in file.spheres.iter().enumerate() {
             spheres.push(Sphere {
@@ -217,23 +219,45 @@ impl Validator<'_> {
     }
 }
 
+/// A parameter of table `table`: `value` if it lies in `lo..=hi` (a located error if not),
+/// else `default`.
+fn ranged(
+    source: &Source,
+    table: &str,
+    key: &str,
+    value: Option<u32>,
+    default: u32,
+    (lo, hi): (u32, u32),
+) -> Result<u32, ConfigError> {
+    match value {
+        Some(v) if !(lo..=hi).contains(&v) => {
+            Err(source.error(&key_path![table, key], format!("must lie in {lo}..={hi}, got {v}")))
+        }
+        v => Ok(v.unwrap_or(default)),
+    }
+}
+
 /// The visibility field's parameters from the scene's `[vlf]` table, each checked against the
 /// range the structure supports.
 fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError> {
     let defaults = VlfSettings::default();
-    let check = |key: &str, value: Option<u32>, default: u32, lo: u32, hi: u32| -> Result<u32, ConfigError> {
-        match value {
-            Some(v) if !(lo..=hi).contains(&v) => {
-                Err(source.error(&key_path!["vlf", key], format!("must lie in {lo}..={hi}, got {v}")))
-            }
-            v => Ok(v.unwrap_or(default)),
-        }
-    };
+    let check = |key, value, default, range| ranged(source, "vlf", key, value, default, range);
     Ok(VlfSettings {
-        level: check("level", d.level, defaults.level, 1, 64)?,
-        tiles: check("tiles", d.tiles, defaults.tiles, 1, 1024)?,
-        depth: check("depth", d.depth, defaults.depth, 0, 6)?,
+        level: check("level", d.level, defaults.level, (1, 64))?,
+        tiles: check("tiles", d.tiles, defaults.tiles, (1, 1024))?,
+        depth: check("depth", d.depth, defaults.depth, (0, 6))?,
         split: d.split.unwrap_or(defaults.split),
-        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, 0, u32::MAX)?,
+        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, (0, u32::MAX))?,
+    })
+}
+
+/// The kd-tree's parameters from the scene's `[kdtree]` table (depth up to what its walk's
+/// stack holds).
+fn kd_settings(d: &KdDesc, source: &Source) -> Result<KdSettings, ConfigError> {
+    let defaults = KdSettings::default();
+    let check = |key, value, default, range| ranged(source, "kdtree", key, value, default, range);
+    Ok(KdSettings {
+        max_depth: check("max_depth", d.max_depth, defaults.max_depth, (0, kdtree::MAX_DEPTH))?,
+        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, (0, 1 << 16))?,
     })
 }
