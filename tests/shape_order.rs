@@ -193,14 +193,14 @@ fn an_unknown_accelerator_is_a_located_error() {
     let path = dir.path().join("s.toml");
     std::fs::write(
         &path,
-        "bvh_preset = \"medium\"\naccelerator = \"kdtree\"\n\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nwidth = 4\n",
+        "bvh_preset = \"medium\"\naccelerator = \"octree\"\n\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nwidth = 4\n",
     )
     .unwrap();
     let e = Scene::load(&path).unwrap_err();
     let text = e.to_string();
     assert!(text.contains("s.toml:2:"), "{text}");
     assert!(text.contains("key `accelerator`"), "{text}");
-    assert!(text.contains("kdtree") && text.contains("bvh"), "{text}");
+    assert!(text.contains("octree") && text.contains("kdtree"), "{text}");
 }
 
 /// The exact answer exists without triangles (a mesh whose triangles were all dropped counts as

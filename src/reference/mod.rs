@@ -4,6 +4,7 @@
 //! receiver point to ~1e-10; [`on_axis`] gives the closed-form umbra and penumbra radii of a
 //! sphere above a plane under a coaxial disk light (../shared/papers/known-facts.md).
 
+pub mod ambient;
 pub mod on_axis;
 pub mod quadrature;
 pub mod visibility;

@@ -2,10 +2,12 @@
 //! in tests. It runs the plan's passes in order, each a parallel loop over pixels (rayon), with
 //! the GPU's sample streams, in double precision.
 
+use super::ambient::{occlusion, AMBIENT_STREAM};
 use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::render::plan::{Pass, RenderPlan};
 use crate::sampling::{shared_points, Pattern, Stream};
+use crate::scene::ambient::{AmbientOcclusion, AoDirections};
 use crate::scene::Scene;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -71,6 +73,32 @@ pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver>
     })
 }
 
+/// The ambient-occlusion pass over every receiver: the image and the rays traced.
+fn ambient_image(
+    scene: &Scene,
+    ao: &AmbientOcclusion,
+    receivers: &[Option<Receiver>],
+    sampling: Sampling,
+) -> (Vec<f32>, u64) {
+    let shared = match (&ao.directions, sampling.pattern) {
+        (AoDirections::Disk(scheme), Pattern::Shared) => {
+            Some(shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM))
+        }
+        _ => None,
+    };
+    let values: Vec<Option<(f64, u64)>> = receivers
+        .par_iter()
+        .enumerate()
+        .map(|(pixel, r)| {
+            let stream = Stream::new(sampling.seed, AMBIENT_STREAM, Some(pixel as u32));
+            r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), stream))
+        })
+        .collect();
+    let rays = values.iter().flatten().map(|v| v.1).sum();
+    let image = values.iter().map(|v| v.map_or(NO_RECEIVER, |v| v.0 as f32)).collect();
+    (image, rays)
+}
+
 impl Backend for CpuBackend {
     fn adapter(&self) -> &AdapterInfo {
         &self.info
@@ -89,6 +117,7 @@ impl Backend for CpuBackend {
             radiance: vec![0.0; pixels],
             visibility: vec![vec![NO_RECEIVER; pixels]; scene.lights.len()],
             hit: vec![NO_HIT; pixels],
+            ambient: None,
             rays: RayCounts::default(),
         };
         let mut receivers: Vec<Option<Receiver>> = vec![];
@@ -135,6 +164,12 @@ impl Backend for CpuBackend {
                             frame.rays.shadow[light] += s.rays;
                         }
                     }
+                }
+                Pass::Ambient { .. } => {
+                    let ao = scene.ambient.as_ref().expect("the plan has the pass only then");
+                    let (image, rays) = ambient_image(scene, ao, &receivers, sampling);
+                    frame.ambient = Some(image);
+                    frame.rays.ambient = rays;
                 }
             }
         }

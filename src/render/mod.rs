@@ -5,6 +5,7 @@
 //! visibility: the fraction of that light's shadow-ray targets that are above the receiver's
 //! horizon, in front of the one-sided emitter, and unoccluded.
 
+pub mod ambient;
 pub mod cpu;
 pub mod gpu;
 pub mod plan;
@@ -57,6 +58,8 @@ pub struct RayCounts {
     pub primary: u64,
     /// Shadow rays per light, in scene order.
     pub shadow: [u64; plan::MAX_LIGHTS],
+    /// Ambient-occlusion rays.
+    pub ambient: u64,
 }
 
 impl RayCounts {
@@ -79,6 +82,9 @@ pub struct Frame {
     pub visibility: Vec<Vec<f32>>,
     /// Per pixel, the object id hit by the camera ray, or [`NO_HIT`].
     pub hit: Vec<u32>,
+    /// Per pixel, the ambient-occlusion value in [0, 1] (the scene's weighting) or
+    /// [`NO_RECEIVER`]; `None` where the scene asks for no ambient occlusion.
+    pub ambient: Option<Vec<f32>>,
     /// Rays traced.
     pub rays: RayCounts,
 }

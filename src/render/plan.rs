@@ -32,6 +32,18 @@ pub enum Pass {
         /// Upper bound on rays: receivers facing away from the light issue none.
         max_rays: u64,
     },
+    /// Ambient-occlusion rays from every receiver point into its hemisphere: any-hit with early
+    /// exit, up to the scene's maximum distance. Only where the scene asks for it.
+    Ambient {
+        /// Where the directions come from, in a few words.
+        directions: String,
+        /// `plain` or `cosine`.
+        weighting: &'static str,
+        /// Rays per receiver point.
+        rays_per_receiver: u32,
+        /// Rays if every pixel sees a receiver.
+        max_rays: u64,
+    },
 }
 
 /// The passes one frame runs, in order.
@@ -73,6 +85,14 @@ impl RenderPlan {
                 max_rays: pixels * n as u64,
             });
         }
+        if let Some(a) = &scene.ambient {
+            passes.push(Pass::Ambient {
+                directions: a.directions.describe(),
+                weighting: a.weighting.name(),
+                rays_per_receiver: a.rays,
+                max_rays: pixels * a.rays as u64,
+            });
+        }
         Ok(RenderPlan { passes })
     }
 
@@ -82,7 +102,7 @@ impl RenderPlan {
             .iter()
             .map(|p| match p {
                 Pass::Primary { rays, .. } => *rays,
-                Pass::Shadow { max_rays, .. } => *max_rays,
+                Pass::Shadow { max_rays, .. } | Pass::Ambient { max_rays, .. } => *max_rays,
             })
             .sum()
     }
@@ -101,6 +121,15 @@ impl fmt::Display for RenderPlan {
                 } => writeln!(
                     f,
                     "shadow light {light} ({kind}): {rays_per_receiver} rays/receiver, <= {max_rays} rays"
+                )?,
+                Pass::Ambient {
+                    directions,
+                    weighting,
+                    rays_per_receiver,
+                    max_rays,
+                } => writeln!(
+                    f,
+                    "ambient occlusion ({directions}, {weighting}): {rays_per_receiver} rays/receiver, <= {max_rays} rays"
                 )?,
             }
         }

@@ -39,7 +39,7 @@ impl Receiver {
     /// would move the shadow edge and bias visibility in proportion to offset / penumbra width).
     /// A mesh is not convex: its own triangle is skipped and the origin is lifted by Waechter &
     /// Binder's scale-relative offset so neighbouring triangles sharing an edge are not hit.
-    fn origin(&self) -> DVec3 {
+    pub fn origin(&self) -> DVec3 {
         if self.triangle == super::NO_HIT {
             self.p
         } else {
@@ -52,7 +52,12 @@ impl Receiver {
 /// skipping the receiver's own sphere or plane (`object`) or triangle.
 pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, r: &Receiver) -> bool {
     let len = d.length();
-    let dir = d / len;
+    blocked(scene, origin, d / len, len, r)
+}
+
+/// Any-hit test of `origin + t dir`, `0 < t < len` (`len` may be infinite), skipping the
+/// receiver's own sphere or plane or triangle.
+pub fn blocked(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver) -> bool {
     let analytic = scene
         .shapes
         .iter()

@@ -33,6 +33,23 @@ pub struct SceneFile {
     /// kd-tree parameters (`accelerator = "kdtree"`).
     #[serde(default)]
     pub kdtree: KdDesc,
+    /// The ambient-occlusion pass, if the scene asks for one.
+    pub ambient_occlusion: Option<AmbientDesc>,
+}
+
+/// `[ambient_occlusion]` as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AmbientDesc {
+    /// `"grid"` (the visibility field's directions) or a disk scheme's name.
+    pub directions: String,
+    /// Rays per receiver; with `"grid"`, 2 L^2 + 1 for a level L (513: L = 16).
+    pub rays: u32,
+    /// `"plain"` (default) or `"cosine"`.
+    #[serde(default)]
+    pub weighting: crate::scene::ambient::Weighting,
+    /// Farthest occluder counted (metres); none when absent.
+    pub max_distance: Option<f64>,
 }
 
 /// The kd-tree's parameters as written; each absent one takes

@@ -1,8 +1,9 @@
 //! Reading a scene file: the TOML ([`super::description`]) validated into a [`Scene`], every
 //! error located by file, line and key.
 
+use super::ambient::{grid_level, AmbientOcclusion, AoDirections};
 use super::camera::{Camera, Projection};
-use super::description::{KdDesc, LightDesc, ProjectionDesc, SceneFile, VlfDesc};
+use super::description::{AmbientDesc, KdDesc, LightDesc, ProjectionDesc, SceneFile, VlfDesc};
 use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
 use crate::accel::kdtree::{self, KdSettings};
 use crate::accel::vlf::VlfSettings;
@@ -10,6 +11,7 @@ use crate::accel::{self, AccelSettings};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
 use crate::mesh::{clean, Triangles};
+use crate::sampling::DiskScheme;
 use glam::{DMat4, DQuat, DVec3};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -156,8 +158,13 @@ impl Scene {
             });
             triangles.positions.extend(kept);
         }
+        let ambient = match &file.ambient_occlusion {
+            Some(a) => Some(ambient(a, &v)?),
+            None => None,
+        };
         Scene::analytic(spheres, planes, lights)
             .with_cameras(cameras)
+            .with_ambient(ambient)
             .try_with_meshes(meshes, triangles, settings)
             .map_err(|e| source.error(&key_path!["accelerator"], format!("{e:#}")))
     }
@@ -217,6 +224,60 @@ impl Validator<'_> {
                 .error(at, format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}")))
         }
     }
+}
+
+/// The `[ambient_occlusion]` table, checked.
+fn ambient(a: &AmbientDesc, v: &Validator) -> Result<AmbientOcclusion, ConfigError> {
+    let at = |k: &str| key_path!["ambient_occlusion", k];
+    if !(1..=MAX_SAMPLES).contains(&a.rays) {
+        return Err(v
+            .source
+            .error(&at("rays"), format!("must be in 1..={MAX_SAMPLES}, got {}", a.rays)));
+    }
+    let directions = if a.directions == "grid" {
+        let level = grid_level(a.rays).ok_or_else(|| {
+            let near: Vec<String> = (1..=64u32)
+                .map(|l| 2 * l * l + 1)
+                .filter(|n| n.abs_diff(a.rays) < a.rays / 2 + 20)
+                .map(|n| n.to_string())
+                .collect();
+            v.source.error(
+                &at("rays"),
+                format!(
+                    "the grid has 2 L^2 + 1 lines for a level L (513 for the paper's 16); got {}, nearby: {}",
+                    a.rays,
+                    near.join(", ")
+                ),
+            )
+        })?;
+        AoDirections::grid(level)
+    } else {
+        let scheme = a.directions.parse::<DiskScheme>().map_err(|_| {
+            v.source.error(
+                &at("directions"),
+                format!(
+                    "`{}` is neither \"grid\" nor a disk scheme ({})",
+                    a.directions,
+                    DiskScheme::ALL
+                        .iter()
+                        .map(|s| s.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })?;
+        AoDirections::Disk(scheme)
+    };
+    let max_distance = match a.max_distance {
+        Some(d) => v.positive(d, &at("max_distance"))?,
+        None => f64::INFINITY,
+    };
+    Ok(AmbientOcclusion {
+        directions,
+        rays: a.rays,
+        weighting: a.weighting,
+        max_distance,
+    })
 }
 
 /// A parameter of table `table`: `value` if it lies in `lo..=hi` (a located error if not),

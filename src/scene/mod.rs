@@ -4,6 +4,7 @@
 //! [`Scene::load`] reads a TOML file ([`description`]) and validates it into this model, so that
 //! everything downstream can assume finite positions, unit normals and positive radii.
 
+pub mod ambient;
 pub mod camera;
 pub mod description;
 mod load;
@@ -88,6 +89,8 @@ pub struct Scene {
     pub accel_settings: AccelSettings,
     /// That structure (None without triangles).
     pub accel: Option<Arc<dyn Accelerator>>,
+    /// The ambient-occlusion pass, where the scene asks for one.
+    pub ambient: Option<ambient::AmbientOcclusion>,
 }
 
 impl Scene {
@@ -105,7 +108,14 @@ impl Scene {
             triangles: Triangles::default(),
             accel_settings: AccelSettings::default(),
             accel: None,
+            ambient: None,
         }
+    }
+
+    /// Asks for (or, with `None`, drops) the ambient-occlusion pass.
+    pub fn with_ambient(mut self, ambient: Option<ambient::AmbientOcclusion>) -> Scene {
+        self.ambient = ambient;
+        self
     }
 
     /// Sets the cameras.

@@ -149,6 +149,10 @@ pub struct Packed {
 /// Packs a scene, view and sampling choice into GPU structs; fails where the scene's
 /// acceleration structure exceeds a limit of its GPU form.
 pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Packed> {
+    anyhow::ensure!(
+        scene.ambient.is_none(),
+        "the GPU backend has no ambient-occlusion pass yet; render this scene with --backend cpu"
+    );
     let local = local_frame(scene, view);
     let (frame, (hx, hy), ortho) = view.camera.gpu_terms(view.width, view.height);
     // Perspective half extents are tangents (unitless); orthographic ones are lengths.

@@ -198,6 +198,7 @@ impl GpuBackend {
             let (pipeline, chunks) = match pass {
                 Pass::Primary { .. } => (&p.primary, &r.passes[0][..1]),
                 Pass::Shadow { light, .. } => (&p.shadow, &r.passes[*light][..]),
+                Pass::Ambient { .. } => unreachable!("`pack` refuses scenes with ambient occlusion"),
             };
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
@@ -326,6 +327,7 @@ impl Backend for GpuBackend {
         let mut rays = RayCounts {
             primary: pixels as u64,
             shadow: [0; MAX_LIGHTS],
+            ambient: 0,
         };
         for (i, s) in rays.shadow.iter_mut().enumerate() {
             *s = counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
@@ -336,6 +338,7 @@ impl Backend for GpuBackend {
             radiance,
             visibility: vis.chunks(pixels.max(1)).map(<[f32]>::to_vec).collect(),
             hit: hits.chunks((HIT_BYTES / 4) as usize).map(|h| h[3]).collect(),
+            ambient: None,
             rays,
         })
     }
