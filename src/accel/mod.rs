@@ -144,6 +144,9 @@ pub struct BuildStats {
     pub build_time: Duration,
     /// Bytes the GPU form occupies.
     pub gpu_bytes: u64,
+    /// Bytes the structure's CPU form occupies beyond the triangles every structure keeps (its
+    /// memory cost in comparisons).
+    pub memory_bytes: u64,
     /// Triangles indexed.
     pub triangles: usize,
     /// One sentence for the report: kind, size, build time, memory.

@@ -3,6 +3,7 @@
 use anyhow::Context;
 use clap::{Parser, ValueEnum};
 use penumbra::config::ConfigError;
+use penumbra::experiment::ao::{self, run_ao, AoSpec};
 use penumbra::experiment::fps::{self, FpsSpec};
 use penumbra::experiment::sweep::filter::{self, Filter};
 use penumbra::experiment::sweep::merge::{merge_shards, MergePlan, MergeRefused};
@@ -126,7 +127,45 @@ fn run(args: Args) -> anyhow::Result<()> {
     match load(|| Experiment::load(&args.experiment))? {
         Experiment::Sweep(spec) => run_sweep_experiment(&args, *spec, started),
         Experiment::Fps(spec) => run_fps_experiment(&args, spec, started),
+        Experiment::Ao(spec) => run_ao_experiment(&args, spec, started),
     }
+}
+
+/// An ambient-occlusion experiment (`kind = "ao"`): times each structure on each mesh on the
+/// CPU backend (the GPU backend has no AO pass yet).
+fn run_ao_experiment(args: &Args, spec: AoSpec, started: Instant) -> anyhow::Result<()> {
+    if !args.filter.is_empty() || args.shard.is_some() || !args.merge.is_empty() {
+        return Err(BadInput(
+            "--filter, --shard and --merge apply to sweeps, not to ambient-occlusion experiments".into(),
+        )
+        .into());
+    }
+    if matches!(args.backend, Some(BackendChoice::Gpu)) {
+        return Err(BadInput("the GPU backend has no ambient-occlusion pass yet; use --backend cpu".into()).into());
+    }
+    if args.dry_run {
+        for m in &spec.meshes {
+            println!(
+                "{}: {} triangles x [{}], {}x{}, {} AO rays per hit",
+                m.name,
+                m.triangles.positions.len(),
+                spec.structures.join(", "),
+                spec.width,
+                spec.height,
+                spec.ao.rays
+            );
+        }
+        return Ok(());
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    let rows = run_ao(&spec, &|mesh, structure| info!("{mesh}: {structure}"))?;
+    let threads = rayon::current_num_threads();
+    ao::report::write_ao(&spec, &rows, threads, started.elapsed().as_secs_f64(), &out)?;
+    info!("{} rows; wrote {}", rows.len(), out.join("report.md").display());
+    Ok(())
 }
 
 /// The shard folders `--merge` names, and N where it was given: a number alone stands for

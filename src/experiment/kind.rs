@@ -14,6 +14,8 @@ pub enum Kind {
     Sweep,
     /// Frame rates timed ([`super::fps`]).
     Fps,
+    /// Ambient occlusion timed per acceleration structure ([`super::ao`]).
+    Ao,
 }
 
 impl Kind {

@@ -1,7 +1,9 @@
 //! Experiments, one module per kind, each with its spec, runner and report: [`sweep`] (sampling
-//! schemes swept and measured against a ground truth) and [`fps`] (the paper's frame rates). An
+//! schemes swept and measured against a ground truth), [`fps`] (the paper's frame rates) and
+//! [`ao`] (the visibility-field paper's ambient-occlusion table). An
 //! experiment file names its kind with `kind` ([`kind`]).
 
+pub mod ao;
 pub mod fps;
 pub mod kind;
 pub mod sweep;
@@ -16,6 +18,8 @@ pub enum Experiment {
     Sweep(Box<sweep::Spec>),
     /// `kind = "fps"`.
     Fps(fps::FpsSpec),
+    /// `kind = "ao"`.
+    Ao(ao::AoSpec),
 }
 
 impl Experiment {
@@ -28,6 +32,7 @@ impl Experiment {
                 .map(|s| Experiment::Sweep(Box::new(s)))
                 .map_err(|e| if declared.is_none() { read_as_sweep(e) } else { e }),
             Kind::Fps => fps::FpsSpec::from_source(&source).map(Experiment::Fps),
+            Kind::Ao => ao::AoSpec::from_source(&source).map(Experiment::Ao),
         }
     }
 }

@@ -61,6 +61,7 @@ impl Accelerator for Brute {
             parameters: "none".into(),
             build_time: Duration::ZERO,
             gpu_bytes: (n * std::mem::size_of::<GpuTri>()) as u64,
+            memory_bytes: 0,
             triangles: n,
             description: format!("brute force over {n} triangles (48 GPU bytes per triangle)"),
         }

@@ -265,6 +265,7 @@ impl Accelerator for Bvh {
             parameters: self.preset.name().to_string(),
             build_time: self.total_time,
             gpu_bytes: bytes,
+            memory_bytes: (std::mem::size_of_val(self.tree.nodes.as_slice()) + 4 * self.tree.primitive_indices.len()) as u64,
             triangles: self.world.len(),
             description: format!(
                 "BVH2 (obvhs, preset `{}`): {} nodes, depth {}, built in {:.1} ms ({:.1} ms core); {:.1} GPU bytes per triangle (32-byte nodes, 48-byte full-f32 triangles)",

@@ -239,6 +239,7 @@ impl Accelerator for KdTree {
             parameters: self.settings.describe(),
             build_time: self.build_time,
             gpu_bytes: (self.bytes() + n * std::mem::size_of::<super::GpuTri>()) as u64,
+            memory_bytes: self.bytes() as u64,
             triangles: n,
             description: format!(
                 "kd-tree (spatial median, {}): {} nodes, {leaves} leaves, depth {}, {:.2} triangle \

@@ -267,6 +267,7 @@ impl Accelerator for VisibilityField {
             parameters: self.settings.describe(),
             build_time: self.build_time,
             gpu_bytes: gpu::bytes(self) as u64,
+            memory_bytes: bytes as u64,
             triangles: self.world.len(),
             description: format!(
                 "visibility field ({}): {} tile entries ({:.1} per triangle per direction), {} split tiles, built in {:.1} ms; {:.1} MB ({:.0} bytes per triangle)",

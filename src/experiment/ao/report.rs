@@ -1,0 +1,262 @@
+//! Outputs of an ambient-occlusion experiment: ao.csv, the AO images, a plot of frame time
+//! against triangle count, and report.md with the paper's Table 1 beside ours and a verdict
+//! computed from the rows.
+
+use super::runner::AoRow;
+use super::spec::AoSpec;
+use crate::files::write_atomic;
+use crate::output::images::{grey, write_png};
+use crate::output::plots::{line_plot, Axes, Series};
+use crate::output::table::{float, write_rows};
+use serde::Serialize;
+use std::path::Path;
+
+/// A row of ao.csv.
+#[derive(Serialize)]
+struct CsvRow<'a> {
+    mesh: &'a str,
+    triangles: usize,
+    structure: &'a str,
+    parameters: &'a str,
+    #[serde(with = "float")]
+    build_s: f64,
+    memory_mb: String,
+    frames: usize,
+    #[serde(with = "float")]
+    frame_s_median: f64,
+    primary_rays: u64,
+    ao_rays: u64,
+    #[serde(with = "float")]
+    mrays_per_s: f64,
+    receivers: usize,
+    #[serde(with = "float")]
+    mean_ao: f64,
+    same_image_as_first: bool,
+}
+
+/// The row of `structure` on `mesh`.
+fn find<'a>(rows: &'a [AoRow], mesh: &str, structure: &str) -> Option<&'a AoRow> {
+    rows.iter().find(|r| r.mesh == mesh && r.structure == structure)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The verdict on the paper's claims, from the rows: VLF-RT against the CRT-like kd-tree and
+/// against the BVH, with the memory and build time it costs.
+pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
+    let mut out = String::new();
+    let ratio = |a: &str, b: &str| -> Vec<(String, f64)> {
+        spec.meshes
+            .iter()
+            .filter_map(|m| {
+                let (x, y) = (find(rows, &m.name, a)?, find(rows, &m.name, b)?);
+                Some((m.name.clone(), y.median_seconds() / x.median_seconds()))
+            })
+            .collect()
+    };
+    let identical = rows.iter().all(|r| r.same_image);
+    out += &format!(
+        "- **Exactness**: every structure's AO image {} the first structure's, bit for bit, on every mesh.\n",
+        if identical { "equals" } else { "does NOT equal" }
+    );
+    for (baseline, label, paper) in [
+        (
+            "kdtree",
+            "the CRT-like kd-tree (the paper's baseline)",
+            Some("1.45-2.51x"),
+        ),
+        (
+            "bvh",
+            "obvhs' BVH2 (very-slow build, the project's f64 traversal)",
+            None,
+        ),
+    ] {
+        let r = ratio("vlf", baseline);
+        if r.is_empty() {
+            continue;
+        }
+        let faster = r.iter().filter(|(_, x)| *x > 1.0).count();
+        let listed: Vec<String> = r.iter().map(|(m, x)| format!("{m} {x:.2}x")).collect();
+        out += &format!(
+            "- **VLF-RT vs {label}**: faster on {faster} of {} meshes; speed-up (their frame time / VLF-RT's) {}, median {:.2}x{}.\n",
+            r.len(),
+            listed.join(", "),
+            median(r.iter().map(|x| x.1).collect()),
+            paper.map_or(String::new(), |p| format!(" (the paper: {p})"))
+        );
+    }
+    let cost: Vec<String> = spec
+        .meshes
+        .iter()
+        .filter_map(|m| {
+            let v = find(rows, &m.name, "vlf")?;
+            let others: Vec<String> = ["kdtree", "bvh"]
+                .iter()
+                .filter_map(|s| find(rows, &m.name, s))
+                .map(|o| {
+                    format!(
+                        "{} {:.2} MB / {:.2} s",
+                        o.structure,
+                        o.memory_bytes as f64 / 1e6,
+                        o.build_seconds
+                    )
+                })
+                .collect();
+            Some(format!(
+                "{} {:.0} MB / {:.2} s ({})",
+                m.name,
+                v.memory_bytes as f64 / 1e6,
+                v.build_seconds,
+                others.join(", ")
+            ))
+        })
+        .collect();
+    if !cost.is_empty() {
+        out += &format!("- **What VLF-RT costs** (memory / build time): {}.\n", cost.join("; "));
+    }
+    out
+}
+
+/// Writes ao.csv, images/, plots/frame_time.png, report.md and manifest.toml under `out`.
+pub fn write_ao(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64, out: &Path) -> anyhow::Result<()> {
+    let csv = rows.iter().map(|r| CsvRow {
+        mesh: &r.mesh,
+        triangles: r.triangles,
+        structure: r.structure,
+        parameters: &r.parameters,
+        build_s: r.build_seconds,
+        memory_mb: format!("{:.3}", r.memory_bytes as f64 / 1e6),
+        frames: r.frame_seconds.len(),
+        frame_s_median: r.median_seconds(),
+        primary_rays: r.rays.0,
+        ao_rays: r.rays.1,
+        mrays_per_s: r.mrays_per_s(),
+        receivers: r.receivers,
+        mean_ao: r.mean_ao,
+        same_image_as_first: r.same_image,
+    });
+    write_rows(&out.join("ao.csv"), csv)?;
+    for m in &spec.meshes {
+        if let Some(r) = rows.iter().find(|r| r.mesh == m.name) {
+            write_png(
+                &out.join(format!("images/{}.png", m.name)),
+                &grey(&r.image, spec.width, spec.height),
+            )?;
+        }
+    }
+    let series: Vec<(usize, Series)> = spec
+        .structures
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let points = rows
+                .iter()
+                .filter(|r| r.structure == *s)
+                .map(|r| (r.triangles as f64, r.median_seconds(), f64::NAN))
+                .collect();
+            (
+                i,
+                Series {
+                    name: s.to_string(),
+                    points,
+                    dashed: false,
+                },
+            )
+        })
+        .collect();
+    line_plot(
+        &out.join("plots/frame_time.png"),
+        &Axes::new(
+            &format!(
+                "AO, {} rays per hit, {}x{}, CPU f64",
+                spec.ao.rays, spec.width, spec.height
+            ),
+            "triangles",
+            "frame seconds (median)",
+            true,
+            true,
+        ),
+        &series,
+        &[],
+    )?;
+    write_atomic(&out.join("report.md"), report(spec, rows, threads, seconds).as_bytes())?;
+    let manifest = format!(
+        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\nbackend = \"cpu\"\nthreads = {threads}\n",
+        crate::output::git_commit(),
+        spec.path.display().to_string(),
+        seconds,
+    );
+    write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}
+
+fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {
+    let mut md = format!(
+        "# {}: ambient occlusion, the visibility-field paper's Table 1 measured\n\n",
+        spec.name
+    );
+    md += &format!(
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Per structure, one untimed frame gives the image, then {} timed frames; the frame time is their median, rays/s count camera and AO rays.\n\n",
+        spec.path.display(),
+        seconds,
+        spec.width,
+        spec.height,
+        spec.ao.rays,
+        spec.ao.weighting.name(),
+        spec.ao.max_distance,
+        spec.repeats
+    );
+    md += "## Verdict\n\n";
+    md += &verdict(spec, rows);
+    md += "\n## Ours\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | vs kdtree | vs bvh | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for r in rows {
+        let vs = |s: &str| {
+            find(rows, &r.mesh, s).map_or("n/a".to_string(), |b| {
+                format!("{:.2}x", b.median_seconds() / r.median_seconds())
+            })
+        };
+        md += &format!(
+            "| {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {:.2} | {} | {} | {} |\n",
+            r.mesh,
+            r.triangles,
+            r.structure,
+            r.parameters,
+            r.build_seconds,
+            r.memory_bytes as f64 / 1e6,
+            r.median_seconds(),
+            r.mrays_per_s(),
+            vs("kdtree"),
+            vs("bvh"),
+            if r.same_image { "yes" } else { "NO" }
+        );
+    }
+    md += "\n## The paper's Table 1 beside ours\n\nThe paper (2.8 GHz Pentium 4, 256x256, 513 rays per point): CRT and VLF-RT seconds at each one's best depth. Ours: the same ratio, CRT-like kd-tree frame time over VLF-RT's.\n\n| mesh | paper CRT s (depth) | paper VLF-RT s (depth) | paper speed-up | our speed-up |\n|---|---|---|---|---|\n";
+    for m in &spec.meshes {
+        let ours = match (find(rows, &m.name, "kdtree"), find(rows, &m.name, "vlf")) {
+            (Some(k), Some(v)) => format!("{:.2}x", k.median_seconds() / v.median_seconds()),
+            _ => "n/a".into(),
+        };
+        match &m.paper {
+            Some(p) => {
+                md += &format!(
+                    "| {} for {} | {:.2} ({}) | {:.2} ({}) | {:.2}x | {ours} |\n",
+                    m.name,
+                    p.scene,
+                    p.crt_seconds,
+                    p.crt_depth,
+                    p.vlf_seconds,
+                    p.vlf_depth,
+                    p.crt_seconds / p.vlf_seconds
+                )
+            }
+            None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
+        }
+    }
+    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `images/MESH.png` (the AO image), `plots/frame_time.png`.\n";
+    md
+}

@@ -1,0 +1,81 @@
+//! The ambient-occlusion experiment kind (`kind = "ao"`): experiments/ao-ci.toml through the
+//! binary (two meshes, every structure including brute force) writes its table, images, plot
+//! and report, and every structure's AO image is brute force's bit for bit; bad input is a
+//! located error with exit status 2 and writes nothing; the verdict says when images differ.
+
+mod common;
+
+use penumbra::experiment::ao::report::verdict;
+use penumbra::experiment::ao::{run_ao, AoSpec};
+use std::ffi::OsStr;
+
+#[test]
+fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ao-ci");
+    let exp = common::repo("experiments/ao-ci.toml");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(out.join("ao.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(csv.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 2 * 4, "{csv}");
+    for r in &rows {
+        assert_eq!(&r[col("same_image_as_first")], "true", "{csv}");
+        assert!(r[col("receivers")].parse::<usize>().unwrap() > 50, "{csv}");
+        assert!(r[col("ao_rays")].parse::<u64>().unwrap() == 33 * r[col("receivers")].parse::<u64>().unwrap());
+    }
+    for file in [
+        "report.md",
+        "manifest.toml",
+        "images/cow.png",
+        "images/mech-holes-shark.png",
+        "plots/frame_time.png",
+    ] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
+    assert!(
+        report.contains("the paper: 1.45-2.51x") && report.contains("Cow (5.8K)"),
+        "{report}"
+    );
+}
+
+#[test]
+fn bad_input_is_located_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::repo("experiments/ao-ci.toml"))
+        .unwrap()
+        .replace("../assets/", &format!("{}/", common::repo("assets").display()));
+    for (edit, key) in [
+        (text.replace("\"vlf\", \"bvh\"", "\"vlf\", \"octree\""), "structures[2]"),
+        (text.replace("rays = 33", "rays = 34"), "rays"),
+        (text.replace("repeats = 1", "repeats = 0"), "repeats"),
+        (text.replace("cow.off", "no-such.off"), "meshes[0].path"),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, edit).unwrap();
+        let out = dir.path().join("out");
+        let (code, err) = common::sweep(&[path.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+        assert_eq!(code, 2, "{key}: {err}");
+        assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
+        assert!(!out.exists(), "{key}: wrote {}", out.display());
+    }
+}
+
+#[test]
+fn the_verdict_reports_images_that_differ() {
+    let spec = AoSpec::load(&common::repo("experiments/ao-ci.toml")).unwrap();
+    let mut small = spec.clone();
+    small.meshes.truncate(1);
+    small.structures = vec!["kdtree", "vlf"];
+    small.width = 8;
+    small.height = 8;
+    let mut rows = run_ao(&small, &|_, _| {}).unwrap();
+    assert!(verdict(&small, &rows).contains("equals"));
+    rows[1].same_image = false;
+    assert!(verdict(&small, &rows).contains("does NOT equal"));
+}
