@@ -5,6 +5,7 @@ mod common;
 
 use glam::DVec3;
 use penumbra::accel::{self, AccelSettings, REGISTRY};
+use penumbra::config::ConfigError;
 use penumbra::mesh::Triangles;
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{Backend, Frame, Sampling, View};
@@ -320,21 +321,25 @@ fn sweeping_the_structure_changes_only_its_columns() {
     );
 }
 
+/// A one-triangle scene in `dir` (scene.toml) indexed by `structure`, whose table of the same
+/// name holds `parameters` (line 3 on).
+fn with_parameters(dir: &std::path::Path, structure: &str, parameters: &str) -> Result<Scene, ConfigError> {
+    let path = dir.join("scene.toml");
+    std::fs::write(dir.join("tri.obj"), "v 0 0 0.5\nv 1 0 0.5\nv 0 1 0.5\nf 1 2 3\n").unwrap();
+    let text = format!(
+        "accelerator = \"{structure}\"\n[{structure}]\n{parameters}\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nwidth = 1.0\n[[meshes]]\npath = \"tri.obj\"\n{}",
+        common::plane_and_light(0.1)
+    );
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path)
+}
+
 /// The visibility field's parameters in a scene file: out-of-range values and unknown keys are
 /// errors naming the file, line and key; valid ones reach the structure.
 #[test]
 fn visibility_field_parameters_are_checked() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("scene.toml");
-    std::fs::write(dir.path().join("tri.obj"), "v 0 0 0.5\nv 1 0 0.5\nv 0 1 0.5\nf 1 2 3\n").unwrap();
-    let load = |vlf: &str| {
-        let text = format!(
-            "accelerator = \"vlf\"\n[vlf]\n{vlf}\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nwidth = 1.0\n[[meshes]]\npath = \"tri.obj\"\n{}",
-            common::plane_and_light(0.1)
-        );
-        std::fs::write(&path, text).unwrap();
-        Scene::load(&path)
-    };
+    let load = |vlf: &str| with_parameters(dir.path(), "vlf", vlf);
     for (vlf, key) in [
         ("tiles = 0", "vlf.tiles"),
         ("depth = 9", "vlf.depth"),
@@ -361,16 +366,7 @@ fn visibility_field_parameters_are_checked() {
 #[test]
 fn kd_tree_parameters_are_checked() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("scene.toml");
-    std::fs::write(dir.path().join("tri.obj"), "v 0 0 0.5\nv 1 0 0.5\nv 0 1 0.5\nf 1 2 3\n").unwrap();
-    let load = |kd: &str| {
-        let text = format!(
-            "accelerator = \"kdtree\"\n[kdtree]\n{kd}\n[cameras.c]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nwidth = 1.0\n[[meshes]]\npath = \"tri.obj\"\n{}",
-            common::plane_and_light(0.1)
-        );
-        std::fs::write(&path, text).unwrap();
-        Scene::load(&path)
-    };
+    let load = |kd: &str| with_parameters(dir.path(), "kdtree", kd);
     for (kd, key) in [
         ("max_depth = 61", "kdtree.max_depth"),
         ("leaf_size = 70000", "kdtree.leaf_size"),

@@ -19,6 +19,11 @@ use std::path::Path;
 const CENTRE: DVec3 = DVec3::new(0.0, 0.0, 1.0);
 const RADIUS: f64 = 0.5;
 const SIZE: u32 = 24;
+const SAMPLING: Sampling = Sampling {
+    scheme: DiskScheme::Uniform,
+    pattern: Pattern::PerPixel,
+    seed: 1,
+};
 
 /// A sphere (or, with `mesh`, a triangulated sphere from that OBJ) of radius 0.5 at height 1
 /// over the plane z = 0, seen from above by an orthographic camera 3 m wide, with `ao` as the
@@ -269,17 +274,7 @@ fn the_pass_runs_only_where_asked_and_bad_values_are_located() {
     ));
     let mut cpu = CpuBackend::default();
     let before = cpu.dispatches();
-    let f = cpu
-        .render(
-            &s,
-            view,
-            Sampling {
-                scheme: DiskScheme::Uniform,
-                pattern: Pattern::PerPixel,
-                seed: 1,
-            },
-        )
-        .unwrap();
+    let f = cpu.render(&s, view, SAMPLING).unwrap();
     assert_eq!(cpu.dispatches() - before, plan.passes.len() as u64);
     let ao = f.ambient.unwrap();
     assert!(f
@@ -330,16 +325,6 @@ fn the_gpu_backend_refuses_ambient_occlusion_rather_than_skip_it() {
         width: SIZE,
         height: SIZE,
     };
-    let e = gpu
-        .render(
-            &s,
-            view,
-            Sampling {
-                scheme: DiskScheme::Uniform,
-                pattern: Pattern::PerPixel,
-                seed: 1,
-            },
-        )
-        .unwrap_err();
+    let e = gpu.render(&s, view, SAMPLING).unwrap_err();
     assert!(format!("{e:#}").contains("--backend cpu"), "{e:#}");
 }

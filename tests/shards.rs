@@ -12,8 +12,6 @@ use penumbra::experiment::sweep::shard::{assign, run_shard, share, Shard};
 use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::output::table::write_rows;
 use penumbra::render::cpu::CpuBackend;
-use penumbra::render::{AdapterInfo, Backend, Frame, Sampling, Timing, View};
-use penumbra::scene::Scene;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -202,6 +200,17 @@ fn groups_sharing_a_costly_ground_truth_stay_together_and_cheap_ones_spread() {
     assert!((load[0] - load[1]).abs() <= smallest, "unbalanced: {load:?}");
 }
 
+/// Asserts each of `files` is byte for byte the same under `a` and `b`.
+fn same_files(a: &Path, b: &Path, files: &[&str]) {
+    for file in files {
+        let (x, y) = (
+            std::fs::read(a.join(file)).unwrap(),
+            std::fs::read(b.join(file)).unwrap(),
+        );
+        assert!(x == y, "{file} differs");
+    }
+}
+
 /// The CI experiment: unsharded into `dir/full`, as 3 shards merged into `dir/sharded`.
 fn full_and_sharded(dir: &Path) -> (PathBuf, PathBuf) {
     let full = dir.join("full");
@@ -246,19 +255,17 @@ fn three_shards_merged_give_the_unsharded_tables_and_figures() {
         shard_runs += n;
     }
     assert_eq!(shard_runs, without_clock(&full.join("runs.csv")).len() - 1);
-    for file in [
-        "ground_truth.csv",
-        "images/fig2_measure.png",
-        "images/ground_truth.exr",
-        "plots/profiles.png",
-        "plots/rmse_vs_samples.png",
-    ] {
-        let (a, b) = (
-            std::fs::read(full.join(file)).unwrap(),
-            std::fs::read(sharded.join(file)).unwrap(),
-        );
-        assert!(a == b, "{file} differs");
-    }
+    same_files(
+        &full,
+        &sharded,
+        &[
+            "ground_truth.csv",
+            "images/fig2_measure.png",
+            "images/ground_truth.exr",
+            "plots/profiles.png",
+            "plots/rmse_vs_samples.png",
+        ],
+    );
     // The merge timed every configuration itself, in one phase.
     let timed = without_clock(&sharded.join("timings.csv")).len();
     assert!(timed > 1, "the merge timed nothing");
@@ -285,18 +292,16 @@ fn a_sweep_over_two_radii_merged_from_two_shards_is_byte_identical_without_timin
         os("--merge"),
         os("2"),
     ]);
-    for table in [
-        "runs.csv",
-        "summary.csv",
-        "ground_truth.csv",
-        "plots/width_vs_radius.png",
-    ] {
-        let (a, b) = (
-            std::fs::read(full.join(table)).unwrap(),
-            std::fs::read(sharded.join(table)).unwrap(),
-        );
-        assert!(a == b, "{table} differs");
-    }
+    same_files(
+        &full,
+        &sharded,
+        &[
+            "runs.csv",
+            "summary.csv",
+            "ground_truth.csv",
+            "plots/width_vs_radius.png",
+        ],
+    );
 }
 
 #[test]
@@ -437,32 +442,13 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
     assert!(tiny_out.join("runs.csv").exists());
 }
 
-/// A backend that fails every render with seed 2, to follow failed runs through shards.
-struct Flaky(CpuBackend);
-
-impl Backend for Flaky {
-    fn adapter(&self) -> &AdapterInfo {
-        self.0.adapter()
-    }
-    fn dispatches(&self) -> u64 {
-        self.0.dispatches()
-    }
-    fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
-        anyhow::ensure!(s.seed != 2, "simulated device loss");
-        self.0.render(scene, view, s)
-    }
-    fn time(&mut self, scene: &Scene, view: View, s: Sampling, w: u32, r: u32) -> anyhow::Result<Timing> {
-        self.0.time(scene, view, s, w, r)
-    }
-}
-
 #[test]
 fn failed_runs_reach_the_merge_as_an_unsharded_sweep_records_them() {
     let dir = tempfile::tempdir().unwrap();
     let spec = Spec::load(&common::tiny_experiment(dir.path(), |t| t)).unwrap();
     let full = run_sweep(
         &spec,
-        &mut Flaky(CpuBackend::default()),
+        &mut common::Flaky(CpuBackend::default()),
         &dir.path().join("j"),
         &dir.path().join("c"),
         true,
@@ -473,7 +459,7 @@ fn failed_runs_reach_the_merge_as_an_unsharded_sweep_records_them() {
     for index in 1..=2 {
         let done = run_shard(
             &spec,
-            &mut Flaky(CpuBackend::default()),
+            &mut common::Flaky(CpuBackend::default()),
             Shard { index, count: 2 },
             &results,
             false,
@@ -488,7 +474,7 @@ fn failed_runs_reach_the_merge_as_an_unsharded_sweep_records_them() {
         rerun: "sweep tiny.toml --shard",
         fresh: false,
     };
-    let merged = merge_shards(&spec, &mut Flaky(CpuBackend::default()), &plan, &results).unwrap();
+    let merged = merge_shards(&spec, &mut common::Flaky(CpuBackend::default()), &plan, &results).unwrap();
     assert_eq!(merged.failures, full.failures);
     let table = |records: &[penumbra::experiment::sweep::Record], name: &str| {
         let path = dir.path().join(name);

@@ -7,8 +7,6 @@ mod common;
 use penumbra::experiment::sweep::record::Status;
 use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
-use penumbra::render::{AdapterInfo, Backend, Frame, Sampling, Timing, View};
-use penumbra::scene::Scene;
 use std::ffi::OsStr;
 use std::path::Path;
 
@@ -79,30 +77,11 @@ fn identical_inputs_give_identical_runs_csv_and_resume_reproduces_it() {
     }
 }
 
-/// A backend that fails every render with seed 2, to exercise the runner's failure path.
-struct Flaky(CpuBackend);
-
-impl Backend for Flaky {
-    fn adapter(&self) -> &AdapterInfo {
-        self.0.adapter()
-    }
-    fn dispatches(&self) -> u64 {
-        self.0.dispatches()
-    }
-    fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
-        anyhow::ensure!(s.seed != 2, "simulated device loss");
-        self.0.render(scene, view, s)
-    }
-    fn time(&mut self, scene: &Scene, view: View, s: Sampling, w: u32, r: u32) -> anyhow::Result<Timing> {
-        self.0.time(scene, view, s, w, r)
-    }
-}
-
 #[test]
 fn failed_runs_are_recorded_and_the_sweep_goes_on() {
     let dir = tempfile::tempdir().unwrap();
     let spec = Spec::load(&common::tiny_experiment(dir.path(), |t| t)).unwrap();
-    let mut backend = Flaky(CpuBackend::default());
+    let mut backend = common::Flaky(CpuBackend::default());
     let out = run_sweep(&spec, &mut backend, &dir.path().join("j"), &dir.path().join("c"), true).unwrap();
     assert_eq!(out.records.len(), 16);
     assert_eq!(out.failures, 8);

@@ -137,3 +137,35 @@ pub fn triangles_scene(triangles: &penumbra::mesh::Triangles, name: &'static str
         },
     )
 }
+
+/// A CPU backend that fails every render with seed 2: the runner's failure path, in sweeps and
+/// through shards.
+pub struct Flaky(pub penumbra::render::cpu::CpuBackend);
+
+impl penumbra::render::Backend for Flaky {
+    fn adapter(&self) -> &penumbra::render::AdapterInfo {
+        self.0.adapter()
+    }
+    fn dispatches(&self) -> u64 {
+        self.0.dispatches()
+    }
+    fn render(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+    ) -> anyhow::Result<penumbra::render::Frame> {
+        anyhow::ensure!(s.seed != 2, "simulated device loss");
+        self.0.render(scene, view, s)
+    }
+    fn time(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<penumbra::render::Timing> {
+        self.0.time(scene, view, s, warmup, repeats)
+    }
+}
