@@ -1,6 +1,7 @@
 //! The ambient-occlusion experiment kind (`kind = "ao"`): experiments/ao-ci.toml through the
-//! binary (two meshes, every structure including brute force) writes its table, images, plot
-//! and report, and every structure's AO image is brute force's bit for bit; bad input is a
+//! binary (two meshes, every structure including brute force, the kd-tree and the field tuned
+//! per mesh) writes its tables, images, plot and report, and every structure's AO image is
+//! brute force's bit for bit; bad input is a
 //! located error with exit status 2 and writes nothing; the verdict says when images differ.
 
 mod common;
@@ -55,6 +56,10 @@ fn bad_input_is_located_and_writes_nothing() {
         (text.replace("rays = 33", "rays = 34"), "rays"),
         (text.replace("repeats = 1", "repeats = 0"), "repeats"),
         (text.replace("cow.off", "no-such.off"), "meshes[0].path"),
+        (
+            text.replace("vlf_depths = [2, 4]", "vlf_depths = [2, 9]"),
+            "tuning.vlf_depths[1]",
+        ),
     ] {
         let path = dir.path().join("bad.toml");
         std::fs::write(&path, edit).unwrap();
@@ -74,7 +79,7 @@ fn the_verdict_reports_images_that_differ() {
     small.structures = vec!["kdtree", "vlf"];
     small.width = 8;
     small.height = 8;
-    let mut rows = run_ao(&small, &|_, _| {}).unwrap();
+    let (mut rows, _) = run_ao(&small, &|_, _| {}).unwrap();
     assert!(verdict(&small, &rows).contains("equals"));
     rows[1].same_image = false;
     assert!(verdict(&small, &rows).contains("does NOT equal"));

@@ -161,9 +161,9 @@ fn run_ao_experiment(args: &Args, spec: AoSpec, started: Instant) -> anyhow::Res
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
-    let rows = run_ao(&spec, &|mesh, structure| info!("{mesh}: {structure}"))?;
+    let (rows, tuning) = run_ao(&spec, &|mesh, structure| info!("{mesh}: {structure}"))?;
     let threads = rayon::current_num_threads();
-    ao::report::write_ao(&spec, &rows, threads, started.elapsed().as_secs_f64(), &out)?;
+    ao::report::write_ao(&spec, (&rows, &tuning), threads, started.elapsed().as_secs_f64(), &out)?;
     info!("{} rows; wrote {}", rows.len(), out.join("report.md").display());
     Ok(())
 }

@@ -7,5 +7,5 @@ pub mod report;
 pub mod runner;
 pub mod spec;
 
-pub use runner::{run_ao, AoRow};
+pub use runner::{run_ao, AoRow, TuningRow};
 pub use spec::AoSpec;

@@ -2,7 +2,7 @@
 //! against triangle count, and report.md with the paper's Table 1 beside ours and a verdict
 //! computed from the rows.
 
-use super::runner::AoRow;
+use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
 use crate::files::write_atomic;
 use crate::output::images::{grey, write_png};
@@ -123,8 +123,36 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     out
 }
 
-/// Writes ao.csv, images/, plots/frame_time.png, report.md and manifest.toml under `out`.
-pub fn write_ao(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64, out: &Path) -> anyhow::Result<()> {
+/// A row of tuning.csv.
+#[derive(Serialize)]
+struct TuningCsv<'a> {
+    mesh: &'a str,
+    structure: &'a str,
+    parameters: &'a str,
+    #[serde(with = "float")]
+    frame_s_median: f64,
+    chosen: bool,
+}
+
+/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png, report.md and manifest.toml under
+/// `out`.
+pub fn write_ao(
+    spec: &AoSpec,
+    (rows, tuning): (&[AoRow], &[TuningRow]),
+    threads: usize,
+    seconds: f64,
+    out: &Path,
+) -> anyhow::Result<()> {
+    write_rows(
+        &out.join("tuning.csv"),
+        tuning.iter().map(|t| TuningCsv {
+            mesh: &t.mesh,
+            structure: t.structure,
+            parameters: &t.parameters,
+            frame_s_median: t.frame_seconds,
+            chosen: t.chosen,
+        }),
+    )?;
     let csv = rows.iter().map(|r| CsvRow {
         mesh: &r.mesh,
         triangles: r.triangles,
@@ -201,7 +229,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
         spec.name
     );
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Per structure, one untimed frame gives the image, then {} timed frames; the frame time is their median, rays/s count camera and AO rays.\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each method is first tuned per mesh, as the paper tuned both (the kd-tree over maximum depths {:?} and leaf sizes {:?}, the field over tile-BSP depths {:?}; {} timed frames each at {}x{}, `tuning.csv`), then the kept settings render one untimed frame, which gives the image, and {} timed frames; the frame time is their median, rays/s count camera and AO rays.\n\n",
         spec.path.display(),
         seconds,
         spec.width,
@@ -209,6 +237,12 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
         spec.ao.rays,
         spec.ao.weighting.name(),
         spec.ao.max_distance,
+        spec.tuning.kdtree_depths,
+        spec.tuning.kdtree_leaves,
+        spec.tuning.vlf_depths,
+        spec.tuning.frames,
+        spec.tuning.width,
+        spec.tuning.height,
         spec.repeats
     );
     md += "## Verdict\n\n";
@@ -257,6 +291,6 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `images/MESH.png` (the AO image), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `tuning.csv` (every candidate of the tuning sweep), `images/MESH.png` (the AO image), `plots/frame_time.png`.\n";
     md
 }

@@ -1,9 +1,13 @@
 //! Runs an ambient-occlusion experiment on the f64 CPU backend (the GPU backend has no AO pass
-//! yet): per mesh, each structure is built at its best settings, renders the AO image once
+//! yet): per mesh, each structure is tuned (the kd-tree's depth and leaf size, the field's
+//! tile-BSP depth, timed at a small size), built at the settings kept, renders the AO image once
 //! (untimed; every structure's image must equal the first's bit for bit) and is then timed over
 //! `repeats` frames.
 
 use super::spec::{best_settings, AoMesh, AoSpec};
+use crate::accel::kdtree::KdSettings;
+use crate::accel::vlf::VlfSettings;
+use crate::accel::AccelSettings;
 use crate::render::cpu::CpuBackend;
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
@@ -69,8 +73,103 @@ pub fn camera() -> Camera {
     }
 }
 
-/// The scene of `mesh` indexed by `structure`, with the experiment's AO pass.
-pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, structure: &'static str) -> anyhow::Result<Scene> {
+/// One candidate of the tuning sweep, timed.
+#[derive(Clone, Debug)]
+pub struct TuningRow {
+    /// Mesh label.
+    pub mesh: String,
+    /// Structure name.
+    pub structure: &'static str,
+    /// Its parameters.
+    pub parameters: String,
+    /// Median frame seconds at the tuning size.
+    pub frame_seconds: f64,
+    /// Whether this candidate was kept.
+    pub chosen: bool,
+}
+
+/// The candidates the tuning sweep tries for `structure` (one, untuned, for the others).
+fn candidates(spec: &AoSpec, structure: &'static str) -> Vec<AccelSettings> {
+    let base = best_settings(structure);
+    match structure {
+        "kdtree" => spec
+            .tuning
+            .kdtree_depths
+            .iter()
+            .flat_map(|&max_depth| {
+                spec.tuning.kdtree_leaves.iter().map(move |&leaf_size| AccelSettings {
+                    kdtree: KdSettings { max_depth, leaf_size },
+                    ..best_settings(structure)
+                })
+            })
+            .collect(),
+        "vlf" => spec
+            .tuning
+            .vlf_depths
+            .iter()
+            .map(|&depth| AccelSettings {
+                vlf: VlfSettings { depth, ..base.vlf },
+                ..best_settings(structure)
+            })
+            .collect(),
+        _ => vec![base],
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The fastest of `structure`'s candidates on `mesh` at the tuning size, and every candidate's
+/// row (a single candidate is not timed).
+fn tune(
+    spec: &AoSpec,
+    mesh: &AoMesh,
+    structure: &'static str,
+    backend: &mut CpuBackend,
+) -> anyhow::Result<(AccelSettings, Vec<TuningRow>)> {
+    let all = candidates(spec, structure);
+    if all.len() == 1 {
+        return Ok((all[0].clone(), vec![]));
+    }
+    let mut rows = Vec::new();
+    let mut best: Option<(f64, AccelSettings)> = None;
+    for settings in all {
+        let scene = ao_scene(spec, mesh, settings.clone())?;
+        let view = View {
+            camera: &scene.cameras["ao"],
+            width: spec.tuning.width,
+            height: spec.tuning.height,
+        };
+        let t = median(backend.time(&scene, view, SAMPLING, 1, spec.tuning.frames)?.seconds);
+        rows.push(TuningRow {
+            mesh: mesh.name.clone(),
+            structure,
+            parameters: scene.accel.as_ref().expect("a structure").stats().parameters,
+            frame_seconds: t,
+            chosen: false,
+        });
+        if best.as_ref().is_none_or(|b| t < b.0) {
+            best = Some((t, settings));
+        }
+    }
+    let (t, settings) = best.expect("at least one candidate");
+    if let Some(r) = rows.iter_mut().find(|r| r.frame_seconds == t) {
+        r.chosen = true;
+    }
+    Ok((settings, rows))
+}
+
+/// The AO frames' sampling (the grid needs none; fixed for the record).
+const SAMPLING: Sampling = Sampling {
+    scheme: DiskScheme::Uniform,
+    pattern: Pattern::PerPixel,
+    seed: 1,
+};
+
+/// The scene of `mesh` indexed by the structure `settings` name, with the experiment's AO pass.
+pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, settings: AccelSettings) -> anyhow::Result<Scene> {
     let descriptor = Mesh {
         source: mesh.path.display().to_string(),
         file_fnv1a: mesh.file_fnv1a,
@@ -80,25 +179,25 @@ pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, structure: &'static str) -> anyhow
     };
     let scene = Scene::analytic(vec![], vec![], vec![])
         .with_cameras(BTreeMap::from([("ao".to_string(), camera())]))
-        .try_with_meshes(vec![descriptor], mesh.triangles.clone(), best_settings(structure))?
+        .try_with_meshes(vec![descriptor], mesh.triangles.clone(), settings)?
         .with_ambient(Some(spec.ao.clone()));
     Ok(scene)
 }
 
-/// Every mesh x structure of the experiment, in file order; `progress` hears each as it starts.
-pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<Vec<AoRow>> {
+/// Every mesh x structure of the experiment, in file order, each structure tuned per mesh
+/// first; `progress` hears each as it starts.
+pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(Vec<AoRow>, Vec<TuningRow>)> {
     let mut backend = CpuBackend::default();
-    let sampling = Sampling {
-        scheme: DiskScheme::Uniform,
-        pattern: Pattern::PerPixel,
-        seed: 1,
-    };
+    let sampling = SAMPLING;
     let mut rows = Vec::new();
+    let mut tuning = Vec::new();
     for mesh in &spec.meshes {
         let mut first: Option<Vec<f32>> = None;
         for &structure in &spec.structures {
             progress(&mesh.name, structure);
-            let scene = ao_scene(spec, mesh, structure)?;
+            let (settings, tried) = tune(spec, mesh, structure, &mut backend)?;
+            tuning.extend(tried);
+            let scene = ao_scene(spec, mesh, settings)?;
             let stats = scene.accel.as_ref().expect("a mesh scene has a structure").stats();
             let view = View {
                 camera: &scene.cameras["ao"],
@@ -127,5 +226,5 @@ pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<Ve
             });
         }
     }
-    Ok(rows)
+    Ok((rows, tuning))
 }

@@ -25,7 +25,28 @@ struct File {
     max_distance: f64,
     repeats: u32,
     structures: Vec<String>,
+    tuning: Tuning,
     meshes: Vec<MeshEntry>,
+}
+
+/// The small tuning sweep run per mesh before the timed frames, as the paper tuned each method
+/// per scene (CRT: BSP depth and leaf size; VLF-RT: tile-BSP depth): every candidate renders
+/// `frames` frames at `width` x `height`, and the fastest median is kept.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Tuning {
+    /// Tuning image size.
+    pub width: u32,
+    /// Tuning image size.
+    pub height: u32,
+    /// Timed frames per candidate.
+    pub frames: u32,
+    /// kd-tree maximum depths tried.
+    pub kdtree_depths: Vec<u32>,
+    /// kd-tree leaf sizes tried.
+    pub kdtree_leaves: Vec<u32>,
+    /// Visibility-field tile-BSP depths tried.
+    pub vlf_depths: Vec<u32>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -85,15 +106,18 @@ pub struct AoSpec {
     pub ao: AmbientOcclusion,
     /// Timed frames per mesh and structure (after one untimed frame that also gives the image).
     pub repeats: u32,
-    /// Registered structures to compare, each at its best settings ([`best_settings`]).
+    /// Registered structures to compare, each at its best settings ([`best_settings`], then
+    /// the tuning sweep's pick per mesh).
     pub structures: Vec<&'static str>,
+    /// The per-mesh tuning sweep.
+    pub tuning: Tuning,
     /// The meshes.
     pub meshes: Vec<AoMesh>,
 }
 
-/// Each structure at the settings its tuning found best: obvhs' slowest, best BVH build, the
-/// kd-tree's measured best (`KdSettings::default`) and the paper's visibility field (513 lines,
-/// 128 x 128 tiles, depth 4).
+/// Each structure at its best settings before the per-mesh tuning: obvhs' slowest, best BVH
+/// build, the kd-tree's best on the cow and bull (`KdSettings::default`) and the paper's
+/// visibility field (513 lines, 128 x 128 tiles, depth 4).
 pub fn best_settings(structure: &'static str) -> AccelSettings {
     AccelSettings {
         name: structure,
@@ -164,6 +188,30 @@ impl AoSpec {
         if f.repeats == 0 {
             return Err(err(&key_path!["repeats"], "at least one timed frame".into()));
         }
+        let t = &f.tuning;
+        for (k, v) in [("width", t.width), ("height", t.height)] {
+            if !(1..=16384).contains(&v) {
+                return Err(err(&key_path!["tuning", k], format!("must be in 1..=16384, got {v}")));
+            }
+        }
+        if t.frames == 0 {
+            return Err(err(&key_path!["tuning", "frames"], "at least one timed frame".into()));
+        }
+        for (k, values, lo, hi) in [
+            ("kdtree_depths", &t.kdtree_depths, 0, crate::accel::kdtree::MAX_DEPTH),
+            ("kdtree_leaves", &t.kdtree_leaves, 0, 1 << 16),
+            ("vlf_depths", &t.vlf_depths, 0, 6),
+        ] {
+            if values.is_empty() {
+                return Err(err(&key_path!["tuning", k], "list at least one value".into()));
+            }
+            if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !(lo..=hi).contains(*v)) {
+                return Err(err(
+                    &key_path!["tuning", k, i],
+                    format!("must lie in {lo}..={hi}, got {v}"),
+                ));
+            }
+        }
         if f.structures.is_empty() {
             return Err(err(&key_path!["structures"], "name at least one structure".into()));
         }
@@ -221,6 +269,7 @@ impl AoSpec {
             },
             repeats: f.repeats,
             structures,
+            tuning: f.tuning,
             meshes,
         })
     }
