@@ -2,7 +2,8 @@
 //! converge on the exact answers of known-facts.md (plain: cos(alpha); cosine-weighted:
 //! 1 - (R/d)^2 cos(theta)); the 513-line grid's own quadrature error is measured against them;
 //! every structure gives the same image on a triangulated sphere; the maximum distance bounds
-//! what occludes; the pass runs only where the scene asks; bad values are located errors.
+//! what occludes; the pass runs only where the scene asks; bad values are located errors; the
+//! GPU's pass agrees with the CPU's.
 
 mod common;
 
@@ -315,16 +316,79 @@ fn the_pass_runs_only_where_asked_and_bad_values_are_located() {
     }
 }
 
+/// The GPU's AO (f32, render.wgsl) against the CPU's (f64) on the same scenes and rays: the same
+/// ray counts and, per receiver, the same value but where f32 decides a grazing ray otherwise;
+/// and against the exact answer on the plane.
 #[test]
-fn the_gpu_backend_refuses_ambient_occlusion_rather_than_skip_it() {
+fn the_gpu_pass_matches_the_cpu_and_the_exact_answer() {
     let Some(mut gpu) = common::gpu() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let s = scene(dir.path(), "directions = \"grid\"\nrays = 513", None).unwrap();
-    let view = View {
-        camera: &s.cameras["top"],
-        width: SIZE,
-        height: SIZE,
-    };
-    let e = gpu.render(&s, view, SAMPLING).unwrap_err();
-    assert!(format!("{e:#}").contains("--backend cpu"), "{e:#}");
+    uv_sphere(&dir.path().join("ball.obj"));
+    // (the `[ambient_occlusion]` table, the mesh and its structure if any, cosine weighting)
+    type Case<'a> = (String, Option<(&'a str, &'a str)>, bool);
+    let cases: Vec<Case> = vec![
+        ("directions = \"grid\"\nrays = 513".into(), None, false),
+        (
+            "directions = \"grid\"\nrays = 513\nweighting = \"cosine\"".into(),
+            None,
+            true,
+        ),
+        ("directions = \"jittered\"\nrays = 256".into(), None, false),
+        (
+            "directions = \"sobol\"\nrays = 256\nweighting = \"cosine\"".into(),
+            None,
+            true,
+        ),
+        (
+            "directions = \"grid\"\nrays = 513\nmax_distance = 0.8".into(),
+            None,
+            false,
+        ),
+        (
+            "directions = \"grid\"\nrays = 513".into(),
+            Some(("ball.obj", "bvh")),
+            false,
+        ),
+        (
+            "directions = \"grid\"\nrays = 513".into(),
+            Some(("ball.obj", "vlf")),
+            false,
+        ),
+        (
+            "directions = \"grid\"\nrays = 513".into(),
+            Some(("ball.obj", "kdtree")),
+            false,
+        ),
+    ];
+    for (ao, mesh, cosine) in cases {
+        let s = scene(dir.path(), &ao, mesh).unwrap();
+        let view = View {
+            camera: &s.cameras["top"],
+            width: SIZE,
+            height: SIZE,
+        };
+        let sampling = Sampling {
+            scheme: DiskScheme::Jittered,
+            pattern: Pattern::PerPixel,
+            seed: 7,
+        };
+        let g = gpu.render(&s, view, sampling).unwrap();
+        let c = CpuBackend::default().render(&s, view, sampling).unwrap();
+        assert_eq!(g.hit, c.hit, "{ao} {mesh:?}");
+        assert_eq!(g.rays.ambient, c.rays.ambient, "{ao} {mesh:?}");
+        let (ga, ca) = (g.ambient.as_ref().unwrap(), c.ambient.unwrap());
+        let diff: Vec<f32> = ga.iter().zip(&ca).map(|(a, b)| (a - b).abs()).collect();
+        let off = diff.iter().filter(|&&d| d > 1e-5).count();
+        let worst = diff.iter().cloned().fold(0.0, f32::max);
+        eprintln!("{ao} {mesh:?}: {off} of {} pixels differ, worst {worst}", diff.len());
+        // A differently decided ray moves a pixel by one ray's weight (1/256 at most here).
+        assert!(
+            off * 20 <= diff.len() && worst <= 2.5 / 256.0,
+            "{ao} {mesh:?}: {off} pixels off, worst {worst}"
+        );
+        if mesh.is_none() && !ao.contains("max_distance") {
+            let (mean, _, _) = errors(&s, &g, cosine);
+            assert!(mean < 0.015, "{ao}: GPU mean error {mean}");
+        }
+    }
 }

@@ -1,5 +1,5 @@
-//! Runs an ambient-occlusion experiment on the f64 CPU backend (the GPU backend has no AO pass
-//! yet): per mesh, each structure is tuned (the kd-tree's depth and leaf size, the field's
+//! Runs an ambient-occlusion experiment on the f64 CPU backend, where every structure answers
+//! exactly (the GPU's f32 walks may decide a grazing ray differently): per mesh, each structure is tuned (the kd-tree's depth and leaf size, the field's
 //! tile-BSP depth, timed at a small size), built at the settings kept, renders the AO image once
 //! (untimed; every structure's image must equal the first's bit for bit) and is then timed over
 //! `repeats` frames.

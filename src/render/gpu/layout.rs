@@ -4,8 +4,10 @@
 
 use crate::accel::GpuStructure;
 use crate::geometry::LocalFrame;
+use crate::render::ambient::AMBIENT_STREAM;
 use crate::render::{Sampling, View};
 use crate::sampling::{shared_points, Pattern};
+use crate::scene::ambient::{AoDirections, Weighting};
 use crate::scene::{Light, Scene, Shape};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -30,7 +32,30 @@ pub struct Params {
     pub half_y: f32,
     pub cam_forward: [f32; 3],
     pub triangle_count: u32,
-    pub _pad: [u32; 4],
+    /// Ambient-occlusion rays per receiver (0: no AO pass).
+    pub ao_rays: u32,
+    /// [`AoMode`] as its number.
+    pub ao_mode: u32,
+    /// The AO disk scheme's id (disk modes).
+    pub ao_scheme: u32,
+    /// Farthest AO occluder, local units (infinite: none).
+    pub ao_max_distance: f32,
+}
+
+/// How the AO kernel makes and weights its directions (`AO_*` in render.wgsl).
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AoMode {
+    /// No AO pass.
+    None = 0,
+    /// Grid lines from `ao_dirs`, oriented into the hemisphere, counted.
+    GridPlain = 1,
+    /// Grid lines, cosine-weighted.
+    GridCosine = 2,
+    /// Disk points lifted by the equal-area map, counted.
+    DiskPlain = 3,
+    /// Disk points lifted by Malley's projection, counted.
+    DiskCosine = 4,
 }
 
 /// A mesh triangle's shading data, in input order: the edges give the geometric normal exactly
@@ -142,6 +167,8 @@ pub struct Packed {
     pub lights: Vec<GpuLight>,
     pub shared: Vec<[f32; 2]>,
     pub mesh_tris: Vec<GpuMeshTri>,
+    /// AO directions: the grid's lines (xyz) or the shared disk points (xy); empty otherwise.
+    pub ao_dirs: Vec<[f32; 4]>,
     /// The acceleration structure's name and buffers; None without triangles.
     pub accel: Option<(&'static str, GpuStructure)>,
 }
@@ -149,10 +176,6 @@ pub struct Packed {
 /// Packs a scene, view and sampling choice into GPU structs; fails where the scene's
 /// acceleration structure exceeds a limit of its GPU form.
 pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Packed> {
-    anyhow::ensure!(
-        scene.ambient.is_none(),
-        "the GPU backend has no ambient-occlusion pass yet; render this scene with --backend cpu"
-    );
     let local = local_frame(scene, view);
     let (frame, (hx, hy), ortho) = view.camera.gpu_terms(view.width, view.height);
     // Perspective half extents are tangents (unitless); orthographic ones are lengths.
@@ -161,7 +184,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
     } else {
         (hx, hy)
     };
-    let params = Params {
+    let mut params = Params {
         width: view.width,
         height: view.height,
         sphere_count: scene.spheres().count() as u32,
@@ -178,8 +201,41 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         half_y: hy as f32,
         cam_forward: dir(frame.forward),
         triangle_count: scene.triangles.positions.len() as u32,
-        _pad: [0; 4],
+        ao_rays: 0,
+        ao_mode: AoMode::None as u32,
+        ao_scheme: 0,
+        ao_max_distance: f32::INFINITY,
     };
+    let mut ao_dirs = Vec::new();
+    if let Some(ao) = &scene.ambient {
+        params.ao_rays = ao.rays;
+        params.ao_max_distance = local.length(ao.max_distance);
+        params.ao_mode = match (&ao.directions, ao.weighting) {
+            (AoDirections::Grid { lines, .. }, w) => {
+                ao_dirs = lines
+                    .iter()
+                    .map(|l| [l.x as f32, l.y as f32, l.z as f32, 0.0])
+                    .collect();
+                match w {
+                    Weighting::Plain => AoMode::GridPlain,
+                    Weighting::Cosine => AoMode::GridCosine,
+                }
+            }
+            (AoDirections::Disk(scheme), w) => {
+                params.ao_scheme = scheme.gpu_id();
+                if sampling.pattern == Pattern::Shared {
+                    ao_dirs = shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM)
+                        .iter()
+                        .map(|p| [p.x as f32, p.y as f32, 0.0, 0.0])
+                        .collect();
+                }
+                match w {
+                    Weighting::Plain => AoMode::DiskPlain,
+                    Weighting::Cosine => AoMode::DiskCosine,
+                }
+            }
+        } as u32;
+    }
     let (mut spheres, mut planes) = (vec![], vec![]);
     for (id, shape) in scene.shapes.iter().enumerate() {
         let object = id as u32;
@@ -268,6 +324,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         lights,
         shared,
         mesh_tris,
+        ao_dirs,
         accel,
     })
 }

@@ -2,8 +2,9 @@
 //!
 //! Setup (adapter, device with the adapter's real limits, pipelines, the loop-cap probe) happens
 //! once in [`GpuBackend::new`]; the scene's geometry is uploaded once and stays resident
-//! ([`resources`]); each frame runs the plan's passes (primary, then one shadow pass per light,
-//! in one dispatch or, on adapters that cap loop iterations, several) with a timestamp pair
+//! ([`resources`]); each frame runs the plan's passes (primary, then one shadow pass per light
+//! and the ambient-occlusion pass where the scene asks, each in one dispatch or, on adapters
+//! that cap loop iterations, several) with a timestamp pair
 //! around each pass when the adapter supports timestamp queries, and reads the outputs back.
 
 #[cfg(feature = "test-hooks")]
@@ -15,7 +16,7 @@ mod resources;
 mod timing;
 
 use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
-use super::{AdapterInfo, Backend, Frame, RayCounts, Sampling, Timing, View};
+use super::{AdapterInfo, Backend, Frame, RayCounts, Sampling, Timing, View, NO_HIT};
 use anyhow::{anyhow, bail, Context};
 use layout::{pack, HIT_BYTES};
 use pipelines::{Layouts, PipelineCache, NO_ACCEL};
@@ -31,9 +32,9 @@ pub use pipelines::scheme_prelude;
 /// How long one frame may run before it is reported as a GPU timeout.
 pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 
-/// u32 words of the counters buffer: per light, shadow rays as (low, high) words; then the
-/// count of invocations whose loops were cut short.
-pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 1;
+/// u32 words of the counters buffer: per light, shadow rays as (low, high) words; the count of
+/// invocations whose loops were cut short; ambient-occlusion rays as (low, high) words.
+pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 3;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
 
@@ -159,6 +160,7 @@ impl GpuBackend {
                 "mesh triangle buffer",
                 std::mem::size_of_val(packed.mesh_tris.as_slice()) as u64,
             ),
+            ("ambient-occlusion buffer", view.pixels() as u64 * 8),
         ];
         if let Some((_, s)) = &packed.accel {
             buffers.extend(s.buffers.iter().map(|(label, b)| (*label, b.len() as u64)));
@@ -183,6 +185,7 @@ impl GpuBackend {
         let p = self.pipelines.get(&self.device, &self.layouts, r.accel, CUT_SHORT_SLOT);
         encoder.clear_buffer(&r.counters, 0, None);
         encoder.clear_buffer(&r.visibility, 0, None);
+        encoder.clear_buffer(&r.ambient, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
         for (index, pass) in plan.passes.iter().enumerate() {
             let timestamp_writes = r.queries.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
@@ -198,7 +201,7 @@ impl GpuBackend {
             let (pipeline, chunks) = match pass {
                 Pass::Primary { .. } => (&p.primary, &r.passes[0][..1]),
                 Pass::Shadow { light, .. } => (&p.shadow, &r.passes[*light][..]),
-                Pass::Ambient { .. } => unreachable!("`pack` refuses scenes with ambient occlusion"),
+                Pass::Ambient { .. } => (&p.ambient, &r.ambient_passes[..]),
             };
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
@@ -332,13 +335,31 @@ impl Backend for GpuBackend {
         for (i, s) in rays.shadow.iter_mut().enumerate() {
             *s = counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
         }
+        let hit: Vec<u32> = hits.chunks((HIT_BYTES / 4) as usize).map(|h| h[3]).collect();
+        let ambient = match scene.ambient {
+            Some(_) => {
+                rays.ambient = counters[CUT_SHORT_SLOT + 1] as u64 | ((counters[CUT_SHORT_SLOT + 2] as u64) << 32);
+                let sums: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.ambient, pixels as u64 * 8)?);
+                Some(
+                    sums.chunks(2)
+                        .zip(&hit)
+                        .map(|(s, &h)| match h {
+                            NO_HIT => super::NO_RECEIVER,
+                            _ if s[1] > 0.0 => s[0] / s[1],
+                            _ => 1.0,
+                        })
+                        .collect(),
+                )
+            }
+            None => None,
+        };
         Ok(Frame {
             width: view.width,
             height: view.height,
             radiance,
             visibility: vis.chunks(pixels.max(1)).map(<[f32]>::to_vec).collect(),
-            hit: hits.chunks((HIT_BYTES / 4) as usize).map(|h| h[3]).collect(),
-            ambient: None,
+            hit,
+            ambient,
             rays,
         })
     }

@@ -47,6 +47,7 @@ pub(super) struct Pipelines {
     pub accel: wgpu::BindGroupLayout,
     pub primary: wgpu::ComputePipeline,
     pub shadow: wgpu::ComputePipeline,
+    pub ambient: wgpu::ComputePipeline,
     #[cfg(feature = "test-hooks")]
     hooks: Option<(wgpu::ComputePipeline, wgpu::ComputePipeline)>,
 }
@@ -85,6 +86,7 @@ impl Layouts {
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
         entries.push(storage(9, true));
+        entries.extend([storage(10, true), storage(11, false)]);
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -211,6 +213,7 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
     Pipelines {
         primary: entry(device, &module, "primary", &layout),
         shadow: entry(device, &module, "shadow", &layout),
+        ambient: entry(device, &module, "ambient", &layout),
         accel,
         #[cfg(feature = "test-hooks")]
         hooks: None,

@@ -13,6 +13,9 @@ use crate::render::View;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
+/// `PassInfo.light` of the AO pass's dispatches (no light has this index).
+const AMBIENT_PASS: u32 = u32::MAX;
+
 /// The scene's static buffers and the hash of the packed content they hold.
 pub(super) struct SceneBuffers {
     key: u64,
@@ -35,6 +38,10 @@ pub(super) struct FrameResources {
     pub hits: wgpu::Buffer,
     pub visibility: wgpu::Buffer,
     pub radiance: wgpu::Buffer,
+    /// Per pixel, the AO pass's (unoccluded, total) weights.
+    pub ambient: wgpu::Buffer,
+    /// One bind group per dispatch of the AO pass's rays (none without the pass).
+    pub ambient_passes: Vec<wgpu::BindGroup>,
     pub counters: wgpu::Buffer,
     pub queries: Option<(wgpu::QuerySet, wgpu::Buffer)>,
     /// The acceleration structure (selects the pipelines) and its bind group.
@@ -160,6 +167,9 @@ impl GpuBackend {
         );
         let radiance = self.output("radiance", pixels * 4);
         let counters = self.output("ray counters", COUNTER_WORDS as u64 * 4);
+        let ao_dirs = self.storage("ambient-occlusion directions", &packed.ao_dirs, [0f32; 4]);
+        let ao_on = packed.params.ao_rays > 0;
+        let ambient = self.output("ambient occlusion", if ao_on { pixels * 8 } else { 16 });
         let buffers = [
             &params,
             &s.spheres,
@@ -171,6 +181,8 @@ impl GpuBackend {
             &radiance,
             &counters,
             &s.mesh_tris,
+            &ao_dirs,
+            &ambient,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -201,8 +213,16 @@ impl GpuBackend {
                     .collect()
             })
             .collect();
+        // AO rays take the shadow samples' chunk: each costs one point and one occlusion query.
+        let ambient_passes = (0..if ao_on {
+            packed.params.ao_rays.div_ceil(chunk)
+        } else {
+            0
+        })
+            .map(|c| self.pass_info(AMBIENT_PASS, c * chunk, chunk))
+            .collect();
         let queries = self.timestamps.then(|| {
-            let count = 2 * (packed.lights.len() as u32 + 1);
+            let count = 2 * (packed.lights.len() as u32 + 1 + ao_on as u32);
             let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("timestamps"),
                 ty: wgpu::QueryType::Timestamp,
@@ -222,6 +242,8 @@ impl GpuBackend {
             hits,
             visibility,
             radiance,
+            ambient,
+            ambient_passes,
             counters,
             queries,
             accel: s.accel,

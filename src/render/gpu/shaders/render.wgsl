@@ -1,5 +1,6 @@
-// The render plan's passes: `primary` (camera rays, closest hit) and `shadow` (per light, one
-// dispatch per chunk of its samples, any-hit with early exit). Mirrors src/render/cpu.rs and
+// The render plan's passes: `primary` (camera rays, closest hit), `shadow` (per light, one
+// dispatch per chunk of its samples, any-hit with early exit) and `ambient` (where the scene
+// asks for ambient occlusion, one dispatch per chunk of its rays). Mirrors src/render/cpu.rs and
 // src/render/shading.rs in f32, in coordinates re-based on the camera's look-at point so that
 // large translations cost nothing. Shapes' structs and tests come from src/scene/shape/*.wgsl,
 // mesh queries from the scene's acceleration structure (accel_closest, accel_any).
@@ -21,10 +22,10 @@ struct Params {
     half_y: f32,
     cam_forward: vec3<f32>,
     triangle_count: u32,
-    _q0: u32,
-    _q1: u32,
-    _q2: u32,
-    _q3: u32,
+    ao_rays: u32,
+    ao_mode: u32,
+    ao_scheme: u32,
+    ao_max_distance: f32,
 }
 
 struct Light {
@@ -84,13 +85,19 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(7) var<storage, read_write> radiance: array<f32>;
 @group(0) @binding(8) var<storage, read_write> counters: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read> mesh_tris: array<MeshTri>;
+@group(0) @binding(10) var<storage, read> ao_dirs: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> ambient_out: array<f32>;
 @group(1) @binding(0) var<uniform> pass_info: PassInfo;
 
 // Any-hit along origin -> origin + d, skipping the receiver's own sphere or plane (`skip`) or
 // triangle (`skip_tri`); see shading::Receiver for why.
 fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
     let len = length(d);
-    let dir = d / len;
+    return blocked(origin, d / len, len, skip, skip_tri);
+}
+
+// Any-hit along origin + t dir, 0 < t < len (len may be infinite), with the same skips.
+fn blocked(origin: vec3<f32>, dir: vec3<f32>, len: f32, skip: u32, skip_tri: u32) -> bool {
     var i = 0u;
     for (; i < params.sphere_count; i++) {
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
@@ -263,6 +270,92 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     visibility[out] += vis;
     radiance[pixel] += hit.albedo / PI * irradiance;
     add_rays(li, rays);
+    if (cut_short) {
+        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
+    }
+}
+
+// Ambient occlusion (src/render/ambient.rs in f32): rays `first_sample ..` of the pass's chunk
+// into the hemisphere of each receiver, any-hit up to `ao_max_distance`. Chunks accumulate
+// (unoccluded weight, total weight) per pixel; the host divides.
+const AO_GRID_PLAIN: u32 = 1u;
+const AO_GRID_COSINE: u32 = 2u;
+const AO_DISK_PLAIN: u32 = 3u;
+const AMBIENT_STREAM: u32 = 0x414fu;
+const AO_RAYS_SLOT: u32 = CUT_SHORT_SLOT + 1u;
+
+// An orthonormal (t, b) completing unit n (Duff et al. 2017), as tangent_basis in ambient.rs.
+fn tangent_basis(n: vec3<f32>) -> mat2x3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(
+        vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        vec3<f32>(b, sign + n.y * n.y * a, -n.y),
+    );
+}
+
+@compute @workgroup_size(8, 8)
+fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    let hit = hits[pixel];
+    if (hit.object == NO_HIT) {
+        return;
+    }
+    let p = hit.position;
+    let n = hit.normal;
+    let origin = select(p, offset_origin(p, n), hit.triangle != NO_HIT);
+    let tb = tangent_basis(n);
+    let stream = stream_pixel(params.seed, AMBIENT_STREAM, pixel);
+    let grid = params.ao_mode == AO_GRID_PLAIN || params.ao_mode == AO_GRID_COSINE;
+    var seen = 0.0;
+    var total = 0.0;
+    let first = pass_info.first_sample;
+    let last = min(first + pass_info.sample_count, params.ao_rays);
+    var k = first;
+    for (; k < last; k++) {
+        var d: vec3<f32>;
+        var w = 1.0;
+        if (grid) {
+            let l = ao_dirs[k].xyz;
+            let c = dot(l, n);
+            d = select(l, -l, c < 0.0);
+            if (params.ao_mode == AO_GRID_COSINE) {
+                w = abs(c);
+            }
+        } else {
+            var s: vec2<f32>;
+            if (params.shared_pattern != 0u) {
+                s = ao_dirs[k].xy;
+            } else {
+                s = disk_point(params.ao_scheme, params.ao_rays, k, stream);
+            }
+            let r2 = min(dot(s, s), 1.0);
+            var l: vec3<f32>;
+            if (params.ao_mode == AO_DISK_PLAIN) {
+                let q = sqrt(2.0 - r2);
+                l = vec3<f32>(s.x * q, s.y * q, 1.0 - r2);
+            } else {
+                l = vec3<f32>(s.x, s.y, sqrt(1.0 - r2));
+            }
+            d = tb[0] * l.x + tb[1] * l.y + n * l.z;
+        }
+        total += w;
+        if (!blocked(origin, d, params.ao_max_distance, hit.object, hit.triangle)) {
+            seen += w;
+        }
+    }
+    cut_short = cut_short || k < last;
+    ambient_out[2u * pixel] += seen;
+    ambient_out[2u * pixel + 1u] += total;
+    let rays = select(0u, last - first, last > first);
+    let old = atomicAdd(&counters[AO_RAYS_SLOT], rays);
+    if (old + rays < old) {
+        atomicAdd(&counters[AO_RAYS_SLOT + 1u], 1u);
+    }
     if (cut_short) {
         atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
     }
