@@ -72,7 +72,7 @@ fn bad_input_is_located_and_writes_nothing() {
 }
 
 #[test]
-fn the_verdict_reports_images_that_differ() {
+fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
     let spec = AoSpec::load(&common::repo("experiments/ao-ci.toml")).unwrap();
     let mut small = spec.clone();
     small.meshes.truncate(1);
@@ -83,4 +83,18 @@ fn the_verdict_reports_images_that_differ() {
     assert!(verdict(&small, &rows).contains("equals"));
     rows[1].same_image = false;
     assert!(verdict(&small, &rows).contains("does NOT equal"));
+    // Speed-ups from hand-set frame times: apart, and within noise.
+    rows[0].frame_seconds = vec![2.0, 2.1, 1.9, 2.0];
+    rows[1].frame_seconds = vec![1.0, 1.1, 0.9, 1.0];
+    let v = verdict(&small, &rows);
+    assert!(
+        v.contains("faster on 1 of 1 meshes and slower on 0") && v.contains("cow 2.00x, median 2.00x"),
+        "{v}"
+    );
+    rows[1].frame_seconds = vec![1.9, 2.2, 1.8, 2.1];
+    let v = verdict(&small, &rows);
+    assert!(
+        v.contains("faster on 0 of 1 meshes and slower on 0") && v.contains("(within noise)"),
+        "{v}"
+    );
 }

@@ -1,6 +1,6 @@
-//! The visibility field's WGSL walk against the BVH's WGSL walk on the same GPU, over the shipped
-//! meshes: both test the same f32 triangles with the same `triangle_t`, so any ray on which
-//! they disagree (hit or miss, triangle, t) is a candidate the field's walk dropped. Ray kinds:
+//! The visibility field's WGSL walk (and the kd-tree's) against the BVH's WGSL walk on the same
+//! GPU, over the shipped meshes: all test the same f32 triangles with the same `triangle_t`, so
+//! any ray on which they disagree (hit or miss, triangle, t) is a candidate a walk dropped. Ray kinds:
 //! random segments, AO rays along the field's own grid directions and in random directions,
 //! shadow rays to a 4 cm disk light, camera rays; 100K of each on every shipped mesh and on the
 //! body. About 80 s on lavapipe (2 cores), the fields' builds included.
@@ -82,22 +82,25 @@ fn check(name: &str, t: &Triangles) {
     let rays = rays(t);
     let probes: Vec<_> = rays.iter().map(|&(_, o, d, tmax)| (o, d, tmax)).collect();
     let bvh: Vec<ProbeHit> = gpu.probe(&common::triangles_scene(t, "bvh"), &probes).unwrap();
-    let vlf: Vec<ProbeHit> = gpu.probe(&common::triangles_scene(t, "vlf"), &probes).unwrap();
     let mut hits = std::collections::BTreeMap::<&str, (u32, u32)>::new();
-    for ((kind, ..), (b, v)) in rays.iter().zip(bvh.iter().zip(&vlf)) {
-        let entry = hits.entry(kind).or_default();
-        entry.0 += b.any as u32;
-        entry.1 += 1;
-        assert_eq!(v.any, b.any, "{name} {kind}: any-hit differs");
-        match (v.closest, b.closest) {
-            // Equal t on two triangles (a shared edge): the field takes the lower index, the
-            // BVH the first it meets.
-            (Some((tv, iv)), Some((tb, ib))) => assert!(
-                tv == tb && iv <= ib,
-                "{name} {kind}: closest ({tv}, {iv}) vs BVH ({tb}, {ib})"
-            ),
-            (None, None) => {}
-            (v, b) => panic!("{name} {kind}: closest {v:?} vs BVH {b:?}"),
+    // The field, and the kd-tree (whose WGSL walk is checked here on whole meshes).
+    for structure in ["vlf", "kdtree"] {
+        let other: Vec<ProbeHit> = gpu.probe(&common::triangles_scene(t, structure), &probes).unwrap();
+        for ((kind, ..), (b, v)) in rays.iter().zip(bvh.iter().zip(&other)) {
+            let entry = hits.entry(kind).or_default();
+            entry.0 += b.any as u32;
+            entry.1 += 1;
+            assert_eq!(v.any, b.any, "{name} {structure} {kind}: any-hit differs");
+            match (v.closest, b.closest) {
+                // Equal t on two triangles (a shared edge): the field and the kd-tree take the
+                // lower index, the BVH the first it meets.
+                (Some((tv, iv)), Some((tb, ib))) => assert!(
+                    tv == tb && iv <= ib,
+                    "{name} {structure} {kind}: closest ({tv}, {iv}) vs BVH ({tb}, {ib})"
+                ),
+                (None, None) => {}
+                (v, b) => panic!("{name} {structure} {kind}: closest {v:?} vs BVH {b:?}"),
+            }
         }
     }
     for (kind, (hit, n)) in hits {

@@ -180,9 +180,14 @@ impl Builder<'_> {
 }
 
 impl KdTree {
-    /// Builds the tree over `triangles` (all of them: degenerate ones are simply never hit).
+    /// Builds the tree over `triangles` (all of them: degenerate ones are simply never hit), no
+    /// deeper than [`MAX_DEPTH`] whatever `settings` ask (the walks' stacks hold that much).
     pub fn build(triangles: &Triangles, settings: KdSettings) -> KdTree {
         let started = Instant::now();
+        let settings = KdSettings {
+            max_depth: settings.max_depth.min(MAX_DEPTH),
+            ..settings
+        };
         let boxes: Vec<(DVec3, DVec3)> = triangles.positions.iter().map(bounds_of).collect();
         let bounds = boxes
             .iter()

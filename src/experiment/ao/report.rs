@@ -5,6 +5,7 @@
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
 use crate::files::write_atomic;
+use crate::metrics::stats::median;
 use crate::output::images::{grey, write_png};
 use crate::output::plots::{line_plot, Axes, Series};
 use crate::output::table::{float, write_rows};
@@ -39,24 +40,23 @@ fn find<'a>(rows: &'a [AoRow], mesh: &str, structure: &str) -> Option<&'a AoRow>
     rows.iter().find(|r| r.mesh == mesh && r.structure == structure)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The verdict on the paper's claims, from the rows: VLF-RT against the CRT-like kd-tree and
 /// against the BVH, with the memory and build time it costs.
 pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     let mut out = String::new();
-    let ratio = |a: &str, b: &str| -> Vec<(String, f64)> {
+    // (mesh, speed-up of `a` over `b`, whether their frame times' interquartile ranges are
+    // disjoint: a difference beyond the noise of the rounds)
+    let ratio = |a: &str, b: &str| -> Vec<(String, f64, bool)> {
         spec.meshes
             .iter()
             .filter_map(|m| {
                 let (x, y) = (find(rows, &m.name, a)?, find(rows, &m.name, b)?);
-                Some((m.name.clone(), y.median_seconds() / x.median_seconds()))
+                let ((x1, x3), (y1, y3)) = (x.quartile_seconds(), y.quartile_seconds());
+                Some((
+                    m.name.clone(),
+                    y.median_seconds() / x.median_seconds(),
+                    x3 < y1 || y3 < x1,
+                ))
             })
             .collect()
     };
@@ -81,13 +81,17 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
         if r.is_empty() {
             continue;
         }
-        let faster = r.iter().filter(|(_, x)| *x > 1.0).count();
-        let listed: Vec<String> = r.iter().map(|(m, x)| format!("{m} {x:.2}x")).collect();
+        let faster = r.iter().filter(|(_, x, apart)| *x > 1.0 && *apart).count();
+        let slower = r.iter().filter(|(_, x, apart)| *x < 1.0 && *apart).count();
+        let listed: Vec<String> = r
+            .iter()
+            .map(|(m, x, apart)| format!("{m} {x:.2}x{}", if *apart { "" } else { " (within noise)" }))
+            .collect();
         out += &format!(
-            "- **VLF-RT vs {label}**: faster on {faster} of {} meshes; speed-up (their frame time / VLF-RT's) {}, median {:.2}x{}.\n",
+            "- **VLF-RT vs {label}**: faster on {faster} of {} meshes and slower on {slower}, counting only frame times whose interquartile ranges are disjoint; speed-up (their median frame time / VLF-RT's) {}, median {:.2}x{}.\n",
             r.len(),
             listed.join(", "),
-            median(r.iter().map(|x| x.1).collect()),
+            median(&r.iter().map(|x| x.1).collect::<Vec<_>>()),
             paper.map_or(String::new(), |p| format!(" (the paper: {p})"))
         );
     }
@@ -229,7 +233,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
         spec.name
     );
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each method is first tuned per mesh, as the paper tuned both (the kd-tree over maximum depths {:?} and leaf sizes {:?}, the field over tile-BSP depths {:?}; {} timed frames each at {}x{}, `tuning.csv`), then the kept settings render one untimed frame, which gives the image, and {} timed frames; the frame time is their median, rays/s count camera and AO rays.\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each method is first tuned per mesh, as the paper tuned both (the kd-tree over maximum depths {:?} and leaf sizes {:?}, the field over tile-BSP depths {:?}; {} timed frames each at {}x{}, `tuning.csv`), then the kept settings render one untimed frame, which gives the image, and every structure of a mesh is timed in {} interleaved rounds (a fresh seeded order each); the frame time is their median (quartiles beside it), rays/s count camera and AO rays.\n\n",
         spec.path.display(),
         seconds,
         spec.width,
@@ -247,7 +251,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
     );
     md += "## Verdict\n\n";
     md += &verdict(spec, rows);
-    md += "\n## Ours\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | vs kdtree | vs bvh | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "\n## Ours\n\n| mesh | triangles | structure | parameters | build s | MB | frame s (q1-q3) | Mrays/s | vs kdtree | vs bvh | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let vs = |s: &str| {
             find(rows, &r.mesh, s).map_or("n/a".to_string(), |b| {
@@ -255,7 +259,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             })
         };
         md += &format!(
-            "| {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {:.2} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {:.2} | {:.1} | {:.3} ({:.3}-{:.3}) | {:.2} | {} | {} | {} |\n",
             r.mesh,
             r.triangles,
             r.structure,
@@ -263,6 +267,8 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             r.build_seconds,
             r.memory_bytes as f64 / 1e6,
             r.median_seconds(),
+            r.quartile_seconds().0,
+            r.quartile_seconds().1,
             r.mrays_per_s(),
             vs("kdtree"),
             vs("bvh"),

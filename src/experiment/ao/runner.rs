@@ -1,8 +1,8 @@
 //! Runs an ambient-occlusion experiment on the f64 CPU backend, where every structure answers
 //! exactly (the GPU's f32 walks may decide a grazing ray differently): per mesh, each structure is tuned (the kd-tree's depth and leaf size, the field's
-//! tile-BSP depth, timed at a small size), built at the settings kept, renders the AO image once
-//! (untimed; every structure's image must equal the first's bit for bit) and is then timed over
-//! `repeats` frames.
+//! tile-BSP depth, timed at a small size), built at the settings kept and renders the AO image
+//! once (untimed; every structure's image must equal the first's bit for bit); then the mesh's
+//! structures are timed in `repeats` interleaved rounds.
 
 use super::spec::{best_settings, AoMesh, AoSpec};
 use crate::accel::kdtree::KdSettings;
@@ -10,6 +10,7 @@ use crate::accel::vlf::VlfSettings;
 use crate::accel::AccelSettings;
 use crate::render::cpu::CpuBackend;
 use crate::render::{Backend, Sampling, View};
+use crate::sampling::rng::pcg;
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Mesh, Scene};
@@ -48,9 +49,13 @@ pub struct AoRow {
 impl AoRow {
     /// Median frame time, seconds.
     pub fn median_seconds(&self) -> f64 {
-        let mut v = self.frame_seconds.clone();
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
+        crate::metrics::stats::median(&self.frame_seconds)
+    }
+
+    /// First and third quartiles of the frame time, seconds.
+    pub fn quartile_seconds(&self) -> (f64, f64) {
+        let (q1, _, q3) = crate::metrics::stats::quartiles(&self.frame_seconds);
+        (q1, q3)
     }
 
     /// Rays (camera and AO) per second at the median frame time, millions.
@@ -116,11 +121,6 @@ fn candidates(spec: &AoSpec, structure: &'static str) -> Vec<AccelSettings> {
     }
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The fastest of `structure`'s candidates on `mesh` at the tuning size, and every candidate's
 /// row (a single candidate is not timed).
 fn tune(
@@ -142,7 +142,7 @@ fn tune(
             width: spec.tuning.width,
             height: spec.tuning.height,
         };
-        let t = median(backend.time(&scene, view, SAMPLING, 1, spec.tuning.frames)?.seconds);
+        let t = crate::metrics::stats::median(&backend.time(&scene, view, SAMPLING, 1, spec.tuning.frames)?.seconds);
         rows.push(TuningRow {
             mesh: mesh.name.clone(),
             structure,
@@ -193,6 +193,7 @@ pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(V
     let mut tuning = Vec::new();
     for mesh in &spec.meshes {
         let mut first: Option<Vec<f32>> = None;
+        let mut scenes = Vec::new();
         for &structure in &spec.structures {
             progress(&mesh.name, structure);
             let (settings, tried) = tune(spec, mesh, structure, &mut backend)?;
@@ -207,7 +208,6 @@ pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(V
             let frame = backend.render(&scene, view, sampling)?;
             let image = frame.ambient.expect("the scene asks for ambient occlusion");
             let seen: Vec<f64> = image.iter().filter(|&&v| v >= 0.0).map(|&v| v as f64).collect();
-            let timing = backend.time(&scene, view, sampling, 0, spec.repeats)?;
             let same_image = first.as_ref().is_none_or(|f| *f == image);
             first.get_or_insert_with(|| image.clone());
             rows.push(AoRow {
@@ -217,13 +217,30 @@ pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(V
                 parameters: stats.parameters.clone(),
                 build_seconds: stats.build_time.as_secs_f64(),
                 memory_bytes: stats.memory_bytes,
-                frame_seconds: timing.seconds,
+                frame_seconds: Vec::new(),
                 rays: (frame.rays.primary, frame.rays.ambient),
                 receivers: seen.len(),
                 mean_ao: seen.iter().sum::<f64>() / seen.len().max(1) as f64,
                 same_image,
                 image,
             });
+            scenes.push(scene);
+        }
+        // Timed in interleaved rounds, each visiting the structures in a fresh seeded order, so a
+        // change of machine load falls on all of them alike.
+        let base = rows.len() - scenes.len();
+        for round in 0..spec.repeats {
+            let mut order: Vec<usize> = (0..scenes.len()).collect();
+            order.sort_by_key(|&i| pcg(pcg(round) ^ i as u32));
+            for i in order {
+                let view = View {
+                    camera: &scenes[i].cameras["ao"],
+                    width: spec.width,
+                    height: spec.height,
+                };
+                let t = backend.time(&scenes[i], view, sampling, 0, 1)?;
+                rows[base + i].frame_seconds.extend(t.seconds);
+            }
         }
     }
     Ok((rows, tuning))
