@@ -119,7 +119,8 @@ pub(super) fn empty_outcome(spec: &Spec) -> anyhow::Result<Outcome> {
 }
 
 /// Renders and measures `groups` (all of a sweep, or a shard's share), taking completed groups
-/// from the journal; no timing. Records come in the order of `groups`.
+/// from the journal; no timing. Records come reference by reference ([`by_reference`]), as an
+/// unsharded sweep lists them.
 pub(super) fn render_groups(
     spec: &Spec,
     backend: &mut dyn Backend,
