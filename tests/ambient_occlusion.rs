@@ -45,18 +45,24 @@ fn scene(dir: &Path, ao: &str, mesh: Option<(&str, &str)>) -> Result<Scene, Stri
     Scene::load(&path).map_err(|e| e.to_string())
 }
 
-fn render(s: &Scene) -> Frame {
-    let view = View {
+/// The top camera's view of `s`.
+fn view(s: &Scene) -> View<'_> {
+    View {
         camera: &s.cameras["top"],
         width: SIZE,
         height: SIZE,
-    };
-    let sampling = Sampling {
-        scheme: DiskScheme::Jittered,
-        pattern: Pattern::PerPixel,
-        seed: 7,
-    };
-    CpuBackend::default().render(s, view, sampling).unwrap()
+    }
+}
+
+/// The sampling of the frames compared with exact answers (the disk schemes' seed).
+const JITTERED: Sampling = Sampling {
+    scheme: DiskScheme::Jittered,
+    pattern: Pattern::PerPixel,
+    seed: 7,
+};
+
+fn render(s: &Scene) -> Frame {
+    CpuBackend::default().render(s, view(s), JITTERED).unwrap()
 }
 
 /// (pixel, point on the plane) of every pixel whose camera ray meets the plane first.
@@ -363,18 +369,8 @@ fn the_gpu_pass_matches_the_cpu_and_the_exact_answer() {
     ];
     for (ao, mesh, cosine) in cases {
         let s = scene(dir.path(), &ao, mesh).unwrap();
-        let view = View {
-            camera: &s.cameras["top"],
-            width: SIZE,
-            height: SIZE,
-        };
-        let sampling = Sampling {
-            scheme: DiskScheme::Jittered,
-            pattern: Pattern::PerPixel,
-            seed: 7,
-        };
-        let g = gpu.render(&s, view, sampling).unwrap();
-        let c = CpuBackend::default().render(&s, view, sampling).unwrap();
+        let g = gpu.render(&s, view(&s), JITTERED).unwrap();
+        let c = render(&s);
         assert_eq!(g.hit, c.hit, "{ao} {mesh:?}");
         assert_eq!(g.rays.ambient, c.rays.ambient, "{ao} {mesh:?}");
         let (ga, ca) = (g.ambient.as_ref().unwrap(), c.ambient.unwrap());

@@ -7,7 +7,7 @@
 mod common;
 
 use penumbra::experiment::sweep::merge::{merge_shards, MergePlan};
-use penumbra::experiment::sweep::run::expand;
+use penumbra::experiment::sweep::run::{expand, Group};
 use penumbra::experiment::sweep::shard::{assign, run_shard, share, Shard};
 use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::output::table::write_rows;
@@ -148,6 +148,16 @@ fn the_deal_covers_every_group_once_is_deterministic_and_balanced() {
     assert_eq!(deal_of(&a), deal_of(&b));
 }
 
+/// The shares the groups of light radius `r` fell to.
+fn shares_of_radius(groups: &[Group], deal: &[u32], r: f64) -> Vec<u32> {
+    groups
+        .iter()
+        .zip(deal)
+        .filter(|(g, _)| g.head().light_radius == r)
+        .map(|(_, &s)| s)
+        .collect()
+}
+
 #[test]
 fn groups_sharing_a_costly_ground_truth_stay_together_and_cheap_ones_spread() {
     let dir = tempfile::tempdir().unwrap();
@@ -160,13 +170,8 @@ fn groups_sharing_a_costly_ground_truth_stay_together_and_cheap_ones_spread() {
     let spec = Spec::load(&costly).unwrap();
     let groups = expand(&spec);
     let deal = assign(&spec, &groups, 2);
-    for r in &spec.axes.light_radii {
-        let shares: Vec<u32> = groups
-            .iter()
-            .zip(&deal)
-            .filter(|(g, _)| g.head().light_radius == *r)
-            .map(|(_, &s)| s)
-            .collect();
+    for &r in &spec.axes.light_radii {
+        let shares = shares_of_radius(&groups, &deal, r);
         assert!(shares.windows(2).all(|w| w[0] == w[1]), "radius {r} split: {shares:?}");
     }
     assert!(deal.contains(&0) && deal.contains(&1), "{deal:?}");
@@ -181,13 +186,8 @@ fn groups_sharing_a_costly_ground_truth_stay_together_and_cheap_ones_spread() {
     let spec = Spec::load(&cheap).unwrap();
     let groups = expand(&spec);
     let deal = assign(&spec, &groups, 2);
-    let split = spec.axes.light_radii.iter().any(|r| {
-        let shares: Vec<u32> = groups
-            .iter()
-            .zip(&deal)
-            .filter(|(g, _)| g.head().light_radius == *r)
-            .map(|(_, &s)| s)
-            .collect();
+    let split = spec.axes.light_radii.iter().any(|&r| {
+        let shares = shares_of_radius(&groups, &deal, r);
         shares.contains(&0) && shares.contains(&1)
     });
     assert!(split, "no radius spread over both shares: {deal:?}");
