@@ -1,7 +1,8 @@
 //! Writing results without ever leaving a half-written file: write a temporary file beside the
 //! target, flush it to disk, then rename it over the target (atomic on POSIX file systems). The
-//! temporary file is named after the host, process and its start, so writers on several machines sharing a
-//! folder (shards filling one ground-truth cache) never write into each other's temporary file.
+//! temporary file is named after the host, the process and its start, so writers on several
+//! machines sharing a folder (shards filling one ground-truth cache) never write into each
+//! other's temporary file.
 
 use anyhow::Context;
 use std::io::Write;
