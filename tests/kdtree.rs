@@ -198,7 +198,7 @@ fn leaves_hold_every_triangle_that_meets_them() {
     let mut leaves = 0;
     let mut stack = vec![(0usize, tree.bounds)];
     while let Some((n, (lo, hi))) = stack.pop() {
-        match tree.nodes[n].inner() {
+        match tree.split(n) {
             Some((axis, split, left)) => {
                 let (mut a, mut b) = ((lo, hi), (lo, hi));
                 a.1[axis] = split;
@@ -245,4 +245,30 @@ fn a_tree_that_lost_a_triangle_reference_is_caught() {
         .collect();
     let (n, _) = wrong(&tree, &t, &aimed);
     assert!(n > 100, "only {n} of 200 rays aimed at the lost triangle noticed");
+}
+
+/// Splits are stored from the root box's corner, not from the origin: a mesh far from the origin
+/// gets the tree it gets at home (an absolute f32 split there would round the planes away and
+/// leave a near brute-force tree), and still answers as brute force does.
+#[test]
+fn a_mesh_far_from_the_origin_keeps_its_tree() {
+    let home = mesh("cow");
+    let nodes_at_home = KdTree::build(&home, KdSettings::default()).nodes.len();
+    for offset in [1e6, 1e7] {
+        let far = tris(
+            home.positions
+                .iter()
+                .map(|t| t.map(|p| p + DVec3::splat(offset)))
+                .collect(),
+        );
+        let tree = KdTree::build(&far, KdSettings::default());
+        assert!(
+            tree.nodes.len() * 2 > nodes_at_home,
+            "offset {offset}: {} nodes, {nodes_at_home} at home",
+            tree.nodes.len()
+        );
+        let rays = ao_random(&far, 2000, &mut Rng(31));
+        let (n, examples) = wrong(&tree, &far, &rays);
+        assert_eq!(n, 0, "offset {offset}: {examples:#?}");
+    }
 }

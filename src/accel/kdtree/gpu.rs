@@ -27,7 +27,7 @@ pub(super) fn structure(tree: &KdTree, triangles: &Triangles, frame: &LocalFrame
         .iter()
         .map(|n| match n.inner() {
             Some((axis, split, _)) => KdNode {
-                word: (((split - frame.origin[axis]) / frame.scale) as f32).to_bits(),
+                word: (((tree.bounds.0[axis] + split - frame.origin[axis]) / frame.scale) as f32).to_bits(),
                 data: n.data,
             },
             None => *n,

@@ -4,9 +4,10 @@
 //! paper tuned it, on maximum depth and leaf size ([`KdSettings`]).
 //!
 //! # Nodes
-//! Two u32 words ([`KdNode`]). Inner: the split plane's coordinate as f32 bits, then
-//! `left << 2 | axis` (the right child is `left + 1`). Leaf: the first entry of its triangle
-//! list in `items`, then `count << 2 | 3`.
+//! Two u32 words ([`KdNode`]). Inner: the split plane's coordinate, measured from the root box's
+//! low corner, as f32 bits (relative to the scene's extent, not its distance from the origin, so a
+//! scene placed far away keeps its splits), then `left << 2 | axis` (the right child is
+//! `left + 1`). Leaf: the first entry of its triangle list in `items`, then `count << 2 | 3`.
 //!
 //! # Exactness
 //! A node's triangles are those whose bounding box meets its closed half-space, so a triangle
@@ -67,7 +68,8 @@ impl KdSettings {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
 pub struct KdNode {
-    /// Inner: split coordinate (f32 bits); leaf: first entry in `items`.
+    /// Inner: split coordinate from the root box's low corner (f32 bits); leaf: first entry in
+    /// `items`.
     pub word: u32,
     /// Inner: `left << 2 | axis`; leaf: `count << 2 | 3`.
     pub data: u32,
@@ -83,7 +85,7 @@ impl KdNode {
         }
     }
 
-    /// `Some((axis, split, left child))` for an inner node.
+    /// `Some((axis, split from the root box's low corner, left child))` for an inner node.
     pub fn inner(&self) -> Option<(usize, f64, usize)> {
         let axis = self.data & 3;
         (axis != LEAF).then(|| {
@@ -124,6 +126,8 @@ fn bounds_of(t: &[DVec3; 3]) -> (DVec3, DVec3) {
 
 struct Builder<'a> {
     boxes: &'a [(DVec3, DVec3)],
+    /// The root box's low corner, from which splits are stored.
+    origin: DVec3,
     settings: KdSettings,
     nodes: Vec<KdNode>,
     items: Vec<u32>,
@@ -146,7 +150,7 @@ impl Builder<'_> {
         self.nodes.push(KdNode::zeroed());
         self.nodes.push(KdNode::zeroed());
         self.nodes[at] = KdNode {
-            word: (s as f32).to_bits(),
+            word: ((s - self.origin[axis]) as f32).to_bits(),
             data: (first as u32) << 2 | axis as u32,
         };
         let (mut lo_box, mut hi_box) = (bounds, bounds);
@@ -156,12 +160,14 @@ impl Builder<'_> {
         self.node(first + 1, right, hi_box, depth + 1);
     }
 
-    /// The spatial median of the longest side (rounded to the f32 the node stores) and each
-    /// side's triangles; `None` where the plane would not divide anything.
+    /// The spatial median of the longest side (rounded to the f32 the node stores, from the root
+    /// box's low corner) and each side's triangles; `None` where the plane would not divide
+    /// anything.
     #[allow(clippy::type_complexity)]
     fn split(&self, tris: &[u32], (lo, hi): (DVec3, DVec3)) -> Option<(usize, f64, Vec<u32>, Vec<u32>)> {
         let axis = (hi - lo).max_position();
-        let s = ((lo[axis] + hi[axis]) * 0.5) as f32 as f64;
+        let o = self.origin[axis];
+        let s = o + ((lo[axis] + hi[axis]) * 0.5 - o) as f32 as f64;
         if !(s > lo[axis] && s < hi[axis]) {
             return None;
         }
@@ -196,6 +202,7 @@ impl KdTree {
             });
         let mut b = Builder {
             boxes: &boxes,
+            origin: bounds.0,
             settings,
             nodes: vec![KdNode::zeroed()],
             items: Vec::new(),
@@ -216,6 +223,13 @@ impl KdTree {
     /// Bytes of nodes and triangle lists (the structure's own memory, triangles aside).
     pub fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<KdNode>() + self.items.len() * 4
+    }
+
+    /// `Some((axis, split coordinate, left child))` of inner node `node`, the split in world
+    /// coordinates.
+    pub fn split(&self, node: usize) -> Option<(usize, f64, usize)> {
+        let (axis, s, left) = self.nodes[node].inner()?;
+        Some((axis, self.bounds.0[axis] + s, left))
     }
 
     /// The build parameters.

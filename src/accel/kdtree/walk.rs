@@ -100,7 +100,7 @@ pub fn walk(
             current = Some(entry);
             continue;
         };
-        while let Some((axis, split, left)) = tree.nodes[node].inner() {
+        while let Some((axis, split, left)) = tree.split(node) {
             let [near, far] = children(axis, split, left, origin, dir, (tn, tf), delta);
             match (near, far) {
                 (Some(n), Some(f)) => {
