@@ -83,18 +83,7 @@ fn load(name: &str) -> Triangles {
         let file = penumbra::mesh::load(&repo(&format!("assets/meshes/{name}.off"))).expect("mesh");
         penumbra::mesh::clean(file.triangles, &glam::DMat4::IDENTITY).0
     };
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for p in positions.iter().flatten() {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    let c = 0.5 * (lo + hi);
-    let r = positions.iter().flatten().map(|p| p.distance(c)).fold(0.0, f64::max);
-    let positions: Vec<[DVec3; 3]> = positions.iter().map(|t| t.map(|p| (p - c) / r)).collect();
-    Triangles {
-        object_of: vec![0; positions.len()],
-        positions,
-    }
+    penumbra::experiment::ao::spec::into_unit_ball(positions)
 }
 
 fn build(name: &'static str) -> Mesh {

@@ -8,7 +8,7 @@
 mod common;
 
 use common::rays::*;
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 use penumbra::accel::kdtree::{KdSettings, KdTree, MAX_DEPTH};
 use penumbra::accel::vlf::directions::Directions;
 use penumbra::accel::{intersect, Accelerator, TriHit};
@@ -45,21 +45,12 @@ fn wrong(tree: &KdTree, t: &Triangles, rays: &[Ray]) -> (usize, Vec<String>) {
     (bad.len(), bad.into_iter().take(3).collect())
 }
 
-fn mesh(name: &str) -> Triangles {
-    let file = penumbra::mesh::load(&common::repo(&format!("assets/meshes/{name}.off"))).unwrap();
-    let (positions, _) = penumbra::mesh::clean(file.triangles, &DMat4::IDENTITY);
-    Triangles {
-        object_of: vec![0; positions.len()],
-        positions,
-    }
-}
-
 #[test]
 fn every_ray_kind_on_every_mesh_matches_brute_force() {
     let dirs = Directions::new(16);
     let mut scenes: Vec<(String, Triangles)> = ["cow", "mech-holes-shark", "bull", "camel", "man"]
         .iter()
-        .map(|m| (m.to_string(), mesh(m)))
+        .map(|m| (m.to_string(), common::off_mesh(m)))
         .collect();
     scenes.push(("soup".into(), soup(3000, 5)));
     for (name, t) in &scenes {
@@ -225,7 +216,7 @@ fn leaves_hold_every_triangle_that_meets_them() {
 
 #[test]
 fn a_tree_that_lost_a_triangle_reference_is_caught() {
-    let t = mesh("cow");
+    let t = common::off_mesh("cow");
     let mut tree = KdTree::build(&t, KdSettings::default());
     let dirs = Directions::new(16);
     let rays = ao_grid(&t, &dirs, 4000, &mut Rng(21));
@@ -252,7 +243,7 @@ fn a_tree_that_lost_a_triangle_reference_is_caught() {
 /// leave a near brute-force tree), and still answers as brute force does.
 #[test]
 fn a_mesh_far_from_the_origin_keeps_its_tree() {
-    let home = mesh("cow");
+    let home = common::off_mesh("cow");
     let nodes_at_home = KdTree::build(&home, KdSettings::default()).nodes.len();
     for offset in [1e6, 1e7] {
         let far = tris(

@@ -12,22 +12,13 @@ mod common;
 use glam::DVec3;
 use penumbra::accel::vlf::directions::Directions;
 use penumbra::accel::vlf::VlfSettings;
-use penumbra::mesh::{self, Triangles};
+use penumbra::mesh::Triangles;
 use penumbra::render::gpu::ProbeHit;
 use penumbra::sampling::Stream;
 use penumbra::scene::Scene;
 
 /// Rays per kind per mesh.
 const RAYS: u32 = 100_000;
-
-fn off_triangles(name: &str) -> Triangles {
-    let m = mesh::load(&common::repo(&format!("assets/meshes/{name}.off"))).unwrap();
-    let (positions, _) = mesh::clean(m.triangles, &glam::DMat4::IDENTITY);
-    Triangles {
-        object_of: vec![0; positions.len()],
-        positions,
-    }
-}
 
 /// Seeded rays of the five kinds over `t`: (kind, origin, unit direction, tmax).
 fn rays(t: &Triangles) -> Vec<(&'static str, DVec3, DVec3, f64)> {
@@ -114,7 +105,7 @@ fn check(name: &str, t: &Triangles) {
 #[test]
 fn off_meshes_on_the_gpu_match_the_bvh() {
     for name in ["cow", "mech-holes-shark", "bull", "camel", "man"] {
-        check(name, &off_triangles(name));
+        check(name, &common::off_mesh(name));
     }
 }
 

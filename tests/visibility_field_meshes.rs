@@ -21,7 +21,6 @@
 mod common;
 
 use common::rays::*;
-use glam::DMat4;
 use penumbra::accel::brute::Brute;
 use penumbra::accel::vlf::{VisibilityField, VlfSettings, DEAD};
 use penumbra::accel::{intersect, Accelerator, Bvh, Preset, TriHit};
@@ -37,17 +36,6 @@ const RAYS: usize = 100_000;
 
 /// Every `BRUTE_STRIDE`-th ray is also checked against brute force.
 const BRUTE_STRIDE: usize = 32;
-
-/// A mesh's triangles as loaded (file units), degenerate ones dropped.
-fn mesh(name: &str) -> Triangles {
-    let file = penumbra::mesh::load(&common::repo(&format!("assets/meshes/{name}.off"))).unwrap();
-    let (positions, _) = penumbra::mesh::clean(file.triangles, &DMat4::IDENTITY);
-    assert!(!positions.is_empty(), "{name}: no triangles");
-    Triangles {
-        object_of: vec![0; positions.len()],
-        positions,
-    }
-}
 
 /// Whether `got` is the answer `want`: both misses, or the same triangle at t within 1e-6
 /// relative.
@@ -160,7 +148,7 @@ fn off_meshes_match_brute_force() {
     let mut failures = Vec::new();
     for (m, name) in MESHES.iter().enumerate() {
         let t0 = Instant::now();
-        let t = mesh(name);
+        let t = common::off_mesh(name);
         let field = VisibilityField::build(&t, VlfSettings::default()).unwrap();
         let bvh = Bvh::build(&t, Preset::Medium);
         let brute = Brute::build(&t);
@@ -205,7 +193,7 @@ fn off_meshes_match_brute_force() {
 /// them in the subset).
 #[test]
 fn a_corrupted_field_fails_the_mesh_check() {
-    let t = mesh("cow");
+    let t = common::off_mesh("cow");
     let mut field = VisibilityField::build(&t, VlfSettings::default()).unwrap();
     let bvh = Bvh::build(&t, Preset::Medium);
     let brute = Brute::build(&t);

@@ -26,6 +26,18 @@ pub fn gpu() -> Option<std::sync::MutexGuard<'static, GpuBackend>> {
     slot.as_ref().map(|m| m.lock().unwrap_or_else(|p| p.into_inner()))
 }
 
+/// A shipped OFF mesh's triangles as loaded (file units, assets/meshes), degenerate ones
+/// dropped; every triangle of object 0.
+pub fn off_mesh(name: &str) -> penumbra::mesh::Triangles {
+    let file = penumbra::mesh::load(&repo(&format!("assets/meshes/{name}.off"))).unwrap();
+    let (positions, _) = penumbra::mesh::clean(file.triangles, &glam::DMat4::IDENTITY);
+    assert!(!positions.is_empty(), "{name}: no triangles");
+    penumbra::mesh::Triangles {
+        object_of: vec![0; positions.len()],
+        positions,
+    }
+}
+
 /// Path of a file in the repository.
 pub fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)

@@ -5,7 +5,7 @@
 //! timing phase itself, so every frame time the report compares comes from one interleaved phase
 //! on one machine, as in an unsharded sweep. Nothing is written unless every check passes.
 
-use super::journal::{GroupRow, Journal};
+use super::journal::{Figure, GroupRow, Journal};
 use super::record::{Record, Status};
 use super::reference::Reference;
 use super::run::{context_key, expand, GroupStats};
@@ -203,7 +203,8 @@ pub fn merge_shards(
     let mut missing: HashMap<u32, Vec<(usize, String)>> = HashMap::new();
     let mut duplicated: Vec<String> = Vec::new();
     let fig_n = figure_samples(spec);
-    let mut taken: HashMap<String, (usize, Vec<Record>, GroupRow)> = HashMap::new();
+    // Per group key: its records, split and figure (groups at the figures' ray count).
+    let mut taken: HashMap<String, (Vec<Record>, GroupRow, Option<Figure>)> = HashMap::new();
     for (g, &own) in groups.iter().zip(&owner) {
         let gk = g.key(&context);
         let mut records = Vec::new();
@@ -248,14 +249,17 @@ pub fn merge_shards(
             continue;
         };
         let rendered = records.iter().any(|r| r.status == Status::Ok);
-        if g.head().samples == fig_n && rendered && shards[s].journal.figure(&gk).is_none() {
+        let figure = (g.head().samples == fig_n)
+            .then(|| shards[s].journal.figure(&gk))
+            .flatten();
+        if g.head().samples == fig_n && rendered && figure.is_none() {
             missing
                 .entry(own)
                 .or_default()
                 .push((0, format!("{}: its figure", g.config())));
             continue;
         }
-        taken.insert(gk, (s, records, row.clone()));
+        taken.insert(gk, (records, row.clone(), figure));
     }
     if !missing.is_empty() {
         let mut owners: Vec<&u32> = missing.keys().collect();
@@ -289,11 +293,9 @@ pub fn merge_shards(
         let reference = Reference::build(spec, backend, lights, radius, &results.join("cache"), &context)?;
         for g in share {
             let gk = g.key(&context);
-            let (s, records, row) = taken.remove(&gk).expect("checked above");
-            if g.head().samples == fig_n {
-                if let Some(f) = shards[s].journal.figure(&gk) {
-                    keep_figure(&mut out, &reference, g.config(), f);
-                }
+            let (records, row, figure) = taken.remove(&gk).expect("checked above");
+            if let Some(f) = figure {
+                keep_figure(&mut out, &reference, g.config(), f);
             }
             out.failures += records.iter().filter(|r| r.status != Status::Ok).count();
             out.records.extend(records);

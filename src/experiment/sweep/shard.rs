@@ -28,6 +28,7 @@ use crate::fingerprint::fnv1a;
 use crate::output::table::write_rows;
 use crate::render::{Backend, RenderPlan, View};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -95,9 +96,16 @@ pub fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
 
 /// [`assign`]'s shares, and each share's expected rays (ground truths it renders included).
 pub fn deal(spec: &Spec, groups: &[Group], count: u32) -> (Vec<u32>, Vec<f64>) {
+    // Frame rays per (lights, samples): each asks for a scene, so each is computed once.
+    let mut memo: HashMap<(u32, u32), f64> = HashMap::new();
+    let mut rays = |lights: u32, samples: u32| {
+        *memo
+            .entry((lights, samples))
+            .or_insert_with(|| frame_rays(spec, lights, samples))
+    };
     let cost: Vec<f64> = groups
         .iter()
-        .map(|g| g.runs.len() as f64 * frame_rays(spec, g.head().lights, g.head().samples))
+        .map(|g| g.runs.len() as f64 * rays(g.head().lights, g.head().samples))
         .collect();
     let pair = |g: &Group| (g.head().lights, g.head().light_radius.to_bits());
     let mut order: Vec<usize> = (0..groups.len()).collect();
@@ -111,7 +119,7 @@ pub fn deal(spec: &Spec, groups: &[Group], count: u32) -> (Vec<u32>, Vec<f64>) {
     let mut share = vec![0u32; groups.len()];
     for i in order {
         let p = pair(&groups[i]);
-        let reference = frame_rays(spec, p.0, spec.ground_truth.samples);
+        let reference = rays(p.0, spec.ground_truth.samples);
         let finish = |s: usize| load[s] + cost[i] + if holds[s].contains(&p) { 0.0 } else { reference };
         let best = (0..count as usize)
             .min_by(|&a, &b| finish(a).total_cmp(&finish(b)))
