@@ -18,6 +18,7 @@ fn mesh(name: &str, albedo: f64, triangles: usize) -> Mesh {
         source: name.into(),
         file_fnv1a: 0,
         albedo,
+        mirror: 0.0,
         triangles,
         skipped: Default::default(),
     }

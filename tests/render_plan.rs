@@ -130,6 +130,7 @@ fn with_quad(scene: Scene) -> Scene {
         source: "quad".into(),
         file_fnv1a: 0,
         albedo: 0.5,
+        mirror: 0.0,
         triangles: 2,
         skipped: Default::default(),
     };

@@ -42,6 +42,7 @@ fn mesh(albedo: f64, triangles: usize) -> Mesh {
         source: "quad".into(),
         file_fnv1a: 0,
         albedo,
+        mirror: 0.0,
         triangles,
         skipped: Default::default(),
     }

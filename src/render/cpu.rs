@@ -3,13 +3,14 @@
 //! the GPU's sample streams, in double precision.
 
 use super::ambient::{occlusion, AMBIENT_STREAM};
+use super::mirror::{mirror_chain, Chain};
 use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::render::plan::{Pass, RenderPlan};
 use crate::sampling::{shared_points, Pattern, Stream};
 use crate::scene::ambient::{AmbientOcclusion, AoDirections};
 use crate::scene::Scene;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::f64::consts::FRAC_1_PI;
 use std::time::Instant;
@@ -40,6 +41,11 @@ impl Default for CpuBackend {
 /// analytic surfaces, geometric normal facing the ray. Analytic shapes are tested in id order
 /// (the first of equal distances wins), then the accelerator within the distance found.
 pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver> {
+    closest_hit_skipping(scene, origin, dir, NO_HIT)
+}
+
+/// [`closest_hit`] ignoring triangle `skip` (a secondary ray's own triangle).
+pub fn closest_hit_skipping(scene: &Scene, origin: DVec3, dir: DVec3, skip: u32) -> Option<Receiver> {
     let mut best: Option<(f64, usize)> = None;
     for (id, shape) in scene.shapes.iter().enumerate() {
         if let Some(t) = shape.first_t(origin, dir) {
@@ -49,7 +55,7 @@ pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver>
         }
     }
     let tmax = best.map_or(f64::INFINITY, |b| b.0);
-    let mesh_hit = scene.accel.as_ref().and_then(|a| a.closest(origin, dir, tmax, NO_HIT));
+    let mesh_hit = scene.accel.as_ref().and_then(|a| a.closest(origin, dir, tmax, skip));
     let (p, n, object, triangle) = match mesh_hit {
         Some(h) if h.t > 0.0 => {
             let tri = &scene.triangles.positions[h.triangle as usize];
@@ -71,6 +77,38 @@ pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver>
         object: object as u32,
         triangle,
     })
+}
+
+/// Where each light's shadow rays land for one frame: the shared set, drawn once, or each
+/// pixel's own stream.
+struct LightTargets {
+    shared: Vec<Option<Vec<DVec2>>>,
+    sampling: Sampling,
+}
+
+impl LightTargets {
+    fn new(scene: &Scene, sampling: Sampling) -> LightTargets {
+        let shared = scene
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                (sampling.pattern == Pattern::Shared)
+                    .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, i as u32))
+            })
+            .collect();
+        LightTargets { shared, sampling }
+    }
+
+    fn of(&self, light: usize, pixel: usize) -> Targets<'_> {
+        match &self.shared[light] {
+            Some(points) => Targets::Shared(points),
+            None => Targets::PerPixel(
+                self.sampling.scheme,
+                Stream::new(self.sampling.seed, light as u32, Some(pixel as u32)),
+            ),
+        }
+    }
 }
 
 /// The ambient-occlusion pass over every receiver: the image and the rays traced.
@@ -122,6 +160,8 @@ impl Backend for CpuBackend {
         };
         let mut receivers: Vec<Option<Receiver>> = vec![];
         let mut irradiance = vec![0f64; pixels];
+        let mut reflected = vec![0f64; pixels];
+        let targets = LightTargets::new(scene, sampling);
         for pass in &plan.passes {
             self.dispatches += 1;
             match *pass {
@@ -141,27 +181,48 @@ impl Backend for CpuBackend {
                 }
                 Pass::Shadow { light, .. } => {
                     let l = &scene.lights[light];
-                    let shared = (sampling.pattern == Pattern::Shared)
-                        .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, light as u32));
                     let samples: Vec<Option<LightSample>> = receivers
                         .par_iter()
                         .enumerate()
-                        .map(|(pixel, r)| {
-                            let targets = match &shared {
-                                Some(points) => Targets::Shared(points),
-                                None => Targets::PerPixel(
-                                    sampling.scheme,
-                                    Stream::new(sampling.seed, light as u32, Some(pixel as u32)),
-                                ),
-                            };
-                            r.as_ref().map(|r| shade_light(scene, r, l, targets))
-                        })
+                        .map(|(pixel, r)| r.as_ref().map(|r| shade_light(scene, r, l, targets.of(light, pixel))))
                         .collect();
                     for (pixel, s) in samples.iter().enumerate() {
                         if let Some(s) = s {
                             frame.visibility[light][pixel] = s.visibility as f32;
                             irradiance[pixel] += s.irradiance;
                             frame.rays.shadow[light] += s.rays;
+                        }
+                    }
+                }
+                Pass::Direct { .. } => {
+                    for (light, l) in scene.lights.iter().enumerate() {
+                        for (pixel, r) in receivers.iter().enumerate() {
+                            if let Some(r) = r {
+                                let s = shade_light(scene, r, l, targets.of(light, pixel));
+                                frame.visibility[light][pixel] = s.visibility as f32;
+                                irradiance[pixel] += s.irradiance;
+                            }
+                        }
+                    }
+                }
+                Pass::Mirror { .. } => {
+                    let chains: Vec<Option<Chain>> = receivers
+                        .par_iter()
+                        .enumerate()
+                        .map(|(pixel, r)| {
+                            let r = r.as_ref()?;
+                            let (x, y) = (pixel as u32 % view.width, pixel as u32 / view.width);
+                            let ray = view.camera.ray(x, y, view.width, view.height);
+                            Some(mirror_chain(scene, r, ray.direction, &|l| targets.of(l, pixel)))
+                        })
+                        .collect();
+                    for (pixel, c) in chains.iter().enumerate() {
+                        if let Some(c) = c {
+                            reflected[pixel] = c.radiance;
+                            frame.rays.reflection += c.reflection_rays;
+                            for (total, n) in frame.rays.shadow.iter_mut().zip(c.shadow_rays) {
+                                *total += n;
+                            }
                         }
                     }
                 }
@@ -173,9 +234,11 @@ impl Backend for CpuBackend {
                 }
             }
         }
-        for ((out, r), e) in frame.radiance.iter_mut().zip(&receivers).zip(&irradiance) {
+        for (pixel, r) in receivers.iter().enumerate() {
             if let Some(r) = r {
-                *out = (r.albedo * FRAC_1_PI * e) as f32;
+                let m = scene.shapes[r.object as usize].mirror();
+                frame.radiance[pixel] =
+                    ((1.0 - m) * r.albedo * FRAC_1_PI * irradiance[pixel] + reflected[pixel]) as f32;
             }
         }
         Ok(frame)

@@ -8,6 +8,7 @@
 pub mod ambient;
 pub mod cpu;
 pub mod gpu;
+pub mod mirror;
 pub mod plan;
 pub mod shading;
 
@@ -60,12 +61,19 @@ pub struct RayCounts {
     pub shadow: [u64; plan::MAX_LIGHTS],
     /// Ambient-occlusion rays.
     pub ambient: u64,
+    /// Mirror-reflection rays (their vertices' shadow rays count in `shadow`).
+    pub reflection: u64,
 }
 
 impl RayCounts {
     /// All shadow rays.
     pub fn shadow_total(&self) -> u64 {
         self.shadow.iter().sum()
+    }
+
+    /// Every ray of the frame.
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow_total() + self.ambient + self.reflection
     }
 }
 

@@ -32,6 +32,24 @@ pub enum Pass {
         /// Upper bound on rays: receivers facing away from the light issue none.
         max_rays: u64,
     },
+    /// Local shading from every light without occlusion tests (OpenGL-like): no rays. Replaces
+    /// the shadow passes where the scene's shading has no shadows.
+    Direct {
+        /// Lights shaded.
+        lights: usize,
+    },
+    /// Whitted's mirror chains: from every receiver with a mirror weight, the reflected ray's
+    /// closest hit and, at each vertex reached, local shading from every light (with shadow rays
+    /// where the scene has shadows), up to `max_depth` bounces. Only where the scene asks for
+    /// reflections and has a mirror.
+    Mirror {
+        /// Most bounces per camera ray.
+        max_depth: u32,
+        /// Rays per bounce at most: the reflected ray and the shadow rays of its vertex.
+        rays_per_bounce: u64,
+        /// Rays if every pixel saw a perfect mirror chain of full depth.
+        max_rays: u64,
+    },
     /// Ambient-occlusion rays from every receiver point into its hemisphere: any-hit with early
     /// exit, up to the scene's maximum distance. Only where the scene asks for it.
     Ambient {
@@ -46,6 +64,19 @@ pub enum Pass {
     },
 }
 
+impl Pass {
+    /// The pass's name, as serialised.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Pass::Primary { .. } => "primary",
+            Pass::Shadow { .. } => "shadow",
+            Pass::Direct { .. } => "direct",
+            Pass::Mirror { .. } => "mirror",
+            Pass::Ambient { .. } => "ambient",
+        }
+    }
+}
+
 /// The passes one frame runs, in order.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RenderPlan {
@@ -55,7 +86,9 @@ pub struct RenderPlan {
 
 impl RenderPlan {
     /// The plan for `scene` seen through `view`: a primary pass over the shapes the scene has,
-    /// then one shadow pass per light with that light's ray count; nothing else.
+    /// then one shadow pass per light with that light's ray count (or one unoccluded direct pass
+    /// where the scene has no shadows), then mirror chains and ambient occlusion where the scene
+    /// asks for them; nothing else.
     pub fn new(scene: &Scene, view: View) -> anyhow::Result<RenderPlan> {
         anyhow::ensure!(
             scene.lights.len() <= MAX_LIGHTS,
@@ -73,7 +106,13 @@ impl RenderPlan {
             shapes.push(format!("mesh ({})", a.name().to_uppercase()));
         }
         let mut passes = vec![Pass::Primary { rays: pixels, shapes }];
-        for (i, light) in scene.lights.iter().enumerate() {
+        let shadows = scene.shading.shadows;
+        if !shadows && !scene.lights.is_empty() {
+            passes.push(Pass::Direct {
+                lights: scene.lights.len(),
+            });
+        }
+        for (i, light) in scene.lights.iter().enumerate().filter(|_| shadows) {
             let n = light.samples();
             passes.push(Pass::Shadow {
                 light: i,
@@ -83,6 +122,19 @@ impl RenderPlan {
                 },
                 rays_per_receiver: n,
                 max_rays: pixels * n as u64,
+            });
+        }
+        let depth = scene.shading.mirror_depth;
+        if depth > 0 && scene.has_mirrors() {
+            let shadow_rays: u64 = if shadows {
+                scene.lights.iter().map(|l| l.samples() as u64).sum()
+            } else {
+                0
+            };
+            passes.push(Pass::Mirror {
+                max_depth: depth,
+                rays_per_bounce: 1 + shadow_rays,
+                max_rays: pixels * depth as u64 * (1 + shadow_rays),
             });
         }
         if let Some(a) = &scene.ambient {
@@ -102,7 +154,10 @@ impl RenderPlan {
             .iter()
             .map(|p| match p {
                 Pass::Primary { rays, .. } => *rays,
-                Pass::Shadow { max_rays, .. } | Pass::Ambient { max_rays, .. } => *max_rays,
+                Pass::Shadow { max_rays, .. } | Pass::Ambient { max_rays, .. } | Pass::Mirror { max_rays, .. } => {
+                    *max_rays
+                }
+                Pass::Direct { .. } => 0,
             })
             .sum()
     }
@@ -121,6 +176,15 @@ impl fmt::Display for RenderPlan {
                 } => writeln!(
                     f,
                     "shadow light {light} ({kind}): {rays_per_receiver} rays/receiver, <= {max_rays} rays"
+                )?,
+                Pass::Direct { lights } => writeln!(f, "direct light from {lights} lights, unoccluded: no rays")?,
+                Pass::Mirror {
+                    max_depth,
+                    rays_per_bounce,
+                    max_rays,
+                } => writeln!(
+                    f,
+                    "mirror chains: <= {max_depth} bounces of {rays_per_bounce} rays, <= {max_rays} rays"
                 )?,
                 Pass::Ambient {
                     directions,

@@ -85,7 +85,8 @@ pub enum Targets<'a> {
     Shared(&'a [DVec2]),
 }
 
-/// Shadow rays from a receiver to `light`.
+/// Shadow rays from a receiver to `light`; where the scene's shading has no shadows (OpenGL-like),
+/// the same estimate with every target taken as visible and no rays traced.
 pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets) -> LightSample {
     let (p, n, origin) = (r.p, r.n, r.origin());
     match light {
@@ -98,7 +99,8 @@ pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets)
                     rays: 0,
                 };
             }
-            let visible = !occluded(scene, origin, *position - origin, r);
+            let shadows = scene.shading.shadows;
+            let visible = !shadows || !occluded(scene, origin, *position - origin, r);
             let irradiance = if visible {
                 power / (4.0 * PI) * n.dot(d.normalize()) / d.length_squared()
             } else {
@@ -107,7 +109,7 @@ pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets)
             LightSample {
                 visibility: visible as u8 as f64,
                 irradiance,
-                rays: 1,
+                rays: shadows as u64,
             }
         }
         Light::Disk(l) => {
@@ -130,8 +132,8 @@ pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets)
                 if n.dot(d) <= 0.0 || l.normal.dot(d) >= 0.0 {
                     continue;
                 }
-                rays += 1;
-                if !occluded(scene, origin, q - origin, r) {
+                rays += scene.shading.shadows as u64;
+                if !scene.shading.shadows || !occluded(scene, origin, q - origin, r) {
                     visible += 1;
                     let d2 = d.length_squared();
                     sum += n.dot(d) * -l.normal.dot(d) / (d2 * d2);

@@ -35,6 +35,34 @@ pub struct SceneFile {
     pub kdtree: KdDesc,
     /// The ambient-occlusion pass, if the scene asks for one.
     pub ambient_occlusion: Option<AmbientDesc>,
+    /// The light transport simulated (shadow rays, mirror reflections).
+    #[serde(default)]
+    pub shading: ShadingDesc,
+}
+
+/// `[shading]` as written ([`crate::scene::Shading`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadingDesc {
+    /// Shadow rays to the lights (false: OpenGL-like unoccluded local shading).
+    #[serde(default = "yes")]
+    pub shadows: bool,
+    /// Mirror bounces after the camera ray (Whitted); 0 for none.
+    #[serde(default)]
+    pub mirror_depth: u32,
+}
+
+impl Default for ShadingDesc {
+    fn default() -> Self {
+        ShadingDesc {
+            shadows: true,
+            mirror_depth: 0,
+        }
+    }
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// `[ambient_occlusion]` as written.
@@ -102,6 +130,9 @@ pub struct MeshDesc {
     /// Lambertian albedo in [0, 1].
     #[serde(default = "default_albedo")]
     pub albedo: f64,
+    /// Mirror weight in [0, 1] (Whitted's k_r); reflections are traced where `[shading]` asks.
+    #[serde(default)]
+    pub mirror: f64,
 }
 
 fn one() -> f64 {

@@ -4,7 +4,7 @@
 use super::ambient::{grid_level, AmbientOcclusion, AoDirections};
 use super::camera::{Camera, Projection};
 use super::description::{AmbientDesc, KdDesc, LightDesc, ProjectionDesc, SceneFile, VlfDesc};
-use super::{DiskLight, Light, Mesh, Plane, Scene, Sphere, MAX_SAMPLES};
+use super::{DiskLight, Light, Mesh, Plane, Scene, Shading, Sphere, MAX_SAMPLES};
 use crate::accel::kdtree::{self, KdSettings};
 use crate::accel::vlf::VlfSettings;
 use crate::accel::{self, AccelSettings};
@@ -130,6 +130,7 @@ impl Scene {
             v.point(&m.rotate, &at("rotate"))?;
             let translate = v.point(&m.translate, &at("translate"))?;
             let albedo = v.albedo(m.albedo, &at("albedo"))?;
+            let mirror = v.fraction(m.mirror, &at("mirror"), "mirror weight")?;
             let path = dir.join(&m.path);
             let raw = crate::mesh::load(&path)
                 .map_err(|e| source.error(&at("path"), e.to_string()))?
@@ -153,6 +154,7 @@ impl Scene {
                 source: path.display().to_string(),
                 file_fnv1a: crate::fingerprint::fnv1a(&bytes),
                 albedo,
+                mirror,
                 triangles: kept.len(),
                 skipped,
             });
@@ -162,9 +164,20 @@ impl Scene {
             Some(a) => Some(ambient(a, &v)?),
             None => None,
         };
+        let depth = file.shading.mirror_depth;
+        if depth > Shading::MAX_MIRROR_DEPTH {
+            return Err(source.error(
+                &key_path!["shading", "mirror_depth"],
+                format!("at most {} bounces are traced, got {depth}", Shading::MAX_MIRROR_DEPTH),
+            ));
+        }
         Scene::analytic(spheres, planes, lights)
             .with_cameras(cameras)
             .with_ambient(ambient)
+            .with_shading(Shading {
+                shadows: file.shading.shadows,
+                mirror_depth: depth,
+            })
             .try_with_meshes(meshes, triangles, settings)
             .map_err(|e| source.error(&key_path!["accelerator"], format!("{e:#}")))
     }
@@ -208,10 +221,14 @@ impl Validator<'_> {
     }
 
     fn albedo(&self, x: f64, at: &[Seg]) -> Result<f64, ConfigError> {
+        self.fraction(x, at, "albedo")
+    }
+
+    fn fraction(&self, x: f64, at: &[Seg], what: &str) -> Result<f64, ConfigError> {
         if (0.0..=1.0).contains(&x) {
             Ok(x)
         } else {
-            Err(self.source.error(at, format!("albedo must be in [0, 1], got {x}")))
+            Err(self.source.error(at, format!("{what} must be in [0, 1], got {x}")))
         }
     }
 

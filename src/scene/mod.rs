@@ -91,6 +91,49 @@ pub struct Scene {
     pub accel: Option<Arc<dyn Accelerator>>,
     /// The ambient-occlusion pass, where the scene asks for one.
     pub ambient: Option<ambient::AmbientOcclusion>,
+    /// Which light transport the frame simulates beyond the camera rays.
+    pub shading: Shading,
+}
+
+/// The light transport a scene asks for (the visibility-field paper's two shadings, Section 6):
+/// OpenGL-like is `shadows = false` (local diffuse shading from every light, no rays beyond the
+/// camera's); Whitted is `mirror_depth > 0` (mirror reflections from meshes that declare a mirror
+/// weight, with shadow rays to every light at every vertex). The default, shadow rays from the
+/// camera's hits and no reflections, is the soft-shadow paper's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shading {
+    /// Whether lights are tested for occlusion by shadow rays.
+    pub shadows: bool,
+    /// Most mirror bounces traced after the camera ray (0: none).
+    pub mirror_depth: u32,
+}
+
+impl Default for Shading {
+    fn default() -> Self {
+        Shading {
+            shadows: true,
+            mirror_depth: 0,
+        }
+    }
+}
+
+impl Shading {
+    /// Primary rays and unoccluded local shading only.
+    pub const OPENGL: Shading = Shading {
+        shadows: false,
+        mirror_depth: 0,
+    };
+
+    /// Deepest mirror chain a scene may ask for.
+    pub const MAX_MIRROR_DEPTH: u32 = 16;
+
+    /// Whitted's model with mirror chains up to `depth` bounces.
+    pub fn whitted(depth: u32) -> Shading {
+        Shading {
+            shadows: true,
+            mirror_depth: depth,
+        }
+    }
 }
 
 impl Scene {
@@ -109,7 +152,20 @@ impl Scene {
             accel_settings: AccelSettings::default(),
             accel: None,
             ambient: None,
+            shading: Shading::default(),
         }
+    }
+
+    /// Sets the light transport simulated.
+    pub fn with_shading(mut self, shading: Shading) -> Scene {
+        self.shading = shading;
+        self
+    }
+
+    /// Whether any object reflects (a mirror weight above zero): without one, a mirror pass
+    /// would trace nothing, so the plan has none.
+    pub fn has_mirrors(&self) -> bool {
+        self.shapes.iter().any(|s| s.mirror() > 0.0)
     }
 
     /// Asks for (or, with `None`, drops) the ambient-occlusion pass.

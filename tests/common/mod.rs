@@ -134,6 +134,7 @@ pub fn triangles_scene(triangles: &penumbra::mesh::Triangles, name: &'static str
         source: "test".into(),
         file_fnv1a: 0,
         albedo: 0.5,
+        mirror: 0.0,
         triangles: triangles.positions.len(),
         skipped: Default::default(),
     };

@@ -174,6 +174,7 @@ pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, settings: AccelSettings) -> anyhow
         source: mesh.path.display().to_string(),
         file_fnv1a: mesh.file_fnv1a,
         albedo: 0.8,
+        mirror: 0.0,
         triangles: mesh.triangles.positions.len(),
         skipped: Default::default(),
     };

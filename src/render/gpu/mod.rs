@@ -202,6 +202,7 @@ impl GpuBackend {
                 Pass::Primary { .. } => (&p.primary, &r.passes[0][..1]),
                 Pass::Shadow { light, .. } => (&p.shadow, &r.passes[*light][..]),
                 Pass::Ambient { .. } => (&p.ambient, &r.ambient_passes[..]),
+                Pass::Direct { .. } | Pass::Mirror { .. } => unreachable!("refused before encoding"),
             };
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
@@ -294,6 +295,18 @@ impl GpuBackend {
     }
 }
 
+/// The passes the GPU kernels cover: primary, shadow and ambient. OpenGL-like direct light and
+/// Whitted's mirror chains run on the CPU backend only, and a plan with them is refused by name.
+fn refuse_unsupported(plan: &RenderPlan) -> anyhow::Result<()> {
+    match plan.passes.iter().find(|p| matches!(p, Pass::Direct { .. } | Pass::Mirror { .. })) {
+        Some(p) => anyhow::bail!(
+            "the GPU backend has no kernel for the {} pass (the scene's [shading]); render this scene with backend = \"cpu\"",
+            p.name()
+        ),
+        None => Ok(()),
+    }
+}
+
 impl Backend for GpuBackend {
     fn adapter(&self) -> &AdapterInfo {
         &self.info
@@ -305,6 +318,7 @@ impl Backend for GpuBackend {
 
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         let plan = RenderPlan::new(scene, view)?;
+        refuse_unsupported(&plan)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
@@ -331,6 +345,7 @@ impl Backend for GpuBackend {
             primary: pixels as u64,
             shadow: [0; MAX_LIGHTS],
             ambient: 0,
+            reflection: 0,
         };
         for (i, s) in rays.shadow.iter_mut().enumerate() {
             *s = counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
@@ -373,6 +388,7 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
+        refuse_unsupported(&plan)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         loop {

@@ -12,6 +12,8 @@ pub struct Mesh {
     pub file_fnv1a: u64,
     /// Lambertian albedo.
     pub albedo: f64,
+    /// Mirror weight in [0, 1]: radiance leaving is (1 - mirror) x diffuse + mirror x reflected.
+    pub mirror: f64,
     /// Triangles kept.
     pub triangles: usize,
     /// Triangles dropped as unhittable.

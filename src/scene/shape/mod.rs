@@ -54,6 +54,15 @@ impl Shape {
         }
     }
 
+    /// Share of light reflected as by a perfect mirror (Whitted's k_r): meshes may declare one,
+    /// analytic shapes are diffuse.
+    pub fn mirror(&self) -> f64 {
+        match self {
+            Shape::Mesh(m) => m.mirror,
+            _ => 0.0,
+        }
+    }
+
     /// The nearest t > 0 along unit `dir` where an analytic shape is met (None for meshes: the
     /// accelerator answers for them).
     pub fn first_t(&self, origin: DVec3, dir: DVec3) -> Option<f64> {
