@@ -5,6 +5,7 @@ use clap::{Parser, ValueEnum};
 use penumbra::config::ConfigError;
 use penumbra::experiment::ao::{self, run_ao, AoSpec};
 use penumbra::experiment::fps::{self, FpsSpec};
+use penumbra::experiment::frames::{self, FramesSpec};
 use penumbra::experiment::sweep::filter::{self, Filter};
 use penumbra::experiment::sweep::merge::{merge_shards, MergePlan, MergeRefused};
 use penumbra::experiment::sweep::report::{write_all, Results};
@@ -128,6 +129,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         Experiment::Sweep(spec) => run_sweep_experiment(&args, *spec, started),
         Experiment::Fps(spec) => run_fps_experiment(&args, spec, started),
         Experiment::Ao(spec) => run_ao_experiment(&args, spec, started),
+        Experiment::Frames(spec) => run_frames_experiment(&args, spec, started),
     }
 }
 
@@ -169,6 +171,55 @@ fn run_ao_experiment(args: &Args, spec: AoSpec, started: Instant) -> anyhow::Res
     let threads = rayon::current_num_threads();
     ao::report::write_ao(&spec, (&rows, &tuning), threads, started.elapsed().as_secs_f64(), &out)?;
     info!("{} rows; wrote {}", rows.len(), out.join("report.md").display());
+    Ok(())
+}
+
+/// A frame-time experiment (`kind = "frames"`): times each structure frame by frame along a
+/// generated scene's camera path on the f64 CPU backend (the OpenGL-like and Whitted passes have
+/// no GPU kernels).
+fn run_frames_experiment(args: &Args, spec: FramesSpec, started: Instant) -> anyhow::Result<()> {
+    if !args.filter.is_empty() || args.shard.is_some() || !args.merge.is_empty() {
+        return Err(
+            BadInput("--filter, --shard and --merge apply to sweeps, not to frame-time experiments".into()).into(),
+        );
+    }
+    if matches!(args.backend, Some(BackendChoice::Gpu)) {
+        return Err(BadInput(
+            "frame-time experiments time the f64 CPU backend (the OpenGL-like and Whitted passes have no GPU kernels)"
+                .into(),
+        )
+        .into());
+    }
+    if args.dry_run {
+        for g in spec.scenes() {
+            println!(
+                "{}: [{}] x {} shadings x {} viewpoints x {} frames at {}x{}{}",
+                g.description,
+                spec.structures.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
+                spec.shadings.len(),
+                spec.viewpoints.len(),
+                spec.frames,
+                spec.width,
+                spec.height,
+                spec.motion
+                    .as_ref()
+                    .map_or(String::new(), |m| format!(", `{}` moving", m.part))
+            );
+        }
+        return Ok(());
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&spec.name));
+    let outcome = frames::run_frames(&spec, &|what| info!("{what}"))?;
+    let threads = rayon::current_num_threads();
+    frames::report::write_frames(&spec, &outcome, threads, started.elapsed().as_secs_f64(), &out)?;
+    info!(
+        "{} frames; wrote {}",
+        outcome.frames.len(),
+        out.join("report.md").display()
+    );
     Ok(())
 }
 

@@ -16,6 +16,8 @@ pub enum Kind {
     Fps,
     /// Ambient occlusion timed per acceleration structure ([`super::ao`]).
     Ao,
+    /// Frames along a camera path timed per acceleration structure ([`super::frames`]).
+    Frames,
 }
 
 impl Kind {

@@ -1,10 +1,12 @@
 //! Experiments, one module per kind, each with its spec, runner and report: [`sweep`] (sampling
-//! schemes swept and measured against a ground truth), [`fps`] (the paper's frame rates) and
-//! [`ao`] (the visibility-field paper's ambient-occlusion table). An
-//! experiment file names its kind with `kind` ([`kind`]).
+//! schemes swept and measured against a ground truth), [`fps`] (the paper's frame rates),
+//! [`ao`] (the visibility-field paper's ambient-occlusion table) and [`frames`] (its frame-time
+//! figures: scaling, walkthrough, dynamic scenes). An experiment file names its kind with
+//! `kind` ([`kind`]).
 
 pub mod ao;
 pub mod fps;
+pub mod frames;
 pub mod kind;
 pub mod sweep;
 
@@ -20,6 +22,8 @@ pub enum Experiment {
     Fps(fps::FpsSpec),
     /// `kind = "ao"`.
     Ao(ao::AoSpec),
+    /// `kind = "frames"`.
+    Frames(frames::FramesSpec),
 }
 
 impl Experiment {
@@ -33,6 +37,7 @@ impl Experiment {
                 .map_err(|e| if declared.is_none() { read_as_sweep(e) } else { e }),
             Kind::Fps => fps::FpsSpec::from_source(&source).map(Experiment::Fps),
             Kind::Ao => ao::AoSpec::from_source(&source).map(Experiment::Ao),
+            Kind::Frames => frames::FramesSpec::from_source(&source).map(Experiment::Frames),
         }
     }
 }

@@ -317,7 +317,7 @@ fn ranged(
 
 /// The visibility field's parameters from the scene's `[vlf]` table, each checked against the
 /// range the structure supports.
-fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError> {
+pub(crate) fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError> {
     let defaults = VlfSettings::default();
     let check = |key, value, default, range| ranged(source, "vlf", key, value, default, range);
     Ok(VlfSettings {
@@ -331,7 +331,7 @@ fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError
 
 /// The kd-tree's parameters from the scene's `[kdtree]` table (depth up to what its walk's
 /// stack holds).
-fn kd_settings(d: &KdDesc, source: &Source) -> Result<KdSettings, ConfigError> {
+pub(crate) fn kd_settings(d: &KdDesc, source: &Source) -> Result<KdSettings, ConfigError> {
     let defaults = KdSettings::default();
     let check = |key, value, default, range| ranged(source, "kdtree", key, value, default, range);
     Ok(KdSettings {

@@ -7,7 +7,8 @@
 pub mod ambient;
 pub mod camera;
 pub mod description;
-mod load;
+pub(crate) mod load;
+pub mod procedural;
 
 pub mod shape;
 

@@ -117,7 +117,61 @@ fn depth(tree: &Bvh2) -> usize {
     deepest
 }
 
+/// `tree` with every box widened by a few f32 ulps of its root's size (see `Bvh::cpu_tree`).
+fn widened(tree: &Bvh2) -> Bvh2 {
+    let mut cpu_tree = tree.clone();
+    if let Some(root) = tree.nodes.first() {
+        let size = root.aabb.min.abs().max(root.aabb.max.abs()).max_element();
+        let pad = Vec3A::splat(size * 8.0 * f32::EPSILON);
+        for n in &mut cpu_tree.nodes {
+            n.aabb.min -= pad;
+            n.aabb.max += pad;
+        }
+    }
+    cpu_tree
+}
+
 impl Bvh {
+    /// Refits the tree to `triangles`, the same triangles in the same order after some moved
+    /// (obvhs' `refit_all`): each leaf's box is recomputed from its whole triangles (a
+    /// pre-split leaf's box grows back to its triangle's), then every inner box bottom-up. The
+    /// topology is kept, so the tree's quality decays the further things move from where it
+    /// was built: the cheap update a dynamic scene weighs against a rebuild. Returns the time.
+    pub fn refit(&mut self, triangles: &Triangles) -> Duration {
+        assert_eq!(
+            triangles.positions.len(),
+            self.world.len(),
+            "a refit keeps the triangles"
+        );
+        let start = Instant::now();
+        let f = |p: DVec3| Vec3A::from((p - self.centre).as_vec3());
+        self.local = triangles
+            .positions
+            .iter()
+            .map(|t| Triangle {
+                v0: f(t[0]),
+                v1: f(t[1]),
+                v2: f(t[2]),
+            })
+            .collect();
+        self.world.clone_from(&triangles.positions);
+        let tree = &mut self.tree;
+        for i in 0..tree.nodes.len() {
+            let n = tree.nodes[i];
+            if n.is_leaf() {
+                let first = n.first_index as usize;
+                let prims = &tree.primitive_indices[first..first + n.prim_count as usize];
+                let aabb = prims.iter().fold(obvhs::aabb::Aabb::empty(), |a, &p| {
+                    a.union(&self.local[p as usize].aabb())
+                });
+                tree.nodes[i].set_aabb(aabb);
+            }
+        }
+        tree.refit_all();
+        self.cpu_tree = widened(&self.tree);
+        start.elapsed()
+    }
+
     /// Builds the tree over `triangles` with `preset`.
     pub fn build(triangles: &Triangles, preset: Preset) -> Bvh {
         let start = Instant::now();
@@ -140,15 +194,7 @@ impl Bvh {
         let mut build_time = Duration::default();
         let tree = build_bvh2_from_tris(&local, preset.params(), &mut build_time);
         let depth = depth(&tree);
-        let mut cpu_tree = tree.clone();
-        if let Some(root) = tree.nodes.first() {
-            let size = root.aabb.min.abs().max(root.aabb.max.abs()).max_element();
-            let pad = Vec3A::splat(size * 8.0 * f32::EPSILON);
-            for n in &mut cpu_tree.nodes {
-                n.aabb.min -= pad;
-                n.aabb.max += pad;
-            }
-        }
+        let cpu_tree = widened(&tree);
         Bvh {
             depth,
             tree,

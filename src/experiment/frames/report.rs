@@ -1,0 +1,535 @@
+//! Outputs of a frame-time experiment: frames.csv, builds.csv, plots (frame time along the
+//! path; with several scene sizes, frame time, memory and build time against triangle count on
+//! log-log axes; with motion, update time along the path), a strip of frames, and report.md
+//! with a verdict on the paper's claims computed from the rows.
+
+use super::runner::{BuildRow, FrameRow, FramesOutcome};
+use super::spec::{FramesSpec, ShadingName};
+use crate::files::write_atomic;
+use crate::metrics::stats::{median, quartiles};
+use crate::output::images::tonemap;
+use crate::output::plots::{image_grid, line_plot, Axes, Series};
+use crate::output::table::{float, write_rows};
+use serde::Serialize;
+use std::path::Path;
+
+#[derive(Serialize)]
+struct FrameCsv<'a> {
+    triangles: usize,
+    structure: &'a str,
+    update: &'a str,
+    shading: &'a str,
+    viewpoint: &'a str,
+    frame: u32,
+    #[serde(with = "float")]
+    frame_s: f64,
+    #[serde(with = "float")]
+    update_s: f64,
+    rays: u64,
+    differing_pixels: usize,
+}
+
+#[derive(Serialize)]
+struct BuildCsv<'a> {
+    triangles: usize,
+    structure: &'a str,
+    parameters: &'a str,
+    #[serde(with = "float")]
+    build_s: f64,
+    memory_mb: String,
+}
+
+/// A structure and the way it follows motion, as rows and plots label it.
+fn label(r: &FrameRow) -> String {
+    match r.update {
+        "none" => r.structure.to_string(),
+        u => format!("{} ({u})", r.structure),
+    }
+}
+
+/// The distinct labels of `rows`, in first-seen order.
+fn labels(rows: &[FrameRow]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in rows {
+        let l = label(r);
+        if !out.contains(&l) {
+            out.push(l);
+        }
+    }
+    out
+}
+
+/// Per frame (scene size, viewpoint, frame) of one shading, the ratio of `b`'s frame time to
+/// `a`'s: above 1 where `a` is faster.
+fn per_frame_ratios(rows: &[FrameRow], shading: ShadingName, triangles: Option<usize>, a: &str, b: &str) -> Vec<f64> {
+    let pick = |l: &str| -> Vec<&FrameRow> {
+        rows.iter()
+            .filter(|r| r.shading == shading && triangles.is_none_or(|t| r.triangles == t) && label(r) == l)
+            .collect()
+    };
+    let (xs, ys) = (pick(a), pick(b));
+    xs.iter()
+        .filter_map(|x| {
+            let y = ys
+                .iter()
+                .find(|y| y.triangles == x.triangles && y.viewpoint == x.viewpoint && y.frame == x.frame)?;
+            Some(y.seconds / x.seconds)
+        })
+        .collect()
+}
+
+/// "median M (q1-q3), faster on K of N frames" for ratios of `b` over `a`.
+fn ratio_summary(r: &[f64]) -> String {
+    let (q1, m, q3) = quartiles(r);
+    format!(
+        "median {m:.2}x (quartiles {q1:.2}-{q3:.2}x), faster on {} of {} frames",
+        r.iter().filter(|&&x| x > 1.0).count(),
+        r.len()
+    )
+}
+
+/// A time ratio (theirs / ours) in words: "2.00x faster" or "3.00x slower".
+fn faster(ratio: f64) -> String {
+    if ratio >= 1.0 {
+        format!("{ratio:.2}x faster")
+    } else {
+        format!("{:.2}x slower", 1.0 / ratio)
+    }
+}
+
+/// Least-squares slope of log y against log x: the exponent a of y ~ x^a.
+pub fn log_log_slope(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (xs, ys): (Vec<f64>, Vec<f64>) = points.iter().map(|(x, y)| (x.ln(), y.ln())).unzip();
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let sxx: f64 = xs.iter().map(|x| (x - mx).powi(2)).sum();
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Median frame seconds of `label` at `triangles` under `shading`, over every frame and viewpoint.
+fn median_at(rows: &[FrameRow], shading: ShadingName, l: &str, triangles: usize) -> Option<f64> {
+    let v: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.shading == shading && r.triangles == triangles && label(r) == l)
+        .map(|r| r.seconds)
+        .collect();
+    (!v.is_empty()).then(|| median(&v))
+}
+
+/// The verdict on the paper's frame-time claims, from the rows.
+pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
+    let rows = &outcome.frames;
+    let mut out = String::new();
+    let differing: usize = rows.iter().map(|r| r.differing_pixels).sum();
+    let worst = rows.iter().map(|r| r.differing_pixels).max().unwrap_or(0);
+    out += &if differing == 0 {
+        format!(
+            "- **Exactness**: every structure's frame equals the first structure's pixel for pixel (object and radiance bits), on all {} frames rendered.\n",
+            rows.len()
+        )
+    } else {
+        format!(
+            "- **Exactness**: {differing} pixels over all {} frames differ from the first structure's frame (at most {worst} in one frame): rays grazing a triangle's plane, which structures may decide differently.\n",
+            rows.len()
+        )
+    };
+    let sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).fold(Vec::new(), |mut v, t| {
+        if !v.contains(&t) {
+            v.push(t);
+        }
+        v
+    });
+    let all = labels(rows);
+    if spec.motion.is_none() {
+        for &(shading, _) in &spec.shadings {
+            for (baseline, what) in [
+                ("kdtree", "the CRT-like kd-tree (the paper's baseline)"),
+                ("bvh", "obvhs' BVH2 (very-slow build)"),
+            ] {
+                if !all.iter().any(|l| l == baseline) || !all.iter().any(|l| l == "vlf") {
+                    continue;
+                }
+                let r = per_frame_ratios(rows, shading, None, "vlf", baseline);
+                out += &format!(
+                    "- **VLF-RT vs {what}, {} shading**: speed-up per frame (its time / VLF-RT's) {}.",
+                    shading.name(),
+                    ratio_summary(&r)
+                );
+                if sizes.len() > 1 {
+                    let per: Vec<String> = sizes
+                        .iter()
+                        .map(|&t| {
+                            let r = per_frame_ratios(rows, shading, Some(t), "vlf", baseline);
+                            format!("{}K {:.2}x", t as f64 / 1e3, median(&r))
+                        })
+                        .collect();
+                    out += &format!(" By size: {}.", per.join(", "));
+                }
+                out += "\n";
+            }
+            if sizes.len() > 1 {
+                let slopes: Vec<String> = all
+                    .iter()
+                    .filter_map(|l| {
+                        let pts: Vec<(f64, f64)> = sizes
+                            .iter()
+                            .filter_map(|&t| Some((t as f64, median_at(rows, shading, l, t)?)))
+                            .collect();
+                        Some(format!("{l} N^{:.2}", log_log_slope(&pts)?))
+                    })
+                    .collect();
+                out += &format!(
+                    "- **Scaling, {} shading**: median frame time grows as {} (least-squares log-log slope over {} sizes, {}K-{}K triangles).\n",
+                    shading.name(),
+                    slopes.join(", "),
+                    sizes.len(),
+                    sizes[0] as f64 / 1e3,
+                    sizes[sizes.len() - 1] as f64 / 1e3
+                );
+            }
+        }
+    } else {
+        let stat = |l: &str, f: &dyn Fn(&FrameRow) -> f64| -> f64 {
+            median(&rows.iter().filter(|r| label(r) == l).map(f).collect::<Vec<_>>())
+        };
+        let update = |l: &str| stat(l, &|r| r.update_seconds.unwrap_or(f64::NAN));
+        let total = |l: &str| stat(l, &|r| r.seconds + r.update_seconds.unwrap_or(0.0));
+        let listed: Vec<String> = all
+            .iter()
+            .map(|l| format!("{l} {:.4} s update, {:.4} s update + frame", update(l), total(l)))
+            .collect();
+        out += &format!("- **Per moving frame (medians)**: {}.\n", listed.join("; "));
+        if all.iter().any(|l| l == "vlf (update)") {
+            let field = update("vlf (update)");
+            for other in all.iter().filter(|l| !l.starts_with("vlf")) {
+                out += &format!(
+                    "- **VLF-RT's update vs {other}**: {} to update, {} per frame including the render.\n",
+                    faster(update(other) / field),
+                    faster(total(other) / total("vlf (update)"))
+                );
+            }
+            if let Some(b) = outcome.builds.iter().find(|b| b.structure == "vlf") {
+                out += &format!(
+                    "- **VLF-RT's update vs its own build**: {:.4} s against {:.2} s ({}).\n",
+                    field,
+                    b.build_seconds,
+                    faster(b.build_seconds / field)
+                );
+            }
+        }
+    }
+    let cost: Vec<String> = outcome
+        .builds
+        .iter()
+        .map(|b| {
+            format!(
+                "{} at {}K: {:.1} MB, {:.2} s",
+                b.structure,
+                b.triangles as f64 / 1e3,
+                b.memory_bytes as f64 / 1e6,
+                b.build_seconds
+            )
+        })
+        .collect();
+    out += &format!("- **Memory and build time**: {}.\n", cost.join("; "));
+    if sizes.len() > 1 {
+        let slopes: Vec<String> = spec
+            .structures
+            .iter()
+            .filter_map(|s| {
+                let pts: Vec<(f64, f64)> = outcome
+                    .builds
+                    .iter()
+                    .filter(|b| b.structure == s.name)
+                    .map(|b| (b.triangles as f64, b.memory_bytes as f64))
+                    .collect();
+                Some(format!("{} N^{:.2}", s.name, log_log_slope(&pts)?))
+            })
+            .collect();
+        out += &format!("- **Memory grows as** {}.\n", slopes.join(", "));
+    }
+    out
+}
+
+/// Writes frames.csv, builds.csv, plots/, images/ and report.md under `out`.
+pub fn write_frames(
+    spec: &FramesSpec,
+    outcome: &FramesOutcome,
+    threads: usize,
+    seconds: f64,
+    out: &Path,
+) -> anyhow::Result<()> {
+    let rows = &outcome.frames;
+    write_rows(
+        &out.join("frames.csv"),
+        rows.iter().map(|r| FrameCsv {
+            triangles: r.triangles,
+            structure: r.structure,
+            update: r.update,
+            shading: r.shading.name(),
+            viewpoint: &r.viewpoint,
+            frame: r.frame,
+            frame_s: r.seconds,
+            update_s: r.update_seconds.unwrap_or(f64::NAN),
+            rays: r.rays,
+            differing_pixels: r.differing_pixels,
+        }),
+    )?;
+    write_rows(
+        &out.join("builds.csv"),
+        outcome.builds.iter().map(|b: &BuildRow| BuildCsv {
+            triangles: b.triangles,
+            structure: b.structure,
+            parameters: &b.parameters,
+            build_s: b.build_seconds,
+            memory_mb: format!("{:.3}", b.memory_bytes as f64 / 1e6),
+        }),
+    )?;
+    let all = labels(rows);
+    let largest = outcome.builds.iter().map(|b| b.triangles).max().unwrap_or(0);
+    for &(shading, _) in &spec.shadings {
+        let series = |value: &dyn Fn(&FrameRow) -> f64| -> Vec<(usize, Series)> {
+            all.iter()
+                .enumerate()
+                .map(|(i, l)| {
+                    let points = rows
+                        .iter()
+                        .filter(|r| r.shading == shading && r.triangles == largest && label(r) == *l)
+                        .filter(|r| r.viewpoint == spec.viewpoints[0])
+                        .map(|r| (r.frame as f64, value(r), f64::NAN))
+                        .collect();
+                    (
+                        i,
+                        Series {
+                            name: l.clone(),
+                            points,
+                            dashed: false,
+                        },
+                    )
+                })
+                .collect()
+        };
+        let title = format!(
+            "{} shading, {}x{}, {}K triangles, viewpoint {}, CPU f64",
+            shading.name(),
+            spec.width,
+            spec.height,
+            largest as f64 / 1e3,
+            spec.viewpoints[0]
+        );
+        line_plot(
+            &out.join(format!("plots/frame_time_{}.png", shading.name())),
+            &Axes::new(&title, "frame", "render seconds", false, false),
+            &series(&|r| r.seconds),
+            &[],
+        )?;
+        if spec.motion.is_some() {
+            line_plot(
+                &out.join(format!("plots/update_time_{}.png", shading.name())),
+                &Axes::new(&title, "frame", "update seconds", false, true),
+                &series(&|r| r.update_seconds.unwrap_or(f64::NAN)),
+                &[],
+            )?;
+        }
+        let sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
+        if sizes.iter().any(|&t| t != largest) {
+            let series: Vec<(usize, Series)> = all
+                .iter()
+                .enumerate()
+                .map(|(i, l)| {
+                    let mut points: Vec<(f64, f64, f64)> = sizes
+                        .iter()
+                        .filter_map(|&t| Some((t as f64, median_at(rows, shading, l, t)?, f64::NAN)))
+                        .collect();
+                    points.dedup_by(|a, b| a.0 == b.0);
+                    (
+                        i,
+                        Series {
+                            name: l.clone(),
+                            points,
+                            dashed: false,
+                        },
+                    )
+                })
+                .collect();
+            line_plot(
+                &out.join(format!("plots/scaling_{}.png", shading.name())),
+                &Axes::new(
+                    &format!(
+                        "{} shading, {}x{}, median over the path",
+                        shading.name(),
+                        spec.width,
+                        spec.height
+                    ),
+                    "triangles",
+                    "frame seconds",
+                    true,
+                    true,
+                ),
+                &series,
+                &[],
+            )?;
+        }
+    }
+    if outcome.builds.iter().any(|b| b.triangles != largest) {
+        for (file, what, value) in [
+            (
+                "memory",
+                "MB beyond the triangles",
+                &(|b: &BuildRow| b.memory_bytes as f64 / 1e6) as &dyn Fn(&BuildRow) -> f64,
+            ),
+            ("build_time", "build seconds", &|b: &BuildRow| b.build_seconds),
+        ] {
+            let series: Vec<(usize, Series)> = spec
+                .structures
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    (
+                        i,
+                        Series {
+                            name: s.name.to_string(),
+                            points: outcome
+                                .builds
+                                .iter()
+                                .filter(|b| b.structure == s.name)
+                                .map(|b| (b.triangles as f64, value(b), f64::NAN))
+                                .collect(),
+                            dashed: false,
+                        },
+                    )
+                })
+                .collect();
+            line_plot(
+                &out.join(format!("plots/{file}.png")),
+                &Axes::new(what, "triangles", what, true, true),
+                &series,
+                &[],
+            )?;
+        }
+    }
+    for &(shading, _) in &spec.shadings {
+        let pictures: Vec<_> = outcome
+            .pictures
+            .iter()
+            .filter(|p| p.shading == shading)
+            .map(|p| {
+                (
+                    format!("frame {}", p.frame),
+                    tonemap(&p.radiance, spec.width, spec.height),
+                )
+            })
+            .collect();
+        let tiles: Vec<(String, &_)> = pictures.iter().map(|(c, img)| (c.clone(), img)).collect();
+        image_grid(
+            &out.join(format!("images/strip_{}.png", shading.name())),
+            &tiles,
+            tiles.len().max(1),
+        )?;
+    }
+    write_atomic(
+        &out.join("report.md"),
+        report(spec, outcome, threads, seconds).as_bytes(),
+    )?;
+    let manifest = format!(
+        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\nbackend = \"cpu\"\nthreads = {threads}\n",
+        crate::output::git_commit(),
+        spec.path.display().to_string(),
+        seconds,
+    );
+    write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}
+
+fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f64) -> String {
+    let rows = &outcome.frames;
+    let mut md = format!("# {}: frame times per acceleration structure\n\n", spec.name);
+    md += &format!(
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}; every frame is rendered by every structure in a fresh seeded order, {} timed render(s) each (median kept), and compared pixel for pixel with the first structure's.{}\n\n",
+        spec.path.display(),
+        seconds,
+        outcome.scenes.join("; "),
+        spec.frames,
+        spec.viewpoints.join(", "),
+        spec.width,
+        spec.height,
+        spec.shadings.iter().map(|s| s.0.name()).collect::<Vec<_>>().join(", "),
+        spec.repeats,
+        spec.motion.as_ref().map_or(String::new(), |m| format!(
+            " Before each frame the part `{}` moves by {:?} m and each structure is brought up to date (the field by its own update, the BVH by a refit and by a rebuild, the kd-tree by a rebuild), the update timed.",
+            m.part,
+            m.step.to_array()
+        ))
+    );
+    md += "## Verdict\n\n";
+    md += &verdict(spec, outcome);
+    md += "\n## Medians\n\n| triangles | shading | structure | frame s (q1-q3) | update s | rays per frame | frames |\n|---|---|---|---|---|---|---|\n";
+    let mut sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
+    sizes.dedup();
+    for &t in &sizes {
+        for &(shading, _) in &spec.shadings {
+            for l in labels(rows) {
+                let sel: Vec<&FrameRow> = rows
+                    .iter()
+                    .filter(|r| r.triangles == t && r.shading == shading && label(r) == l)
+                    .collect();
+                if sel.is_empty() {
+                    continue;
+                }
+                let secs: Vec<f64> = sel.iter().map(|r| r.seconds).collect();
+                let (q1, m, q3) = quartiles(&secs);
+                let upd: Vec<f64> = sel.iter().filter_map(|r| r.update_seconds).collect();
+                md += &format!(
+                    "| {t} | {} | {l} | {m:.4} ({q1:.4}-{q3:.4}) | {} | {:.0} | {} |\n",
+                    shading.name(),
+                    if upd.is_empty() {
+                        "-".into()
+                    } else {
+                        format!("{:.4}", median(&upd))
+                    },
+                    median(&sel.iter().map(|r| r.rays as f64).collect::<Vec<_>>()),
+                    sel.len()
+                );
+            }
+        }
+    }
+    md += "\n## Builds\n\n| triangles | structure | parameters | build s | MB |\n|---|---|---|---|---|\n";
+    for b in &outcome.builds {
+        md += &format!(
+            "| {} | {} | {} | {:.3} | {:.1} |\n",
+            b.triangles,
+            b.structure,
+            b.parameters,
+            b.build_seconds,
+            b.memory_bytes as f64 / 1e6
+        );
+    }
+    md += "\nOutputs: `frames.csv` (one row per frame and structure), `builds.csv`, `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
+    if spec.motion.is_some() {
+        md += ", `plots/update_time_SHADING.png` (update time along the path)";
+    }
+    if sizes.len() > 1 {
+        md += ", `plots/scaling_SHADING.png`, `plots/memory.png`, `plots/build_time.png` (log-log against triangle count)";
+    }
+    md += ", `images/strip_SHADING.png` (frames along the path, first structure).\n";
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_log_slope_recovers_a_power_law() {
+        let pts: Vec<(f64, f64)> = [1e3, 4e3, 16e3, 256e3]
+            .iter()
+            .map(|&x: &f64| (x, 3.0 * x.powf(0.37)))
+            .collect();
+        assert!((log_log_slope(&pts).unwrap() - 0.37).abs() < 1e-12);
+        assert_eq!(log_log_slope(&pts[..1]), None);
+        assert_eq!(log_log_slope(&[(2.0, 1.0), (2.0, 5.0)]), None);
+    }
+}

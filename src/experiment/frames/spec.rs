@@ -1,0 +1,360 @@
+//! The frame-time experiment file (`kind = "frames"`): a generated scene walked along its camera
+//! path and rendered by each acceleration structure, frame by frame, on the f64 CPU backend.
+//! One kind serves the visibility-field paper's three frame-time figures: scaling with scene
+//! size (Fig. 5: random triangles at several counts, two viewpoints), the classroom walkthrough
+//! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part
+//! moves every frame and each structure is updated before rendering it).
+
+use crate::accel::{self, kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
+use crate::config::{ConfigError, Seg, Source};
+use crate::experiment::kind::Kind;
+use crate::key_path;
+use crate::scene::description::{KdDesc, VlfDesc};
+use crate::scene::load::{kd_settings, vlf_settings};
+use crate::scene::procedural::{classroom, random, Generated};
+use crate::scene::Shading;
+use glam::DVec3;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    kind: Kind,
+    name: String,
+    width: u32,
+    height: u32,
+    structures: Vec<String>,
+    shadings: Vec<ShadingName>,
+    #[serde(default = "three")]
+    mirror_depth: u32,
+    #[serde(default = "one")]
+    repeats: u32,
+    scene: SceneEntry,
+    path: PathEntry,
+    motion: Option<MotionEntry>,
+    #[serde(default)]
+    kdtree: KdDesc,
+    #[serde(default)]
+    vlf: VlfDesc,
+    #[serde(default = "six")]
+    strip: u32,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn three() -> u32 {
+    3
+}
+
+fn six() -> u32 {
+    6
+}
+
+/// A shading as the experiment names it.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadingName {
+    /// Primary rays, unoccluded local diffuse light.
+    Opengl,
+    /// Shadow rays to every light at every vertex and mirror chains.
+    Whitted,
+}
+
+impl ShadingName {
+    /// The name in files and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadingName::Opengl => "opengl",
+            ShadingName::Whitted => "whitted",
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneEntry {
+    generator: String,
+    #[serde(default)]
+    triangles: Vec<usize>,
+    #[serde(default = "one")]
+    seed: u32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathEntry {
+    frames: u32,
+    #[serde(default)]
+    viewpoints: Vec<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MotionEntry {
+    part: String,
+    step: [f64; 3],
+}
+
+/// What a scene of the experiment is made by.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Generator {
+    /// [`classroom::classroom`].
+    Classroom,
+    /// [`random::random_triangles`] at each count, from one seed.
+    RandomTriangles {
+        /// Triangle counts, ascending.
+        counts: Vec<usize>,
+        /// Generator seed.
+        seed: u32,
+    },
+}
+
+/// A part moved by a fixed step every frame, each structure updated in its own way.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    /// The moving part's name.
+    pub part: String,
+    /// Translation per frame, metres.
+    pub step: DVec3,
+}
+
+/// A validated frame-time experiment.
+#[derive(Clone, Debug)]
+pub struct FramesSpec {
+    /// Results folder name.
+    pub name: String,
+    /// The experiment file.
+    pub path: PathBuf,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Each structure with its parameters.
+    pub structures: Vec<AccelSettings>,
+    /// Shadings rendered, each over the whole path.
+    pub shadings: Vec<(ShadingName, Shading)>,
+    /// Timed renders per frame (the median is kept).
+    pub repeats: u32,
+    /// The scene generator.
+    pub generator: Generator,
+    /// Frames per viewpoint.
+    pub frames: u32,
+    /// Viewpoints (random triangles: each a short path; the classroom: its one walk).
+    pub viewpoints: Vec<String>,
+    /// The moving part, for dynamic experiments.
+    pub motion: Option<Motion>,
+    /// Frames saved as pictures, evenly along the path.
+    pub strip: u32,
+}
+
+/// The registered structures the experiment compares at the file's parameters; obvhs' BVH at
+/// its slowest, best build.
+fn structure(name: &'static str, kdtree: KdSettings, vlf: VlfSettings) -> AccelSettings {
+    AccelSettings {
+        name,
+        bvh_preset: Preset::VerySlow,
+        vlf,
+        kdtree,
+    }
+}
+
+impl FramesSpec {
+    /// Reads and validates a frame-time experiment.
+    pub fn load(path: &Path) -> Result<FramesSpec, ConfigError> {
+        FramesSpec::from_source(&Source::read(path)?)
+    }
+
+    /// Validates a frame-time experiment read from `source`.
+    pub fn from_source(source: &Source) -> Result<FramesSpec, ConfigError> {
+        let f: File = source.parse()?;
+        let err = |p: &[Seg], m: String| source.error(p, m);
+        if f.kind != Kind::Frames {
+            return Err(err(
+                &key_path!["kind"],
+                "a frame-time experiment has kind = \"frames\"".into(),
+            ));
+        }
+        for (k, v) in [("width", f.width), ("height", f.height)] {
+            if !(1..=16384).contains(&v) {
+                return Err(err(&key_path![k], format!("must be in 1..=16384, got {v}")));
+            }
+        }
+        if f.repeats == 0 {
+            return Err(err(&key_path!["repeats"], "at least one timed render per frame".into()));
+        }
+        if f.mirror_depth == 0 || f.mirror_depth > Shading::MAX_MIRROR_DEPTH {
+            return Err(err(
+                &key_path!["mirror_depth"],
+                format!("must be in 1..={}, got {}", Shading::MAX_MIRROR_DEPTH, f.mirror_depth),
+            ));
+        }
+        let (kdtree, vlf) = (kd_settings(&f.kdtree, source)?, vlf_settings(&f.vlf, source)?);
+        if f.structures.is_empty() {
+            return Err(err(&key_path!["structures"], "name at least one structure".into()));
+        }
+        let mut structures: Vec<AccelSettings> = Vec::new();
+        for (i, s) in f.structures.iter().enumerate() {
+            let r = accel::registered(s).ok_or_else(|| {
+                err(
+                    &key_path!["structures", i],
+                    format!(
+                        "unknown acceleration structure `{s}`; known: {}",
+                        accel::names().join(", ")
+                    ),
+                )
+            })?;
+            if structures.iter().any(|a| a.name == r.name) {
+                return Err(err(&key_path!["structures", i], format!("`{s}` is listed twice")));
+            }
+            structures.push(structure(r.name, kdtree, vlf));
+        }
+        if f.shadings.is_empty() {
+            return Err(err(&key_path!["shadings"], "name at least one shading".into()));
+        }
+        let mut shadings = Vec::new();
+        for (i, s) in f.shadings.iter().enumerate() {
+            if shadings.iter().any(|(n, _)| n == s) {
+                return Err(err(
+                    &key_path!["shadings", i],
+                    format!("`{}` is listed twice", s.name()),
+                ));
+            }
+            shadings.push((
+                *s,
+                match s {
+                    ShadingName::Opengl => Shading::OPENGL,
+                    ShadingName::Whitted => Shading::whitted(f.mirror_depth),
+                },
+            ));
+        }
+        let generator = match f.scene.generator.as_str() {
+            "classroom" => {
+                if !f.scene.triangles.is_empty() {
+                    return Err(err(
+                        &key_path!["scene", "triangles"],
+                        "the classroom has its own triangles; counts apply to random-triangles".into(),
+                    ));
+                }
+                Generator::Classroom
+            }
+            "random-triangles" => {
+                let counts = f.scene.triangles.clone();
+                if counts.is_empty() {
+                    return Err(err(
+                        &key_path!["scene", "triangles"],
+                        "list at least one triangle count".into(),
+                    ));
+                }
+                if let Some(i) = (0..counts.len()).find(|&i| counts[i] == 0 || (i > 0 && counts[i] <= counts[i - 1])) {
+                    return Err(err(
+                        &key_path!["scene", "triangles", i],
+                        "counts must be positive and ascending".into(),
+                    ));
+                }
+                Generator::RandomTriangles {
+                    counts,
+                    seed: f.scene.seed,
+                }
+            }
+            other => {
+                return Err(err(
+                    &key_path!["scene", "generator"],
+                    format!("unknown generator `{other}`; known: classroom, random-triangles"),
+                ))
+            }
+        };
+        if f.path.frames == 0 {
+            return Err(err(&key_path!["path", "frames"], "at least one frame".into()));
+        }
+        let viewpoints = match generator {
+            Generator::Classroom => {
+                if !f.path.viewpoints.is_empty() {
+                    return Err(err(
+                        &key_path!["path", "viewpoints"],
+                        "the classroom has one walk; viewpoints apply to random-triangles".into(),
+                    ));
+                }
+                vec!["walk".to_string()]
+            }
+            Generator::RandomTriangles { .. } => {
+                if f.path.viewpoints.is_empty() {
+                    return Err(err(
+                        &key_path!["path", "viewpoints"],
+                        format!("list viewpoints from: {}", random::VIEWPOINTS.join(", ")),
+                    ));
+                }
+                for (i, v) in f.path.viewpoints.iter().enumerate() {
+                    if !random::VIEWPOINTS.contains(&v.as_str()) {
+                        return Err(err(
+                            &key_path!["path", "viewpoints", i],
+                            format!("unknown viewpoint `{v}`; known: {}", random::VIEWPOINTS.join(", ")),
+                        ));
+                    }
+                }
+                f.path.viewpoints.clone()
+            }
+        };
+        let motion = match &f.motion {
+            None => None,
+            Some(m) => {
+                let probe = match &generator {
+                    Generator::Classroom => classroom::classroom(),
+                    Generator::RandomTriangles { seed, .. } => random::random_triangles(1, *seed),
+                };
+                if probe.part(&m.part).is_none() {
+                    let names: Vec<&str> = probe.parts.iter().map(|p| p.name.as_str()).collect();
+                    return Err(err(
+                        &key_path!["motion", "part"],
+                        format!("no part `{}`; the scene has: {}", m.part, names.join(", ")),
+                    ));
+                }
+                let step = DVec3::from_array(m.step);
+                if !step.is_finite() {
+                    return Err(err(&key_path!["motion", "step"], "coordinates must be finite".into()));
+                }
+                Some(Motion {
+                    part: m.part.clone(),
+                    step,
+                })
+            }
+        };
+        Ok(FramesSpec {
+            name: f.name,
+            path: source.path.clone(),
+            width: f.width,
+            height: f.height,
+            structures,
+            shadings,
+            repeats: f.repeats,
+            generator,
+            frames: f.path.frames,
+            viewpoints,
+            motion,
+            strip: f.strip,
+        })
+    }
+
+    /// Every scene of the experiment, generated: the classroom once, or random triangles at
+    /// each count.
+    pub fn scenes(&self) -> Vec<Generated> {
+        match &self.generator {
+            Generator::Classroom => vec![classroom::classroom()],
+            Generator::RandomTriangles { counts, seed } => {
+                counts.iter().map(|&n| random::random_triangles(n, *seed)).collect()
+            }
+        }
+    }
+
+    /// The camera of `frame` along `viewpoint`.
+    pub fn camera(&self, viewpoint: &str, frame: u32) -> crate::scene::camera::Camera {
+        match self.generator {
+            Generator::Classroom => classroom::camera_path(frame, self.frames),
+            Generator::RandomTriangles { .. } => {
+                random::camera_path(viewpoint, frame).expect("viewpoints are validated")
+            }
+        }
+    }
+}
