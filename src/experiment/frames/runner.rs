@@ -245,7 +245,7 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
             }
             for (vp, viewpoint) in spec.viewpoints.iter().enumerate() {
                 for frame in 0..spec.frames {
-                    let camera = spec.camera(viewpoint, frame);
+                    let camera = spec.camera(viewpoint, frame)?;
                     let view = View {
                         camera: &camera,
                         width: spec.width,

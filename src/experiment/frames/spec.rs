@@ -89,6 +89,7 @@ struct PathEntry {
     frames: u32,
     #[serde(default)]
     viewpoints: Vec<String>,
+    look_at: Option<[f64; 3]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -144,6 +145,9 @@ pub struct FramesSpec {
     pub frames: u32,
     /// Viewpoints (random triangles: each a short path; the classroom: its one walk).
     pub viewpoints: Vec<String>,
+    /// A point every camera of the path looks at instead of its own (keeps a moving part in
+    /// view).
+    pub look_at: Option<DVec3>,
     /// The moving part, for dynamic experiments.
     pub motion: Option<Motion>,
     /// Frames saved as pictures, evenly along the path.
@@ -297,6 +301,12 @@ impl FramesSpec {
                 f.path.viewpoints.clone()
             }
         };
+        let look_at = match f.path.look_at {
+            Some(p) if !p.iter().all(|x| x.is_finite()) => {
+                return Err(err(&key_path!["path", "look_at"], "coordinates must be finite".into()))
+            }
+            p => p.map(DVec3::from_array),
+        };
         let motion = match &f.motion {
             None => None,
             Some(m) => {
@@ -332,6 +342,7 @@ impl FramesSpec {
             generator,
             frames: f.path.frames,
             viewpoints,
+            look_at,
             motion,
             strip: f.strip,
         })
@@ -348,13 +359,25 @@ impl FramesSpec {
         }
     }
 
-    /// The camera of `frame` along `viewpoint`.
-    pub fn camera(&self, viewpoint: &str, frame: u32) -> crate::scene::camera::Camera {
-        match self.generator {
+    /// The camera of `frame` along `viewpoint`, or an error where it cannot look at the
+    /// file's `look_at` (standing on it, or looking straight up or down at it).
+    pub fn camera(&self, viewpoint: &str, frame: u32) -> anyhow::Result<crate::scene::camera::Camera> {
+        let mut camera = match self.generator {
             Generator::Classroom => classroom::camera_path(frame, self.frames),
             Generator::RandomTriangles { .. } => {
                 random::camera_path(viewpoint, frame).expect("viewpoints are validated")
             }
+        };
+        if let Some(p) = self.look_at {
+            camera.look_at = p;
         }
+        anyhow::ensure!(
+            camera.frame().is_some(),
+            "{}: frame {frame} of viewpoint `{viewpoint}` stands at {} and cannot look at {} with up = z (path.look_at)",
+            self.path.display(),
+            camera.position,
+            camera.look_at
+        );
+        Ok(camera)
     }
 }

@@ -1,0 +1,190 @@
+//! The frame-time experiment kind (`kind = "frames"`) through the binary: the CI walkthrough
+//! (experiments/frames-ci.toml) and small scaling and dynamic variants of it write their tables,
+//! plots, strips and reports, and every structure, including brute force, renders every frame
+//! identically: the committed threshold is zero differing pixels, static or moving. Bad input is
+//! a located error with exit status 2 that writes nothing.
+
+mod common;
+
+use std::ffi::OsStr;
+use std::path::Path;
+
+/// Runs `text` as an experiment; returns frames.csv as (header, rows) and the report.
+fn run(dir: &Path, text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>, String) {
+    let exp = dir.join("exp.toml");
+    std::fs::write(&exp, text).unwrap();
+    let out = dir.join("out");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    let mut reader = csv::Reader::from_path(out.join("frames.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let rows = reader.records().map(Result::unwrap).collect();
+    (header, rows, std::fs::read_to_string(out.join("report.md")).unwrap())
+}
+
+fn ci() -> String {
+    std::fs::read_to_string(common::repo("experiments/frames-ci.toml")).unwrap()
+}
+
+#[test]
+fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let (header, rows, report) = run(dir.path(), &ci());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
+    for r in &rows {
+        assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
+        let rays: u64 = r[col("rays")].parse().unwrap();
+        match &r[col("shading")] {
+            "opengl" => assert_eq!(rays, 32 * 32, "OpenGL-like shading traces camera rays only"),
+            _ => assert!(
+                rays > 4 * 32 * 32,
+                "Whitted: shadow rays to 4 lights and reflections; {rays}"
+            ),
+        }
+        assert!(r[col("frame_s")].parse::<f64>().unwrap() > 0.0);
+    }
+    let out = dir.path().join("out");
+    for file in [
+        "builds.csv",
+        "manifest.toml",
+        "plots/frame_time_opengl.png",
+        "plots/frame_time_whitted.png",
+        "images/strip_opengl.png",
+        "images/strip_whitted.png",
+    ] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    assert!(
+        report.contains("equals the first structure's pixel for pixel"),
+        "{report}"
+    );
+    assert!(
+        report.contains("VLF-RT vs the CRT-like kd-tree (the paper's baseline), whitted shading"),
+        "{report}"
+    );
+    assert!(
+        !out.join("plots/scaling_opengl.png").exists(),
+        "one scene size: no scaling plot"
+    );
+}
+
+#[test]
+fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = ci()
+        .replace(
+            "generator = \"classroom\"",
+            "generator = \"random-triangles\"\ntriangles = [300, 2400]\nseed = 5",
+        )
+        .replace("frames = 3", "frames = 2\nviewpoints = [\"outside\", \"inside\"]")
+        .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]");
+    let (header, rows, report) = run(dir.path(), &text);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 2 * 2 * 4, "sizes x viewpoints x frames x structures");
+    assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
+    for file in ["plots/scaling_opengl.png", "plots/memory.png", "plots/build_time.png"] {
+        assert!(dir.path().join("out").join(file).exists(), "{file} missing");
+    }
+    assert!(report.contains("median frame time grows as kdtree N^"), "{report}");
+    assert!(report.contains("Memory grows as"), "{report}");
+}
+
+#[test]
+fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    // Every camera of the walk looks at the teacher's desk while the chrome ball rolls on it.
+    let text = ci().replace(
+        "[path]\nframes = 3",
+        "[path]\nframes = 3\nlook_at = [-3.5, 0.0, 0.9]\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, -0.05, 0.0]",
+    );
+    let (header, rows, report) = run(dir.path(), &text);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let methods: Vec<String> = rows
+        .iter()
+        .map(|r| format!("{} {}", &r[col("structure")], &r[col("update")]))
+        .collect();
+    for m in [
+        "kdtree rebuild",
+        "vlf update",
+        "bvh rebuild",
+        "bvh refit",
+        "brute rebuild",
+    ] {
+        assert!(methods.iter().any(|x| x == m), "{m} missing: {methods:?}");
+    }
+    assert_eq!(rows.len(), 2 * 3 * 5);
+    for r in &rows {
+        assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
+        assert!(r[col("update_s")].parse::<f64>().unwrap() > 0.0, "{r:?}");
+    }
+    assert!(report.contains("VLF-RT's update vs bvh (refit)"), "{report}");
+    assert!(dir.path().join("out/plots/update_time_whitted.png").exists());
+}
+
+#[test]
+fn bad_input_is_located_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = ci();
+    let random = text.replace(
+        "generator = \"classroom\"",
+        "generator = \"random-triangles\"\ntriangles = [300, 2400]",
+    );
+    for (edit, key) in [
+        (
+            text.replace("generator = \"classroom\"", "generator = \"office\""),
+            "scene.generator",
+        ),
+        (
+            text.replace("\"bvh\", \"brute\"", "\"bvh\", \"octree\""),
+            "structures[3]",
+        ),
+        (
+            text.replace("\"opengl\", \"whitted\"", "\"opengl\", \"opengl\""),
+            "shadings[1]",
+        ),
+        (text.replace("mirror_depth = 3", "mirror_depth = 0"), "mirror_depth"),
+        (text.replace("frames = 3", "frames = 0"), "path.frames"),
+        (text.replace("depth = 3", "depth = 9"), "vlf.depth"),
+        (
+            text.replace(
+                "frames = 3",
+                "frames = 3\n\n[motion]\npart = \"piano\"\nstep = [0.0, 0.0, 0.1]",
+            ),
+            "motion.part",
+        ),
+        (
+            text.replace(
+                "generator = \"classroom\"",
+                "generator = \"classroom\"\ntriangles = [10]",
+            ),
+            "scene.triangles",
+        ),
+        (random.replace("[300, 2400]", "[2400, 300]"), "scene.triangles[1]"),
+        (random.clone(), "path.viewpoints"),
+        (
+            random.replace("frames = 3", "frames = 3\nviewpoints = [\"above\"]"),
+            "path.viewpoints[0]",
+        ),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, edit).unwrap();
+        let out = dir.path().join("out");
+        let (code, err) = common::sweep(&[path.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+        assert_eq!(code, 2, "{key}: {err}");
+        assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
+        assert!(!out.exists(), "{key}: wrote {}", out.display());
+    }
+    let exp = common::repo("experiments/frames-ci.toml");
+    let out = dir.path().join("gpu");
+    let (code, err) = common::sweep(&[
+        exp.as_os_str(),
+        OsStr::new("--backend"),
+        OsStr::new("gpu"),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("CPU backend"), "{err}");
+    assert!(!out.exists());
+}
