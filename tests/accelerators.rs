@@ -310,6 +310,21 @@ fn sweeping_the_structure_changes_only_its_columns() {
     for (name, rows) in &by_structure {
         assert_eq!(rows, first, "{name}'s measurements differ");
     }
+    assert!(
+        header.iter().any(|h| h == "image_fnv1a"),
+        "runs.csv carries each image's hash"
+    );
+    // The report sets each structure beside the first: 2 schemes x 2 patterns x 2 seeds each.
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let others = 8 * (REGISTRY.len() - 1);
+    assert!(report.contains("## What the acceleration structure costs"), "{report}");
+    assert!(
+        report.contains(&format!(
+            "Identical shadow images in {others} of {others} runs compared."
+        )),
+        "{report}"
+    );
+    assert!(!report.contains("NaN"), "{report}");
 
     let bad = common::tiny_experiment(dir.path(), |t| {
         t.replace("seeds = [1, 2]", "seeds = [1, 2]\naccelerators = [\"bvh\", \"kd\"]")

@@ -50,19 +50,14 @@ fn disagreements(a: &dyn Accelerator, current: &Triangles, rays: &[Ray]) -> usiz
         .count()
 }
 
-#[test]
-fn refit_bvh_and_updated_field_answer_as_brute_force_after_the_ball_rolls_away() {
+/// Rolls the ball three times (two small steps, then far across the room), refitting the BVH
+/// and updating a field built with `settings`; both must answer as brute force after each move.
+fn roll_the_ball(settings: VlfSettings) {
     let g = classroom();
     let (object, _) = g.part("chrome-ball").unwrap();
     let object = object as u32;
     let mut current = g.triangles();
     let mut bvh = Bvh::build(&current, Preset::Fast);
-    let settings = VlfSettings {
-        level: 4,
-        tiles: 32,
-        depth: 3,
-        ..VlfSettings::default()
-    };
     let mut field = VisibilityField::build(&current, settings).unwrap();
     let mut hits_on_ball = 0;
     for (k, step) in [
@@ -88,9 +83,31 @@ fn refit_bvh_and_updated_field_answer_as_brute_force_after_the_ball_rolls_away()
             })
             .count();
         assert_eq!(disagreements(&bvh, &current, &rays), 0, "refit BVH, move {k}");
-        assert_eq!(disagreements(&field, &current, &rays), 0, "updated field, move {k}");
+        assert_eq!(
+            disagreements(&field, &current, &rays),
+            0,
+            "updated field {settings:?}, move {k}"
+        );
     }
     assert!(hits_on_ball > 1000, "the queries reach the moving ball: {hits_on_ball}");
+}
+
+#[test]
+fn refit_bvh_and_coarse_updated_field_answer_as_brute_force_after_the_ball_rolls_away() {
+    roll_the_ball(VlfSettings {
+        level: 4,
+        tiles: 32,
+        depth: 3,
+        ..VlfSettings::default()
+    });
+}
+
+#[test]
+fn the_walkthrough_field_updated_answers_as_brute_force_after_the_ball_rolls_away() {
+    roll_the_ball(VlfSettings {
+        depth: 5,
+        ..VlfSettings::default()
+    });
 }
 
 #[test]

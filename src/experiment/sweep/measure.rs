@@ -21,6 +21,7 @@ fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, stat
         time: FrameTime::UNTIMED,
         bvh: BvhColumns::NONE,
         device: Device::of(backend.adapter()),
+        image_fnv1a: String::new(),
         error: error.to_string(),
     }
 }
@@ -54,6 +55,8 @@ pub fn measure_run(
     let image = shadow_image(&frame.visibility);
     let rays = frame.rays;
     let mut r = unmeasured(spec, backend, run, context, Status::Ok, "");
+    let bits: Vec<u8> = image.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect();
+    r.image_fnv1a = format!("{:016x}", crate::fingerprint::fnv1a(&bits));
     measure_radial(&image, reference, &mut r);
     let vs_gt = ErrorMetrics::measure(&image, &reference.ground_truth, &reference.mask);
     let rmse_exact = reference

@@ -43,6 +43,9 @@ pub struct Record {
     pub bvh: BvhColumns,
     /// The device that rendered it.
     pub device: Device,
+    /// FNV-1a of the shadow image's f32 bits: runs that differ only in the acceleration
+    /// structure must give the same hash (empty when it did not render).
+    pub image_fnv1a: String,
     /// Why it failed; empty when it rendered.
     pub error: String,
 }
@@ -54,9 +57,10 @@ struct Head {
     status: Status,
 }
 
-/// The column after the device's.
+/// The columns after the device's.
 #[derive(Serialize, Deserialize)]
 struct Tail {
+    image_fnv1a: String,
     error: String,
 }
 
@@ -79,6 +83,7 @@ impl Serialize for Record {
             status: self.status,
         };
         let tail = Tail {
+            image_fnv1a: self.image_fnv1a.clone(),
             error: self.error.clone(),
         };
         (
@@ -109,6 +114,7 @@ impl<'de> Deserialize<'de> for Record {
             time,
             bvh,
             device,
+            image_fnv1a: tail.image_fnv1a,
             error: tail.error,
         })
     }

@@ -94,6 +94,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
         s += &cost_section(outcome, summaries, &slice, n, radius);
     }
+    s += &super::structures::structure_section(spec, outcome, summaries);
     s += "\n## Outputs\n\n- `runs.csv`: one row per run; `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
     s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time (any scene).\n";
     s += "- `images/`: Fig. 2-style comparisons (measuring view and picture), EXR of the ground truth and exact images.\n- `manifest.toml`: commit, adapter, experiment, seeds.\n";

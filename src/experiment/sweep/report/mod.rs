@@ -8,6 +8,7 @@ pub mod markdown;
 pub mod pictures;
 pub mod plots;
 pub mod results;
+pub mod structures;
 pub mod summary;
 pub mod tables;
 pub mod thresholds;
