@@ -33,6 +33,22 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
     for r in &rows {
+        let same_frame: Vec<&csv::StringRecord> = rows
+            .iter()
+            .filter(|o| o[col("shading")] == r[col("shading")] && o[col("frame")] == r[col("frame")])
+            .collect();
+        assert!(
+            same_frame.iter().all(|o| o[col("rays")] == r[col("rays")]),
+            "every structure traces the same rays"
+        );
+        // Whitted's bound: camera rays, a shadow ray per light at the hit, and per bounce (3) a
+        // reflected ray and a shadow ray per light (4).
+        assert!(
+            r[col("rays")].parse::<u64>().unwrap() <= 32 * 32 * (1 + 4 + 3 * 5),
+            "{r:?}"
+        );
+    }
+    for r in &rows {
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
         let rays: u64 = r[col("rays")].parse().unwrap();
         match &r[col("shading")] {
@@ -60,7 +76,7 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
         "{report}"
     );
     assert!(
-        report.contains("VLF-RT vs the CRT-like kd-tree (the paper's baseline), whitted shading"),
+        report.contains("Is VLF-RT faster than the CRT-like kd-tree (the paper's baseline), whitted shading?"),
         "{report}"
     );
     assert!(
@@ -108,17 +124,21 @@ fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
         "kdtree rebuild",
         "vlf update",
         "bvh rebuild",
+        "bvh rebuild-fastest",
         "bvh refit",
         "brute rebuild",
     ] {
         assert!(methods.iter().any(|x| x == m), "{m} missing: {methods:?}");
     }
-    assert_eq!(rows.len(), 2 * 3 * 5);
+    assert_eq!(rows.len(), 2 * 3 * 6);
     for r in &rows {
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
         assert!(r[col("update_s")].parse::<f64>().unwrap() > 0.0, "{r:?}");
     }
-    assert!(report.contains("VLF-RT's update vs bvh (refit)"), "{report}");
+    assert!(
+        report.contains("Is VLF-RT's update cheaper than bvh (refit)'s?"),
+        "{report}"
+    );
     assert!(dir.path().join("out/plots/update_time_whitted.png").exists());
 }
 
@@ -163,6 +183,18 @@ fn bad_input_is_located_and_writes_nothing() {
         (random.replace("[300, 2400]", "[2400, 300]"), "scene.triangles[1]"),
         (random.clone(), "path.viewpoints"),
         (
+            text.replace("frames = 3", "frames = 3\nlook_at = [-4.2, 0.0, 1.6]"),
+            "path.look_at",
+        ),
+        (
+            text.replace(
+                "frames = 3",
+                "frames = 3\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, 0.0, 1.0]",
+            ),
+            "motion.step",
+        ),
+        (text.replace("strip = 3", "strip = 0"), "strip"),
+        (
             random.replace("frames = 3", "frames = 3\nviewpoints = [\"above\"]"),
             "path.viewpoints[0]",
         ),
@@ -187,4 +219,92 @@ fn bad_input_is_located_and_writes_nothing() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("CPU backend"), "{err}");
     assert!(!out.exists());
+}
+
+/// The verdict is computed from the rows: a structure whose frames differ fails exactness by
+/// name, and "is VLF-RT faster" reads yes, no or not clearly from the per-frame ratios'
+/// quartiles.
+#[test]
+fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
+    use penumbra::experiment::frames::report::verdict;
+    use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
+    use penumbra::experiment::frames::spec::ShadingName;
+    let mut spec = penumbra::experiment::frames::FramesSpec::load(&common::repo("experiments/frames-ci.toml")).unwrap();
+    spec.shadings.truncate(1);
+    let row = |structure: &'static str, frame: u32, seconds: f64, differing_pixels: usize| FrameRow {
+        triangles: 100,
+        structure,
+        update: "none",
+        shading: ShadingName::Opengl,
+        viewpoint: "walk".into(),
+        frame,
+        seconds,
+        update_seconds: None,
+        rays: 10,
+        differing_pixels,
+    };
+    // kd-tree 2x slower than the field on every frame; the BVH faster on 2 of 4, slower on 2.
+    let mut frames = Vec::new();
+    for f in 0..4 {
+        frames.push(row("kdtree", f, 2.0, 0));
+        frames.push(row("vlf", f, 1.0, if f == 2 { 7 } else { 0 }));
+        frames.push(row("bvh", f, if f < 2 { 1.5 } else { 0.5 }, 0));
+    }
+    let outcome = FramesOutcome {
+        frames,
+        ..Default::default()
+    };
+    let v = verdict(&spec, &outcome);
+    assert!(
+        v.contains("Exactness FAILED") && v.contains("vlf: 7 pixels on 1 frames (at most 7)"),
+        "{v}"
+    );
+    assert!(
+        v.contains("the CRT-like kd-tree (the paper's baseline), opengl shading?** **yes**"),
+        "{v}"
+    );
+    assert!(
+        v.contains("median 2.00x (quartiles 2.00-2.00x), faster on 4 of 4 frames"),
+        "{v}"
+    );
+    assert!(
+        v.contains("obvhs' BVH2 (very-slow build), opengl shading?** **not clearly**"),
+        "{v}"
+    );
+    assert!(v.contains("faster on 2 of 4 frames"), "{v}");
+    frames_all_slower(&spec);
+}
+
+/// Every frame slower reads "no".
+fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
+    use penumbra::experiment::frames::report::verdict;
+    use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
+    use penumbra::experiment::frames::spec::ShadingName;
+    let frames = (0..4)
+        .flat_map(|f| {
+            [("kdtree", 0.5), ("vlf", 1.0)].map(|(structure, seconds)| FrameRow {
+                triangles: 100,
+                structure,
+                update: "none",
+                shading: ShadingName::Opengl,
+                viewpoint: "walk".into(),
+                frame: f,
+                seconds,
+                update_seconds: None,
+                rays: 10,
+                differing_pixels: 0,
+            })
+        })
+        .collect();
+    let v = verdict(
+        spec,
+        &FramesOutcome {
+            frames,
+            ..Default::default()
+        },
+    );
+    assert!(
+        v.contains("opengl shading?** **no**") && v.contains("- **Exactness**: every structure"),
+        "{v}"
+    );
 }

@@ -201,6 +201,12 @@ fn a_flat_mirror_shows_what_the_mirrored_camera_sees() {
         "one reflected ray per mirror pixel at depth 1"
     );
     assert_eq!(a0.rays.reflection, 0);
+    assert!(
+        a1.rays.total() <= plan.max_rays(),
+        "{:?} within the plan's {}",
+        a1.rays,
+        plan.max_rays()
+    );
 }
 
 #[test]
@@ -226,6 +232,16 @@ fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_
         );
         let (f, _) = render(&perfect, &camera, w, h);
         let pixels = (w * h) as u64;
+        let view = View {
+            camera: &camera,
+            width: w,
+            height: h,
+        };
+        let plan = RenderPlan::new(&perfect, view).unwrap();
+        assert!(
+            matches!(plan.passes.last(), Some(Pass::Mirror { max_rays, .. }) if *max_rays == pixels * depth as u64 * 2)
+        );
+        assert!(f.rays.total() <= plan.max_rays());
         assert_eq!(f.rays.reflection, depth as u64 * pixels);
         assert_eq!(f.rays.shadow_total(), pixels, "only the camera's hits are shaded");
         assert!(
@@ -328,6 +344,9 @@ fn the_gpu_backend_refuses_passes_it_has_no_kernel_for() {
     let whitted = with_mirrors(room(), &[quad(0.0, [-1.5, 1.5], [0.0, 2.0])], 0.5, Shading::whitted(2));
     let e = gpu.render(&whitted, view, SAMPLING).unwrap_err();
     assert!(format!("{e:#}").contains("mirror pass"), "{e:#}");
+    let unreflected = with_mirrors(room(), &[quad(0.0, [-1.5, 1.5], [0.0, 2.0])], 0.5, Shading::default());
+    let e = gpu.render(&unreflected, view, SAMPLING).unwrap_err();
+    assert!(format!("{e:#}").contains("mirror materials"), "{e:#}");
 }
 
 mod common;

@@ -111,6 +111,33 @@ impl LightTargets {
     }
 }
 
+/// One light over every receiver (its shadow rays, or unoccluded where the scene has no
+/// shadows): visibility into `frame`, irradiance added to `irradiance`; returns the rays traced.
+fn light_pass(
+    scene: &Scene,
+    receivers: &[Option<Receiver>],
+    light: usize,
+    targets: &LightTargets,
+    frame: &mut Frame,
+    irradiance: &mut [f64],
+) -> u64 {
+    let l = &scene.lights[light];
+    let samples: Vec<Option<LightSample>> = receivers
+        .par_iter()
+        .enumerate()
+        .map(|(pixel, r)| r.as_ref().map(|r| shade_light(scene, r, l, targets.of(light, pixel))))
+        .collect();
+    let mut rays = 0;
+    for (pixel, s) in samples.iter().enumerate() {
+        if let Some(s) = s {
+            frame.visibility[light][pixel] = s.visibility as f32;
+            irradiance[pixel] += s.irradiance;
+            rays += s.rays;
+        }
+    }
+    rays
+}
+
 /// The ambient-occlusion pass over every receiver: the image and the rays traced.
 fn ambient_image(
     scene: &Scene,
@@ -180,29 +207,12 @@ impl Backend for CpuBackend {
                     frame.rays.primary = rays;
                 }
                 Pass::Shadow { light, .. } => {
-                    let l = &scene.lights[light];
-                    let samples: Vec<Option<LightSample>> = receivers
-                        .par_iter()
-                        .enumerate()
-                        .map(|(pixel, r)| r.as_ref().map(|r| shade_light(scene, r, l, targets.of(light, pixel))))
-                        .collect();
-                    for (pixel, s) in samples.iter().enumerate() {
-                        if let Some(s) = s {
-                            frame.visibility[light][pixel] = s.visibility as f32;
-                            irradiance[pixel] += s.irradiance;
-                            frame.rays.shadow[light] += s.rays;
-                        }
-                    }
+                    frame.rays.shadow[light] +=
+                        light_pass(scene, &receivers, light, &targets, &mut frame, &mut irradiance);
                 }
                 Pass::Direct { .. } => {
-                    for (light, l) in scene.lights.iter().enumerate() {
-                        for (pixel, r) in receivers.iter().enumerate() {
-                            if let Some(r) = r {
-                                let s = shade_light(scene, r, l, targets.of(light, pixel));
-                                frame.visibility[light][pixel] = s.visibility as f32;
-                                irradiance[pixel] += s.irradiance;
-                            }
-                        }
+                    for light in 0..scene.lights.len() {
+                        light_pass(scene, &receivers, light, &targets, &mut frame, &mut irradiance);
                     }
                 }
                 Pass::Mirror { .. } => {
@@ -234,13 +244,16 @@ impl Backend for CpuBackend {
                 }
             }
         }
-        for (pixel, r) in receivers.iter().enumerate() {
-            if let Some(r) = r {
-                let m = scene.shapes[r.object as usize].mirror();
-                frame.radiance[pixel] =
-                    ((1.0 - m) * r.albedo * FRAC_1_PI * irradiance[pixel] + reflected[pixel]) as f32;
-            }
-        }
+        frame
+            .radiance
+            .par_iter_mut()
+            .zip(receivers.par_iter().zip(irradiance.par_iter().zip(&reflected)))
+            .for_each(|(out, (r, (e, reflected)))| {
+                if let Some(r) = r {
+                    let m = scene.shapes[r.object as usize].mirror();
+                    *out = ((1.0 - m) * r.albedo * FRAC_1_PI * e + reflected) as f32;
+                }
+            });
         Ok(frame)
     }
 

@@ -153,6 +153,24 @@ pub struct VisibilityField {
     pub build_time: Duration,
 }
 
+/// The ball a field over `world` is built in: centred on the triangles' bounding box, out to
+/// the farthest vertex. Dynamic updates must stay inside it.
+pub fn ball(world: &[[DVec3; 3]]) -> (DVec3, f64) {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in world.iter().flatten() {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
+    let radius = world
+        .iter()
+        .flatten()
+        .map(|p| p.distance(centre))
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE.sqrt());
+    (centre, radius)
+}
+
 impl VisibilityField {
     /// Builds the field over `triangles` (an empty list gives a field that never hits).
     pub fn build(triangles: &Triangles, settings: VlfSettings) -> anyhow::Result<VisibilityField> {
@@ -179,18 +197,7 @@ impl VisibilityField {
             settings.depth,
             bsp::id_mask(settings.depth) - 1
         );
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for p in world.iter().flatten() {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
-        let radius = world
-            .iter()
-            .flatten()
-            .map(|p| p.distance(centre))
-            .fold(0.0, f64::max)
-            .max(f64::MIN_POSITIVE.sqrt());
+        let (centre, radius) = ball(&world);
         let frame = Frame {
             centre,
             radius,

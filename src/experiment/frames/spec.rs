@@ -331,7 +331,13 @@ impl FramesSpec {
                 })
             }
         };
-        Ok(FramesSpec {
+        if f.strip == 0 {
+            return Err(err(
+                &key_path!["strip"],
+                "at least one frame in the strip of pictures".into(),
+            ));
+        }
+        let spec = FramesSpec {
             name: f.name,
             path: source.path.clone(),
             width: f.width,
@@ -345,7 +351,65 @@ impl FramesSpec {
             look_at,
             motion,
             strip: f.strip,
-        })
+        };
+        spec.check_path(source)?;
+        Ok(spec)
+    }
+
+    /// Every camera of the path can look where it is told, and a moving part stays inside the
+    /// ball a visibility field is built in (the field cannot follow it out), for every scene.
+    fn check_path(&self, source: &Source) -> Result<(), ConfigError> {
+        for viewpoint in &self.viewpoints {
+            for frame in 0..self.frames {
+                let c = self.camera(viewpoint, frame);
+                if c.frame().is_none() {
+                    let at = if self.look_at.is_some() {
+                        key_path!["path", "look_at"]
+                    } else {
+                        key_path!["path", "frames"]
+                    };
+                    return Err(source.error(
+                        &at,
+                        format!(
+                            "frame {frame} of viewpoint `{viewpoint}` stands at {} and cannot look at {} with z up",
+                            c.position, c.look_at
+                        ),
+                    ));
+                }
+            }
+        }
+        let Some(m) = &self.motion else { return Ok(()) };
+        if !self.structures.iter().any(|s| s.name == "vlf") {
+            return Ok(());
+        }
+        let travel = m.step * self.moving_frames() as f64;
+        for g in self.scenes() {
+            let t = g.triangles();
+            let (centre, radius) = crate::accel::vlf::ball(&t.positions);
+            let (index, _) = g.part(&m.part).expect("validated part");
+            let out = t
+                .positions
+                .iter()
+                .zip(&t.object_of)
+                .filter(|(_, &o)| o as usize == index)
+                .flat_map(|(p, _)| p.iter())
+                .map(|p| (*p + travel).distance(centre))
+                .fold(0.0, f64::max);
+            if out > radius {
+                return Err(source.error(
+                    &key_path!["motion", "step"],
+                    format!(
+                        "over {} frames (every shading and viewpoint) `{}` travels {:?} m and leaves the ball the visibility field is built in ({:.3} m from its centre, radius {:.3} m): shorten the step",
+                        self.moving_frames(),
+                        m.part,
+                        travel.to_array(),
+                        out,
+                        radius
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Every scene of the experiment, generated: the classroom once, or random triangles at
@@ -359,9 +423,9 @@ impl FramesSpec {
         }
     }
 
-    /// The camera of `frame` along `viewpoint`, or an error where it cannot look at the
-    /// file's `look_at` (standing on it, or looking straight up or down at it).
-    pub fn camera(&self, viewpoint: &str, frame: u32) -> anyhow::Result<crate::scene::camera::Camera> {
+    /// The camera of `frame` along `viewpoint` (looking at the file's `look_at` where it has
+    /// one; [`FramesSpec::from_source`] checks every camera of the path can).
+    pub fn camera(&self, viewpoint: &str, frame: u32) -> crate::scene::camera::Camera {
         let mut camera = match self.generator {
             Generator::Classroom => classroom::camera_path(frame, self.frames),
             Generator::RandomTriangles { .. } => {
@@ -371,13 +435,11 @@ impl FramesSpec {
         if let Some(p) = self.look_at {
             camera.look_at = p;
         }
-        anyhow::ensure!(
-            camera.frame().is_some(),
-            "{}: frame {frame} of viewpoint `{viewpoint}` stands at {} and cannot look at {} with up = z (path.look_at)",
-            self.path.display(),
-            camera.position,
-            camera.look_at
-        );
-        Ok(camera)
+        camera
+    }
+
+    /// Frames the moving part moves through: it moves on through every shading and viewpoint.
+    pub fn moving_frames(&self) -> u32 {
+        self.frames * self.shadings.len() as u32 * self.viewpoints.len() as u32
     }
 }

@@ -295,16 +295,25 @@ impl GpuBackend {
     }
 }
 
-/// The passes the GPU kernels cover: primary, shadow and ambient. OpenGL-like direct light and
-/// Whitted's mirror chains run on the CPU backend only, and a plan with them is refused by name.
-fn refuse_unsupported(plan: &RenderPlan) -> anyhow::Result<()> {
-    match plan.passes.iter().find(|p| matches!(p, Pass::Direct { .. } | Pass::Mirror { .. })) {
-        Some(p) => anyhow::bail!(
+/// The passes the GPU kernels cover: primary, shadow and ambient, over diffuse materials.
+/// OpenGL-like direct light, Whitted's mirror chains and mirror materials (whose diffuse part is
+/// scaled by 1 - mirror) are the CPU backend's only, and a scene asking for them is refused by
+/// name.
+fn refuse_unsupported(scene: &crate::scene::Scene, plan: &RenderPlan) -> anyhow::Result<()> {
+    if let Some(p) = plan
+        .passes
+        .iter()
+        .find(|p| matches!(p, Pass::Direct { .. } | Pass::Mirror { .. }))
+    {
+        bail!(
             "the GPU backend has no kernel for the {} pass (the scene's [shading]); render this scene with backend = \"cpu\"",
             p.name()
-        ),
-        None => Ok(()),
+        );
     }
+    if scene.has_mirrors() {
+        bail!("the GPU backend has no mirror materials (a mesh's `mirror` weight); render this scene with backend = \"cpu\"");
+    }
+    Ok(())
 }
 
 impl Backend for GpuBackend {
@@ -318,7 +327,7 @@ impl Backend for GpuBackend {
 
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(&plan)?;
+        refuse_unsupported(scene, &plan)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
@@ -388,7 +397,7 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(&plan)?;
+        refuse_unsupported(scene, &plan)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         loop {

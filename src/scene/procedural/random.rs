@@ -12,6 +12,9 @@ use crate::scene::Light;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 
+/// The size distribution in a sentence, for reports.
+pub const DISTRIBUTION: &str = "each triangle's centre is uniform in the cube [-1, 1]^3 and its three corners lie at distance a = 0.05 m x (9000 / N)^(1/2) from it along independent uniform directions, so the total area (and the triangles a ray crossing the cube meets, about 2 on average) stays the same at every count N";
+
 /// Corner distance from the centre at `count` triangles.
 pub fn corner_distance(count: usize) -> f64 {
     0.05 * (9000.0 / count.max(1) as f64).sqrt()
