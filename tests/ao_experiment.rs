@@ -61,13 +61,7 @@ fn bad_input_is_located_and_writes_nothing() {
             "tuning.vlf_depths[1]",
         ),
     ] {
-        let path = dir.path().join("bad.toml");
-        std::fs::write(&path, edit).unwrap();
-        let out = dir.path().join("out");
-        let (code, err) = common::sweep(&[path.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
-        assert_eq!(code, 2, "{key}: {err}");
-        assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
-        assert!(!out.exists(), "{key}: wrote {}", out.display());
+        common::rejected_at(dir.path(), &edit, key);
     }
 }
 

@@ -51,3 +51,29 @@ fn read_as_sweep(mut e: ConfigError) -> ConfigError {
     }
     e
 }
+
+/// The registered structures an experiment's `structures` list names, each once; an unknown or
+/// repeated name is an error at its place in the list.
+pub(crate) fn structure_names(source: &Source, names: &[String]) -> Result<Vec<&'static str>, ConfigError> {
+    if names.is_empty() {
+        return Err(source.error(&crate::key_path!["structures"], "name at least one structure"));
+    }
+    let mut out = Vec::new();
+    for (i, s) in names.iter().enumerate() {
+        let at = crate::key_path!["structures", i];
+        let r = crate::accel::registered(s).ok_or_else(|| {
+            source.error(
+                &at,
+                format!(
+                    "unknown acceleration structure `{s}`; known: {}",
+                    crate::accel::names().join(", ")
+                ),
+            )
+        })?;
+        if out.contains(&r.name) {
+            return Err(source.error(&at, format!("`{s}` is listed twice")));
+        }
+        out.push(r.name);
+    }
+    Ok(out)
+}

@@ -28,3 +28,19 @@ pub fn git_commit() -> String {
         None => "unknown".into(),
     }
 }
+
+/// manifest.toml of an experiment timed on the CPU backend: the commit, the experiment file, the
+/// run's seconds and the thread count.
+pub fn write_cpu_manifest(
+    out: &std::path::Path,
+    experiment: &std::path::Path,
+    seconds: f64,
+    threads: usize,
+) -> anyhow::Result<()> {
+    let manifest = format!(
+        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {seconds:.1}\nbackend = \"cpu\"\nthreads = {threads}\n",
+        git_commit(),
+        experiment.display().to_string(),
+    );
+    crate::files::write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+}

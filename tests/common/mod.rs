@@ -75,6 +75,18 @@ repeats = 0
     path
 }
 
+/// Runs experiment `text` (written to DIR/bad.toml) and checks it is refused as bad input at
+/// `key`: exit status 2, the file and key named, nothing written.
+pub fn rejected_at(dir: &std::path::Path, text: &str, key: &str) {
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let (code, err) = sweep(&[path.as_os_str(), std::ffi::OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 2, "{key}: {err}");
+    assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
+    assert!(!out.exists(), "{key}: wrote {}", out.display());
+}
+
 /// Runs the `sweep` binary; returns (exit code, stderr).
 pub fn sweep(args: &[&std::ffi::OsStr]) -> (i32, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))

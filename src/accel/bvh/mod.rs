@@ -117,6 +117,19 @@ fn depth(tree: &Bvh2) -> usize {
     deepest
 }
 
+/// `positions` in f32 relative to `centre`, as obvhs builds and walks them.
+fn relative(positions: &[[DVec3; 3]], centre: DVec3) -> Vec<Triangle> {
+    let f = |p: DVec3| Vec3A::from((p - centre).as_vec3());
+    positions
+        .iter()
+        .map(|t| Triangle {
+            v0: f(t[0]),
+            v1: f(t[1]),
+            v2: f(t[2]),
+        })
+        .collect()
+}
+
 /// `tree` with every box widened by a few f32 ulps of its root's size (see `Bvh::cpu_tree`).
 fn widened(tree: &Bvh2) -> Bvh2 {
     let mut cpu_tree = tree.clone();
@@ -144,16 +157,7 @@ impl Bvh {
             "a refit keeps the triangles"
         );
         let start = Instant::now();
-        let f = |p: DVec3| Vec3A::from((p - self.centre).as_vec3());
-        self.local = triangles
-            .positions
-            .iter()
-            .map(|t| Triangle {
-                v0: f(t[0]),
-                v1: f(t[1]),
-                v2: f(t[2]),
-            })
-            .collect();
+        self.local = relative(&triangles.positions, self.centre);
         self.world.clone_from(&triangles.positions);
         let tree = &mut self.tree;
         for i in 0..tree.nodes.len() {
@@ -181,16 +185,7 @@ impl Bvh {
             hi = hi.max(*t);
         }
         let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
-        let f = |p: DVec3| Vec3A::from((p - centre).as_vec3());
-        let local: Vec<Triangle> = triangles
-            .positions
-            .iter()
-            .map(|t| Triangle {
-                v0: f(t[0]),
-                v1: f(t[1]),
-                v2: f(t[2]),
-            })
-            .collect();
+        let local = relative(&triangles.positions, centre);
         let mut build_time = Duration::default();
         let tree = build_bvh2_from_tris(&local, preset.params(), &mut build_time);
         let depth = depth(&tree);

@@ -218,13 +218,7 @@ pub fn write_ao(
         &[],
     )?;
     write_atomic(&out.join("report.md"), report(spec, rows, threads, seconds).as_bytes())?;
-    let manifest = format!(
-        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\nbackend = \"cpu\"\nthreads = {threads}\n",
-        crate::output::git_commit(),
-        spec.path.display().to_string(),
-        seconds,
-    );
-    write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+    crate::output::write_cpu_manifest(out, &spec.path, seconds, threads)
 }
 
 fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {

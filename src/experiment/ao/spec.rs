@@ -2,7 +2,7 @@
 //! into the unit ball and seen by a camera that frames the ball, AO along the visibility field's
 //! grid lines from every camera hit (the visibility-field paper's Table 1 set-up).
 
-use crate::accel::{self, kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
+use crate::accel::{kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
 use crate::config::{ConfigError, Source};
 use crate::experiment::kind::Kind;
 use crate::key_path;
@@ -212,25 +212,7 @@ impl AoSpec {
                 ));
             }
         }
-        if f.structures.is_empty() {
-            return Err(err(&key_path!["structures"], "name at least one structure".into()));
-        }
-        let mut structures = Vec::new();
-        for (i, s) in f.structures.iter().enumerate() {
-            let r = accel::registered(s).ok_or_else(|| {
-                err(
-                    &key_path!["structures", i],
-                    format!(
-                        "unknown acceleration structure `{s}`; known: {}",
-                        accel::names().join(", ")
-                    ),
-                )
-            })?;
-            if structures.contains(&r.name) {
-                return Err(err(&key_path!["structures", i], format!("`{s}` is listed twice")));
-            }
-            structures.push(r.name);
-        }
+        let structures = crate::experiment::structure_names(source, &f.structures)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let mut meshes = Vec::new();
         for (i, m) in f.meshes.iter().enumerate() {

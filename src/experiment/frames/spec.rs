@@ -5,7 +5,7 @@
 //! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part
 //! moves every frame and each structure is updated before rendering it).
 
-use crate::accel::{self, kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
+use crate::accel::{kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
 use crate::config::{ConfigError, Seg, Source};
 use crate::experiment::kind::Kind;
 use crate::key_path;
@@ -196,25 +196,10 @@ impl FramesSpec {
             ));
         }
         let (kdtree, vlf) = (kd_settings(&f.kdtree, source)?, vlf_settings(&f.vlf, source)?);
-        if f.structures.is_empty() {
-            return Err(err(&key_path!["structures"], "name at least one structure".into()));
-        }
-        let mut structures: Vec<AccelSettings> = Vec::new();
-        for (i, s) in f.structures.iter().enumerate() {
-            let r = accel::registered(s).ok_or_else(|| {
-                err(
-                    &key_path!["structures", i],
-                    format!(
-                        "unknown acceleration structure `{s}`; known: {}",
-                        accel::names().join(", ")
-                    ),
-                )
-            })?;
-            if structures.iter().any(|a| a.name == r.name) {
-                return Err(err(&key_path!["structures", i], format!("`{s}` is listed twice")));
-            }
-            structures.push(structure(r.name, kdtree, vlf));
-        }
+        let structures = crate::experiment::structure_names(source, &f.structures)?
+            .into_iter()
+            .map(|name| structure(name, kdtree, vlf))
+            .collect();
         if f.shadings.is_empty() {
             return Err(err(&key_path!["shadings"], "name at least one shading".into()));
         }
