@@ -6,7 +6,8 @@ pub mod numbers;
 pub mod plots;
 pub mod table;
 
-/// The checkout's commit, suffixed `-dirty` when tracked files differ from it.
+/// The checkout's commit, suffixed `-dirty` when tracked files outside `results/` differ from
+/// it (a rerun rewriting committed results is not a change to what produced them).
 pub fn git_commit() -> String {
     let run = |args: &[&str]| {
         std::process::Command::new("git")
@@ -18,7 +19,7 @@ pub fn git_commit() -> String {
     };
     match run(&["rev-parse", "HEAD"]) {
         Some(c) => {
-            let dirty = run(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+            let dirty = run(&["status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"]).is_some_and(|s| !s.is_empty());
             if dirty {
                 format!("{c}-dirty")
             } else {
