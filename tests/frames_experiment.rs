@@ -104,6 +104,7 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
     }
     assert!(report.contains("median frame time grows as kdtree N^"), "{report}");
     assert!(report.contains("Memory grows as"), "{report}");
+    assert!(!report.contains("NaN"), "{report}");
 }
 
 #[test]

@@ -143,6 +143,21 @@ pub fn line_plot(path: &Path, axes: &Axes, series: &[(usize, Series)], reference
     )
 }
 
+/// A tick label with at most four significant digits and no trailing zeros (log axes'
+/// ticks are computed in floating point: 0.7 arrives as 0.7000000000000001).
+fn tick(v: &f64) -> String {
+    if *v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 fn draw<DB: DrawingBackend, X, Y>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     axes: &Axes,
@@ -169,6 +184,8 @@ where
         .configure_mesh()
         .x_desc(axes.x)
         .y_desc(axes.y)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .label_style(("sans-serif", 15))
         .draw()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -177,7 +194,7 @@ where
         let pts: Vec<(f64, f64)> = s
             .points
             .iter()
-            .filter(|p| p.1.is_finite())
+            .filter(|p| p.1.is_finite() && !(axes.log_y && p.1 <= 0.0) && !(axes.log_x && p.0 <= 0.0))
             .map(|p| (p.0, p.1))
             .collect();
         let stroke = c.stroke_width(2);
@@ -286,5 +303,22 @@ fn upscale(img: &Rgb, k: u32) -> Rgb {
         width: w,
         height: h,
         data,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn ticks_read_as_written() {
+        for (v, s) in [
+            (0.7000000000000001, "0.7"),
+            (1000000.0, "1000000"),
+            (0.00001, "0.00001"),
+            (12.5, "12.5"),
+            (0.0, "0"),
+            (-0.25, "-0.25"),
+        ] {
+            assert_eq!(super::tick(&v), s);
+        }
     }
 }

@@ -98,9 +98,10 @@ fn faster(ratio: f64) -> String {
     }
 }
 
-/// Least-squares slope of log y against log x: the exponent a of y ~ x^a.
+/// Least-squares slope of log y against log x: the exponent a of y ~ x^a; None with fewer than
+/// two points or any non-positive value (no logarithm: a structure that stores nothing).
 pub fn log_log_slope(points: &[(f64, f64)]) -> Option<f64> {
-    if points.len() < 2 {
+    if points.len() < 2 || points.iter().any(|&(x, y)| !(x > 0.0 && y > 0.0)) {
         return None;
     }
     let n = points.len() as f64;
@@ -590,5 +591,10 @@ mod tests {
         assert!((log_log_slope(&pts).unwrap() - 0.37).abs() < 1e-12);
         assert_eq!(log_log_slope(&pts[..1]), None);
         assert_eq!(log_log_slope(&[(2.0, 1.0), (2.0, 5.0)]), None);
+        assert_eq!(
+            log_log_slope(&[(1e3, 0.0), (1e4, 0.0)]),
+            None,
+            "brute force stores nothing"
+        );
     }
 }
