@@ -221,9 +221,9 @@ fn bad_input_is_located_and_writes_nothing() {
 /// quartiles.
 #[test]
 fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
-    use penumbra::experiment::frames::report::verdict;
     use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
     use penumbra::experiment::frames::spec::ShadingName;
+    use penumbra::experiment::frames::verdict::verdict;
     let mut spec = penumbra::experiment::frames::FramesSpec::load(&common::repo("experiments/frames-ci.toml")).unwrap();
     spec.shadings.truncate(1);
     let row = |structure: &'static str, frame: u32, seconds: f64, differing_pixels: usize| FrameRow {
@@ -272,9 +272,9 @@ fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
 
 /// Every frame slower reads "no".
 fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
-    use penumbra::experiment::frames::report::verdict;
     use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
     use penumbra::experiment::frames::spec::ShadingName;
+    use penumbra::experiment::frames::verdict::verdict;
     let frames = (0..4)
         .flat_map(|f| {
             [("kdtree", 0.5), ("vlf", 1.0)].map(|(structure, seconds)| FrameRow {

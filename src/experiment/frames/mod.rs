@@ -4,6 +4,7 @@
 pub mod report;
 pub mod runner;
 pub mod spec;
+pub mod verdict;
 
 pub use runner::run_frames;
 pub use spec::FramesSpec;

@@ -301,9 +301,12 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                             update,
                         ));
                     }
-                    let first = rendered[0].as_ref().expect("rendered").0.clone();
-                    for (v, r) in variants.iter().zip(rendered) {
-                        let (f, seconds, update_seconds) = r.expect("rendered");
+                    let rendered: Vec<(Frame, f64, Option<f64>)> = rendered
+                        .into_iter()
+                        .map(|r| r.expect("every variant rendered"))
+                        .collect();
+                    let first = &rendered[0].0;
+                    for (v, (f, seconds, update_seconds)) in variants.iter().zip(&rendered) {
                         outcome.frames.push(FrameRow {
                             triangles,
                             structure: v.structure,
@@ -311,17 +314,17 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                             shading: name,
                             viewpoint: viewpoint.clone(),
                             frame,
-                            seconds,
-                            update_seconds,
+                            seconds: *seconds,
+                            update_seconds: *update_seconds,
                             rays: f.rays.total(),
-                            differing_pixels: differing(&first, &f),
+                            differing_pixels: differing(first, f),
                         });
                     }
                     if s + 1 == scenes.len() && vp == 0 && strip.contains(&frame) {
                         outcome.pictures.push(Picture {
                             shading: name,
                             frame,
-                            radiance: first.radiance,
+                            radiance: first.radiance.clone(),
                         });
                     }
                 }
