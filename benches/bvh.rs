@@ -38,7 +38,10 @@ fn build(c: &mut Criterion) {
 
 fn traverse(c: &mut Criterion) {
     let scene = body();
-    let bvh = Bvh::build(&scene.triangles, scene.accel_settings.bvh_preset);
+    let bvh = Bvh::build(
+        &scene.triangles,
+        scene.accel_settings.typed::<penumbra::accel::bvh::BvhSettings>().preset,
+    );
     let rays = rays(&bvh, 4096);
     let mut g = c.benchmark_group("bvh_traverse");
     g.throughput(Throughput::Elements(rays.len() as u64));

@@ -10,6 +10,14 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::de::{DeTable, DeValue};
 
+/// Largest image side a file may ask for.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most pixels a file may ask for in one image (a frame's buffers stay within a few GB).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 25;
+
+/// Largest experiment or scene file read.
+pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
 /// An error in a configuration file, located as precisely as the document allows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConfigError {
@@ -96,30 +104,100 @@ pub struct Source {
 }
 
 impl Source {
-    /// Reads a file; a missing or unreadable file is a [`ConfigError`] naming it.
+    /// Reads a file; a missing, unreadable, non-regular or oversized file (beyond
+    /// [`MAX_CONFIG_BYTES`]: `/dev/zero` is refused, not read until memory runs out) is a
+    /// [`ConfigError`] naming it.
     pub fn read(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
+        let fail = |message: String| ConfigError {
             file: path.to_path_buf(),
             position: None,
             key: String::new(),
-            message: format!("cannot read: {e}"),
-        })?;
+            message,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+        if !meta.is_file() {
+            return Err(fail("not a regular file".into()));
+        }
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(
+                std::fs::File::open(path).map_err(|e| fail(format!("cannot read: {e}")))?,
+                MAX_CONFIG_BYTES + 1,
+            ),
+            &mut bytes,
+        )
+        .map_err(|e| fail(format!("cannot read: {e}")))?;
+        if bytes.len() as u64 > MAX_CONFIG_BYTES {
+            return Err(fail(format!(
+                "larger than {MAX_CONFIG_BYTES} bytes: not a configuration file"
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| fail(format!("not UTF-8 text: {e}")))?;
         Ok(Source {
             path: path.to_path_buf(),
             text,
         })
     }
 
+    /// Checks an image size given at `width_at` and `height_at`: each side in
+    /// 1..=[`MAX_IMAGE_SIDE`], at most [`MAX_IMAGE_PIXELS`] in all (the one image-size rule of
+    /// every file).
+    pub fn image_size(&self, width_at: &[Seg], height_at: &[Seg], width: u32, height: u32) -> Result<(), ConfigError> {
+        for (at, v) in [(width_at, width), (height_at, height)] {
+            if !(1..=MAX_IMAGE_SIDE).contains(&v) {
+                return Err(self.error(at, format!("must be in 1..={MAX_IMAGE_SIDE} pixels, got {v}")));
+            }
+        }
+        if width as u64 * height as u64 > MAX_IMAGE_PIXELS {
+            return Err(self.error(
+                width_at,
+                format!("{width} x {height} is more than {MAX_IMAGE_PIXELS} pixels"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Deserialises the whole document, locating syntax errors and unknown or missing keys.
     pub fn parse<T: DeserializeOwned>(&self) -> Result<T, ConfigError> {
         toml::from_str(&self.text).map_err(|e| {
             let span = e.span();
+            let message = e.message().trim().to_string();
+            if let (Some(field), Some(s)) = (missing_field(&message), span.as_ref()) {
+                return self.missing(s, field);
+            }
             let mut key = span.as_ref().map(|s| self.key_at(s)).unwrap_or_default();
             if key.is_empty() {
                 key = span.as_ref().map(|s| self.key_on_line(s.start)).unwrap_or_default();
             }
-            self.error_at_span(span, key, e.message().trim().to_string())
+            self.error_at_span(span, key, message)
         })
+    }
+
+    /// A required key absent from the table spanning `span`: named with its table's path, at the
+    /// table's header line (no line for the top level, where the key would go anywhere).
+    fn missing(&self, span: &Range<usize>, field: &str) -> ConfigError {
+        let table = DeTable::parse(&self.text)
+            .ok()
+            .and_then(|doc| {
+                let mut best = None;
+                let mut path = Vec::new();
+                enclosing_table(Node::Table(doc.get_ref()), span, &mut path, &mut best);
+                best
+            })
+            .unwrap_or_default();
+        let position = (!table.is_empty())
+            .then(|| self.locate(&table))
+            .flatten()
+            .map(|s| line_col(&self.text, s.start));
+        let mut key = table;
+        key.push(Seg::Key(field.to_string()));
+        let what = if key.len() == 1 { "file" } else { "table" };
+        ConfigError {
+            file: self.path.clone(),
+            position,
+            key: format_path(&key),
+            message: format!("missing: the {what} needs `{field}`"),
+        }
     }
 
     /// The bare key that starts the line holding `offset` (for syntax errors, where no
@@ -220,6 +298,39 @@ fn search(node: Node, at: usize, path: &mut Vec<Seg>, best: &mut Option<(usize, 
     }
 }
 
+/// The field serde reports missing ("missing field `x`").
+fn missing_field(message: &str) -> Option<&str> {
+    message.strip_prefix("missing field `")?.split('`').next()
+}
+
+/// The path of the deepest table whose value span holds all of `span`.
+fn enclosing_table(node: Node, span: &Range<usize>, path: &mut Vec<Seg>, best: &mut Option<Vec<Seg>>) {
+    let Node::Table(t) = node else { return };
+    for (k, v) in t.iter() {
+        let r = v.span();
+        if matches!(v.get_ref(), DeValue::Table(_)) && r.start <= span.start && span.end <= r.end.max(r.start + 1) {
+            path.push(Seg::Key(k.get_ref().to_string()));
+            *best = Some(path.clone());
+            enclosing_table(Node::of(v.get_ref()), span, path, best);
+            path.pop();
+            return;
+        }
+        if let DeValue::Array(a) = v.get_ref() {
+            for (i, item) in a.iter().enumerate() {
+                let r = item.span();
+                if matches!(item.get_ref(), DeValue::Table(_)) && r.start <= span.start && span.end <= r.end {
+                    path.push(Seg::Key(k.get_ref().to_string()));
+                    path.push(Seg::Index(i));
+                    *best = Some(path.clone());
+                    enclosing_table(Node::of(item.get_ref()), span, path, best);
+                    path.truncate(path.len() - 2);
+                    return;
+                }
+            }
+        }
+    }
+}
+
 /// A position in the spanned document while walking a key path.
 #[derive(Clone, Copy)]
 enum Node<'a, 'i> {
@@ -276,6 +387,40 @@ mod tests {
         let e = s.parse::<Doc>().unwrap_err();
         assert_eq!(e.position.map(|p| p.0), Some(5), "{e}");
         assert!(e.key.contains("radios") && e.message.contains("unknown field"), "{e}");
+    }
+
+    #[derive(serde::Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Nested {
+        name: String,
+        measure: Measure,
+    }
+    #[derive(serde::Deserialize, Debug)]
+    #[serde(deny_unknown_fields)]
+    #[allow(dead_code)]
+    struct Measure {
+        width: u32,
+        height: u32,
+    }
+
+    #[test]
+    fn missing_keys_are_named_with_their_table() {
+        let e = src("name = \"a\"\n").parse::<Nested>().unwrap_err();
+        assert_eq!((e.key.as_str(), e.position), ("measure", None), "{e}");
+        assert!(e.message.contains("missing"), "{e}");
+        let e = src("name = \"a\"\n\n[measure]\nwidth = 3\n")
+            .parse::<Nested>()
+            .unwrap_err();
+        assert_eq!(
+            (e.key.as_str(), e.position.map(|p| p.0)),
+            ("measure.height", Some(3)),
+            "{e}"
+        );
+        let e = src("name = \"a\"\n[[lights]]\nradius = 1.0\n[[lights]]\n")
+            .parse::<Doc>()
+            .unwrap_err();
+        assert_eq!(e.key, "lights[1].radius", "{e}");
     }
 
     #[test]

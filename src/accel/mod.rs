@@ -21,9 +21,12 @@
 pub mod brute;
 pub mod bvh;
 pub mod kdtree;
+pub mod settings;
 pub mod vlf;
+pub mod work;
 
 pub use bvh::{Bvh, Preset};
+pub use settings::AccelSettings;
 
 use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
@@ -133,6 +136,26 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
 
     /// The GPU form in `frame`'s local coordinates, or an error naming the limit it exceeds.
     fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure>;
+
+    /// The ways it can follow triangles that moved, its own first (a field's update in place,
+    /// paper Section 8; a BVH's refit; a rebuild): the names [`Accelerator::update`] takes.
+    fn updates(&self) -> &'static [&'static str] {
+        &["rebuild"]
+    }
+
+    /// Brings it up to date after the triangles of `object` moved by `step` (the scene's
+    /// triangles are now `moved`, same count and order), by `method`, one of
+    /// [`Accelerator::updates`].
+    fn update(&mut self, method: &str, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<()>;
+}
+
+/// Refuses an update method a structure does not offer.
+pub(crate) fn unknown_update(structure: &dyn Accelerator, method: &str) -> anyhow::Error {
+    anyhow::anyhow!(
+        "{} cannot update by `{method}`; it offers {}",
+        structure.name(),
+        structure.updates().join(", ")
+    )
 }
 
 /// Build cost and size, for records and reports.
@@ -162,30 +185,6 @@ pub struct GpuStructure {
     pub walk_iterations: u32,
 }
 
-/// What a scene asks of its acceleration structure: which one, and each one's parameters.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct AccelSettings {
-    /// Registry name.
-    pub name: &'static str,
-    /// obvhs build preset (BVH).
-    pub bvh_preset: Preset,
-    /// Visibility-field parameters.
-    pub vlf: vlf::VlfSettings,
-    /// kd-tree parameters.
-    pub kdtree: kdtree::KdSettings,
-}
-
-impl Default for AccelSettings {
-    fn default() -> Self {
-        AccelSettings {
-            name: REGISTRY[0].name,
-            bvh_preset: Preset::default(),
-            vlf: vlf::VlfSettings::default(),
-            kdtree: kdtree::KdSettings::default(),
-        }
-    }
-}
-
 /// One registered structure.
 pub struct Registered {
     /// Name in scene files and sweeps.
@@ -194,9 +193,20 @@ pub struct Registered {
     pub wgsl: &'static str,
     /// Storage buffers its WGSL declares at `@group(2)`.
     pub gpu_buffers: u32,
+    /// Its parameters from its table, validated and completed with defaults, or the key that
+    /// is wrong and why ([`settings::validate`] over its typed [`settings::Params`]).
+    pub params: fn(&toml::Table) -> Result<toml::Table, (String, String)>,
+    /// The grid it is tuned over where an experiment lists none ([`settings::Params::tuning`]).
+    pub tuning: fn() -> toml::Table,
     /// Builds it over `triangles`, or says which limit the scene exceeds.
     pub build: fn(&Triangles, &AccelSettings) -> anyhow::Result<Arc<dyn Accelerator>>,
+    /// The ball (centre, radius) a structure built over these triangles can follow moved
+    /// triangles within, where it has one (the field's directions are fixed to its ball).
+    pub follows_within: Option<Region>,
 }
+
+/// The ball (centre, radius) a structure built over some triangles can follow them within.
+pub type Region = fn(&[[DVec3; 3]]) -> (DVec3, f64);
 
 /// Every acceleration structure, the default first.
 pub const REGISTRY: &[Registered] = &[
@@ -204,25 +214,37 @@ pub const REGISTRY: &[Registered] = &[
         name: "bvh",
         wgsl: bvh::WGSL,
         gpu_buffers: 2,
-        build: |t, s| Ok(Arc::new(Bvh::build(t, s.bvh_preset))),
+        params: settings::validate::<bvh::BvhSettings>,
+        tuning: <bvh::BvhSettings as settings::Params>::tuning,
+        build: |t, s| Ok(Arc::new(Bvh::build(t, s.typed::<bvh::BvhSettings>().preset))),
+        follows_within: None,
     },
     Registered {
         name: "brute",
         wgsl: brute::WGSL,
         gpu_buffers: 1,
+        params: settings::validate::<brute::BruteSettings>,
+        tuning: <brute::BruteSettings as settings::Params>::tuning,
         build: |t, _| Ok(Arc::new(brute::Brute::build(t))),
+        follows_within: None,
     },
     Registered {
         name: "vlf",
         wgsl: vlf::WGSL,
         gpu_buffers: vlf::GPU_BUFFERS,
-        build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.vlf)?)),
+        params: settings::validate::<vlf::VlfSettings>,
+        tuning: <vlf::VlfSettings as settings::Params>::tuning,
+        build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.typed())?)),
+        follows_within: Some(vlf::ball),
     },
     Registered {
         name: "kdtree",
         wgsl: kdtree::WGSL,
         gpu_buffers: kdtree::GPU_BUFFERS,
-        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.kdtree))),
+        params: settings::validate::<kdtree::KdSettings>,
+        tuning: <kdtree::KdSettings as settings::Params>::tuning,
+        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()))),
+        follows_within: None,
     },
 ];
 

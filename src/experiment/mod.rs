@@ -1,55 +1,113 @@
-//! Experiments, one module per kind, each with its spec, runner and report: [`sweep`] (sampling
-//! schemes swept and measured against a ground truth), [`fps`] (the paper's frame rates),
-//! [`ao`] (the visibility-field paper's ambient-occlusion table) and [`frames`] (its frame-time
-//! figures: scaling, walkthrough, dynamic scenes). An experiment file names its kind with
-//! `kind` ([`kind`]).
+//! Experiments: one contract ([`Experiment`]) that every kind implements and one [`driver`] that
+//! runs any of them. The kinds: [`sweep`] (sampling schemes swept and measured against a ground
+//! truth), [`fps`] (the paper's frame rates), [`ao`] (the visibility-field paper's
+//! ambient-occlusion table) and [`frames`] (its frame-time figures: scaling, walkthrough, dynamic
+//! scenes).
+//!
+//! The driver owns what every kind shares: the header (`kind`, `name`, `backend`, `[timing]`,
+//! [`header`]) validated once, the command line's refusals, the output folder and its atomic
+//! replacement ([`outputs`]), the manifest ([`manifest`]), logging and progress ([`progress`]),
+//! and the timing method ([`timing`]). A kind is its spec, its runner and its report.
 
 pub mod ao;
+pub mod cli;
+pub mod driver;
 pub mod fps;
 pub mod frames;
+pub mod header;
 pub mod kind;
+pub mod manifest;
+pub mod outputs;
+pub mod progress;
 pub mod sweep;
+pub mod timing;
 
 use crate::config::{ConfigError, Source};
+use crate::render::Backend;
+use cli::Cli;
+use header::Header;
 use kind::Kind;
-use std::path::Path;
+use outputs::Outputs;
+use progress::Progress;
+use std::path::{Path, PathBuf};
 
-/// An experiment file, read by its kind.
-pub enum Experiment {
-    /// `kind = "sweep"`, or no `kind`.
-    Sweep(Box<sweep::Spec>),
-    /// `kind = "fps"`.
-    Fps(fps::FpsSpec),
-    /// `kind = "ao"`.
-    Ao(ao::AoSpec),
-    /// `kind = "frames"`.
-    Frames(frames::FramesSpec),
+/// What a kind accepts beyond the shared command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Accepts {
+    /// `--filter`, `--shard` and `--merge` (sweeps).
+    pub subsets: bool,
+    /// Whether it runs on the GPU; a kind that does not times the f64 CPU backend, where every
+    /// structure is exact, and refuses `--backend gpu`.
+    pub gpu: bool,
 }
 
-impl Experiment {
-    /// Reads and validates an experiment file of any kind.
-    pub fn load(path: &Path) -> Result<Experiment, ConfigError> {
-        let source = Source::read(path)?;
-        let declared = Kind::declared(&source)?;
-        match declared.unwrap_or_default() {
-            Kind::Sweep => sweep::Spec::from_source(&source)
-                .map(|s| Experiment::Sweep(Box::new(s)))
-                .map_err(|e| if declared.is_none() { read_as_sweep(e) } else { e }),
-            Kind::Fps => fps::FpsSpec::from_source(&source).map(Experiment::Fps),
-            Kind::Ao => ao::AoSpec::from_source(&source).map(Experiment::Ao),
-            Kind::Frames => frames::FramesSpec::from_source(&source).map(Experiment::Frames),
-        }
-    }
+/// Everything a kind's run may use.
+pub struct Run<'a> {
+    /// The device.
+    pub backend: &'a mut dyn Backend,
+    /// The command line.
+    pub cli: &'a Cli,
+    /// The results folder, where state that outlives a run stays (a sweep's journal, its
+    /// ground-truth cache, shards); never the outputs themselves.
+    pub home: &'a Path,
+    /// Where this run's outputs go, swapped in as one set when the run succeeds.
+    pub out: &'a Outputs,
+    /// Progress bars or, off a terminal, timestamped log lines.
+    pub progress: &'a Progress,
+    /// When the run started (reports state its length).
+    pub started: std::time::Instant,
 }
 
-/// A key a sweep does not know, in a file without `kind`, may be another kind's: says how the
-/// file was read.
-fn read_as_sweep(mut e: ConfigError) -> ConfigError {
-    if e.message.starts_with("unknown field") {
-        e.message +=
-            " (a file without `kind` is read as kind = \"sweep\"; a frame-rate experiment says kind = \"fps\")";
+/// How a run ended.
+pub enum Finished {
+    /// The outputs are written; `details` is the kind's table in the manifest; `failed` names
+    /// runs that failed and the table saying why (exit status 3).
+    Results {
+        /// The kind's part of the manifest.
+        details: toml::Table,
+        /// Failed runs and the file whose rows say why.
+        failed: Option<(usize, String)>,
+    },
+    /// A share of a sweep, written into its own folder; no result set to swap in.
+    Shard {
+        /// Failed runs and the file whose rows say why.
+        failed: Option<(usize, String)>,
+    },
+}
+
+/// An experiment of any kind, read from its file.
+pub trait Experiment {
+    /// The shared keys.
+    fn header(&self) -> &Header;
+
+    /// What it accepts beyond the shared command line.
+    fn accepts(&self) -> Accepts;
+
+    /// Every file it read (experiment, scenes, meshes), hashed into the manifest.
+    fn inputs(&self) -> Vec<PathBuf>;
+
+    /// What `--dry-run` prints: every unit and its render plan.
+    fn dry_run(&self, cli: &Cli) -> anyhow::Result<String>;
+
+    /// The results folder's name under `results/` (a sweep run with filters appends them).
+    fn folder(&self, _cli: &Cli) -> anyhow::Result<String> {
+        Ok(self.header().name.clone())
     }
-    e
+
+    /// Runs and writes the outputs into `run.out`.
+    fn run(&self, run: &mut Run) -> anyhow::Result<Finished>;
+}
+
+/// Reads an experiment file of any kind: the shared header first, then the kind's own keys.
+pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
+    let source = Source::read(path)?;
+    let header = Header::read(&source)?;
+    Ok(match header.kind {
+        Kind::Sweep => Box::new(sweep::Spec::from_source(&source, header)?),
+        Kind::Fps => Box::new(fps::FpsSpec::from_source(&source, header)?),
+        Kind::Ao => Box::new(ao::AoSpec::from_source(&source, header)?),
+        Kind::Frames => Box::new(frames::FramesSpec::from_source(&source, header)?),
+    })
 }
 
 /// The registered structures an experiment's `structures` list names, each once; an unknown or

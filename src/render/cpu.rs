@@ -6,6 +6,7 @@ use super::ambient::{occlusion, AMBIENT_STREAM};
 use super::mirror::{mirror_chain, Chain};
 use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
+use crate::accel::work::{self, Work};
 use crate::render::plan::{Pass, RenderPlan};
 use crate::sampling::{shared_points, Pattern, Stream};
 use crate::scene::ambient::{AmbientOcclusion, AoDirections};
@@ -46,6 +47,8 @@ pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver>
 
 /// [`closest_hit`] ignoring triangle `skip` (a secondary ray's own triangle).
 pub fn closest_hit_skipping(scene: &Scene, origin: DVec3, dir: DVec3, skip: u32) -> Option<Receiver> {
+    work::query();
+    work::add(0, scene.shapes.len() as u64);
     let mut best: Option<(f64, usize)> = None;
     for (id, shape) in scene.shapes.iter().enumerate() {
         if let Some(t) = shape.first_t(origin, dir) {
@@ -122,11 +125,13 @@ fn light_pass(
     irradiance: &mut [f64],
 ) -> u64 {
     let l = &scene.lights[light];
-    let samples: Vec<Option<LightSample>> = receivers
+    let samples: Vec<(Option<LightSample>, Work)> = receivers
         .par_iter()
         .enumerate()
-        .map(|(pixel, r)| r.as_ref().map(|r| shade_light(scene, r, l, targets.of(light, pixel))))
+        .map(|(pixel, r)| work::counted(|| r.as_ref().map(|r| shade_light(scene, r, l, targets.of(light, pixel)))))
         .collect();
+    let (samples, work) = split_work(samples);
+    frame.work += work;
     let mut rays = 0;
     for (pixel, s) in samples.iter().enumerate() {
         if let Some(s) = s {
@@ -144,24 +149,31 @@ fn ambient_image(
     ao: &AmbientOcclusion,
     receivers: &[Option<Receiver>],
     sampling: Sampling,
-) -> (Vec<f32>, u64) {
+) -> (Vec<f32>, u64, Work) {
     let shared = match (&ao.directions, sampling.pattern) {
         (AoDirections::Disk(scheme), Pattern::Shared) => {
             Some(shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM))
         }
         _ => None,
     };
-    let values: Vec<Option<(f64, u64)>> = receivers
+    let values: Vec<(Option<(f64, u64)>, Work)> = receivers
         .par_iter()
         .enumerate()
         .map(|(pixel, r)| {
             let stream = Stream::new(sampling.seed, AMBIENT_STREAM, Some(pixel as u32));
-            r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), stream))
+            work::counted(|| r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), stream)))
         })
         .collect();
+    let (values, work) = split_work(values);
     let rays = values.iter().flatten().map(|v| v.1).sum();
     let image = values.iter().map(|v| v.map_or(NO_RECEIVER, |v| v.0 as f32)).collect();
-    (image, rays)
+    (image, rays, work)
+}
+
+/// Per-pixel values and the sum of their work.
+fn split_work<T>(pixels: Vec<(T, Work)>) -> (Vec<T>, Work) {
+    let work = pixels.iter().map(|p| p.1).sum();
+    (pixels.into_iter().map(|p| p.0).collect(), work)
 }
 
 impl Backend for CpuBackend {
@@ -184,6 +196,8 @@ impl Backend for CpuBackend {
             hit: vec![NO_HIT; pixels],
             ambient: None,
             rays: RayCounts::default(),
+            work: Work::ZERO,
+            counted: true,
         };
         let mut receivers: Vec<Option<Receiver>> = vec![];
         let mut irradiance = vec![0f64; pixels];
@@ -193,14 +207,17 @@ impl Backend for CpuBackend {
             self.dispatches += 1;
             match *pass {
                 Pass::Primary { rays, .. } => {
-                    receivers = (0..pixels)
+                    let hits: Vec<(Option<Receiver>, Work)> = (0..pixels)
                         .into_par_iter()
                         .map(|i| {
                             let (x, y) = (i as u32 % view.width, i as u32 / view.width);
                             let ray = view.camera.ray(x, y, view.width, view.height);
-                            closest_hit(scene, ray.origin, ray.direction)
+                            work::counted(|| closest_hit(scene, ray.origin, ray.direction))
                         })
                         .collect();
+                    let work;
+                    (receivers, work) = split_work(hits);
+                    frame.work += work;
                     for (h, r) in frame.hit.iter_mut().zip(&receivers) {
                         *h = r.map_or(NO_HIT, |r| r.object);
                     }
@@ -216,16 +233,20 @@ impl Backend for CpuBackend {
                     }
                 }
                 Pass::Mirror { .. } => {
-                    let chains: Vec<Option<Chain>> = receivers
+                    let chains: Vec<(Option<Chain>, Work)> = receivers
                         .par_iter()
                         .enumerate()
                         .map(|(pixel, r)| {
-                            let r = r.as_ref()?;
-                            let (x, y) = (pixel as u32 % view.width, pixel as u32 / view.width);
-                            let ray = view.camera.ray(x, y, view.width, view.height);
-                            Some(mirror_chain(scene, r, ray.direction, &|l| targets.of(l, pixel)))
+                            work::counted(|| {
+                                let r = r.as_ref()?;
+                                let (x, y) = (pixel as u32 % view.width, pixel as u32 / view.width);
+                                let ray = view.camera.ray(x, y, view.width, view.height);
+                                Some(mirror_chain(scene, r, ray.direction, &|l| targets.of(l, pixel)))
+                            })
                         })
                         .collect();
+                    let (chains, work) = split_work(chains);
+                    frame.work += work;
                     for (pixel, c) in chains.iter().enumerate() {
                         if let Some(c) = c {
                             reflected[pixel] = c.radiance;
@@ -238,7 +259,8 @@ impl Backend for CpuBackend {
                 }
                 Pass::Ambient { .. } => {
                     let ao = scene.ambient.as_ref().expect("the plan has the pass only then");
-                    let (image, rays) = ambient_image(scene, ao, &receivers, sampling);
+                    let (image, rays, work) = ambient_image(scene, ao, &receivers, sampling);
+                    frame.work += work;
                     frame.ambient = Some(image);
                     frame.rays.ambient = rays;
                 }

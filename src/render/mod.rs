@@ -95,6 +95,18 @@ pub struct Frame {
     pub ambient: Option<Vec<f32>>,
     /// Rays traced.
     pub rays: RayCounts,
+    /// What the queries cost (nodes visited, primitives tested), where the backend counts it:
+    /// the CPU always; the GPU not (`counted` false, `work` zero).
+    pub work: crate::accel::work::Work,
+    /// Whether `work` was counted.
+    pub counted: bool,
+}
+
+impl Frame {
+    /// The work counters, where counted.
+    pub fn work(&self) -> Option<crate::accel::work::Work> {
+        self.counted.then_some(self.work)
+    }
 }
 
 /// How a frame time was measured.
@@ -129,7 +141,7 @@ pub struct Timing {
 }
 
 /// Identity of the device that produced a result, written into every record.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct AdapterInfo {
     /// `gpu` or `cpu`.
     pub backend: String,

@@ -1,6 +1,7 @@
 //! Per-receiver shadow-ray logic of the CPU backend, in f64. `shaders/render.wgsl` follows it
 //! line for line in f32; change both together.
 
+use crate::accel::work;
 use crate::geometry::offset_origin;
 use crate::sampling::{DiskScheme, Stream};
 use crate::scene::{DiskLight, Light, Scene};
@@ -58,11 +59,13 @@ pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, r: &Receiver) -> bool {
 /// Any-hit test of `origin + t dir`, `0 < t < len` (`len` may be infinite), skipping the
 /// receiver's own sphere or plane or triangle.
 pub fn blocked(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver) -> bool {
-    let analytic = scene
-        .shapes
-        .iter()
-        .enumerate()
-        .any(|(id, s)| id as u32 != r.object && s.blocks(origin, dir, len));
+    work::query();
+    let mut tests = 0;
+    let analytic = scene.shapes.iter().enumerate().any(|(id, s)| {
+        tests += (id as u32 != r.object) as u64;
+        id as u32 != r.object && s.blocks(origin, dir, len)
+    });
+    work::add(0, tests);
     analytic
         || scene
             .accel

@@ -24,15 +24,10 @@ pub struct SceneFile {
     /// The acceleration structure over the meshes' triangles (`crate::accel::REGISTRY`).
     #[serde(default)]
     pub accelerator: crate::accel::AccelName,
-    /// obvhs build preset of the meshes' BVH.
+    /// Each structure's parameters, `[accel.NAME]` (`crate::accel::settings`): the chosen
+    /// structure's, and those a sweep over structures builds.
     #[serde(default)]
-    pub bvh_preset: crate::accel::Preset,
-    /// Visibility-field parameters (`accelerator = "vlf"`).
-    #[serde(default)]
-    pub vlf: VlfDesc,
-    /// kd-tree parameters (`accelerator = "kdtree"`).
-    #[serde(default)]
-    pub kdtree: KdDesc,
+    pub accel: BTreeMap<String, toml::Table>,
     /// The ambient-occlusion pass, if the scene asks for one.
     pub ambient_occlusion: Option<AmbientDesc>,
     /// The light transport simulated (shadow rays, mirror reflections).
@@ -78,34 +73,6 @@ pub struct AmbientDesc {
     pub weighting: crate::scene::ambient::Weighting,
     /// Farthest occluder counted (metres); none when absent.
     pub max_distance: Option<f64>,
-}
-
-/// The kd-tree's parameters as written; each absent one takes
-/// [`crate::accel::kdtree::KdSettings`]' default.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct KdDesc {
-    /// Deepest split level.
-    pub max_depth: Option<u32>,
-    /// Nodes with at most this many triangles become leaves.
-    pub leaf_size: Option<u32>,
-}
-
-/// The visibility field's parameters as written; each absent one takes
-/// [`crate::accel::vlf::VlfSettings`]' default.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct VlfDesc {
-    /// Direction subdivision level (16: the paper's 513 directions).
-    pub level: Option<u32>,
-    /// Tiles per side of each parallel subfield.
-    pub tiles: Option<u32>,
-    /// Tile-BSP depth.
-    pub depth: Option<u32>,
-    /// `"uniform"` slabs or `"median"` splits.
-    pub split: Option<crate::accel::vlf::Split>,
-    /// Tiles with at most this many triangles stay unsplit.
-    pub leaf_size: Option<u32>,
 }
 
 /// A mesh as written: an OBJ file (relative to the scene file), some of its groups, and a

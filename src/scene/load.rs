@@ -3,10 +3,8 @@
 
 use super::ambient::{grid_level, AmbientOcclusion, AoDirections};
 use super::camera::{Camera, Projection};
-use super::description::{AmbientDesc, KdDesc, LightDesc, ProjectionDesc, SceneFile, VlfDesc};
+use super::description::{AmbientDesc, LightDesc, ProjectionDesc, SceneFile};
 use super::{DiskLight, Light, Mesh, Plane, Scene, Shading, Sphere, MAX_SAMPLES};
-use crate::accel::kdtree::{self, KdSettings};
-use crate::accel::vlf::VlfSettings;
 use crate::accel::{self, AccelSettings};
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
@@ -19,9 +17,13 @@ use std::path::Path;
 impl Scene {
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, ConfigError> {
-        let source = Source::read(path)?;
+        Scene::from_source(&Source::read(path)?)
+    }
+
+    /// Validates a scene file's text.
+    pub fn from_source(source: &Source) -> Result<Scene, ConfigError> {
         let file: SceneFile = source.parse()?;
-        Scene::from_file(&file, &source)
+        Scene::from_file(&file, source)
     }
 
     /// Validates a parsed scene file; errors are located in `source`.
@@ -66,23 +68,25 @@ impl Scene {
             cameras.insert(name.clone(), camera);
         }
         let mut spheres = Vec::new();
-        let settings = AccelSettings {
-            name: accel::registered(&file.accelerator.0)
-                .ok_or_else(|| {
-                    source.error(
-                        &key_path!["accelerator"],
-                        format!(
-                            "unknown acceleration structure `{}`; known: {}",
-                            file.accelerator.0,
-                            accel::names().join(", ")
-                        ),
-                    )
-                })?
-                .name,
-            bvh_preset: file.bvh_preset,
-            vlf: vlf_settings(&file.vlf, source)?,
-            kdtree: kd_settings(&file.kdtree, source)?,
-        };
+        let chosen = accel::registered(&file.accelerator.0).ok_or_else(|| {
+            source.error(
+                &key_path!["accelerator"],
+                format!(
+                    "unknown acceleration structure `{}`; known: {}",
+                    file.accelerator.0,
+                    accel::names().join(", ")
+                ),
+            )
+        })?;
+        let tables: BTreeMap<&'static str, AccelSettings> =
+            accel::settings::read_tables(source, &key_path!["accel"], &file.accel, false)?
+                .into_iter()
+                .map(|(name, mut one)| (name, one.remove(0)))
+                .collect();
+        let settings = tables
+            .get(chosen.name)
+            .cloned()
+            .unwrap_or_else(|| AccelSettings::default_for(chosen));
         for (i, s) in file.spheres.iter().enumerate() {
             spheres.push(Sphere {
                 center: v.point(&s.center, &key_path!["spheres", i, "center"])?,
@@ -178,6 +182,7 @@ impl Scene {
                 shadows: file.shading.shadows,
                 mirror_depth: depth,
             })
+            .with_accel_tables(tables)
             .try_with_meshes(meshes, triangles, settings)
             .map_err(|e| source.error(&key_path!["accelerator"], format!("{e:#}")))
     }
@@ -294,48 +299,5 @@ fn ambient(a: &AmbientDesc, v: &Validator) -> Result<AmbientOcclusion, ConfigErr
         rays: a.rays,
         weighting: a.weighting,
         max_distance,
-    })
-}
-
-/// A parameter of table `table`: `value` if it lies in `lo..=hi` (a located error if not),
-/// else `default`.
-fn ranged(
-    source: &Source,
-    table: &str,
-    key: &str,
-    value: Option<u32>,
-    default: u32,
-    (lo, hi): (u32, u32),
-) -> Result<u32, ConfigError> {
-    match value {
-        Some(v) if !(lo..=hi).contains(&v) => {
-            Err(source.error(&key_path![table, key], format!("must lie in {lo}..={hi}, got {v}")))
-        }
-        v => Ok(v.unwrap_or(default)),
-    }
-}
-
-/// The visibility field's parameters from the scene's `[vlf]` table, each checked against the
-/// range the structure supports.
-pub(crate) fn vlf_settings(d: &VlfDesc, source: &Source) -> Result<VlfSettings, ConfigError> {
-    let defaults = VlfSettings::default();
-    let check = |key, value, default, range| ranged(source, "vlf", key, value, default, range);
-    Ok(VlfSettings {
-        level: check("level", d.level, defaults.level, (1, 64))?,
-        tiles: check("tiles", d.tiles, defaults.tiles, (1, 1024))?,
-        depth: check("depth", d.depth, defaults.depth, (0, 6))?,
-        split: d.split.unwrap_or(defaults.split),
-        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, (0, u32::MAX))?,
-    })
-}
-
-/// The kd-tree's parameters from the scene's `[kdtree]` table (depth up to what its walk's
-/// stack holds).
-pub(crate) fn kd_settings(d: &KdDesc, source: &Source) -> Result<KdSettings, ConfigError> {
-    let defaults = KdSettings::default();
-    let check = |key, value, default, range| ranged(source, "kdtree", key, value, default, range);
-    Ok(KdSettings {
-        max_depth: check("max_depth", d.max_depth, defaults.max_depth, (0, kdtree::MAX_DEPTH))?,
-        leaf_size: check("leaf_size", d.leaf_size, defaults.leaf_size, (0, 1 << 16))?,
     })
 }

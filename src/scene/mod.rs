@@ -88,6 +88,9 @@ pub struct Scene {
     pub triangles: Triangles,
     /// Which acceleration structure indexes `triangles`, and its parameters.
     pub accel_settings: AccelSettings,
+    /// The parameters the scene file gives each structure (`[accel.NAME]`); a structure it does
+    /// not name takes its defaults ([`Scene::settings_for`]).
+    pub accel_tables: BTreeMap<&'static str, AccelSettings>,
     /// That structure (None without triangles).
     pub accel: Option<Arc<dyn Accelerator>>,
     /// The ambient-occlusion pass, where the scene asks for one.
@@ -151,6 +154,7 @@ impl Scene {
             lights,
             triangles: Triangles::default(),
             accel_settings: AccelSettings::default(),
+            accel_tables: BTreeMap::new(),
             accel: None,
             ambient: None,
             shading: Shading::default(),
@@ -210,6 +214,20 @@ impl Scene {
         self.triangles.positions.extend(triangles.positions);
         self.triangles.object_of.extend(triangles.object_of);
         self.try_with_accelerator(settings)
+    }
+
+    /// The parameters the scene gives each structure.
+    pub fn with_accel_tables(mut self, tables: BTreeMap<&'static str, AccelSettings>) -> Scene {
+        self.accel_tables = tables;
+        self
+    }
+
+    /// Structure `r`'s parameters in this scene: its `[accel.NAME]` table, or its defaults.
+    pub fn settings_for(&self, r: &accel::Registered) -> AccelSettings {
+        self.accel_tables
+            .get(r.name)
+            .cloned()
+            .unwrap_or_else(|| AccelSettings::default_for(r))
     }
 
     /// The same scene with its triangles indexed by the structure `settings` names.

@@ -2,7 +2,7 @@
 //! no tree, nothing to get wrong: the independent path other structures are checked against
 //! (select it with `accelerator = "brute"`; it costs O(triangles) per ray).
 
-use super::{brute_force, intersect, Accelerator, BuildStats, GpuStructure, GpuTri, TriHit};
+use super::{brute_force, intersect, work, Accelerator, BuildStats, GpuStructure, GpuTri, TriHit};
 use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
 use glam::DVec3;
@@ -10,6 +10,17 @@ use std::time::Duration;
 
 /// Its WGSL: `accel_closest` and `accel_any` as loops over every triangle.
 pub const WGSL: &str = include_str!("brute.wgsl");
+
+/// Brute force has no parameters (`[accel.brute]` is empty).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BruteSettings {}
+
+impl super::settings::Params for BruteSettings {
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        Ok(())
+    }
+}
 
 /// The triangles, in input order.
 #[derive(Clone, Debug)]
@@ -32,6 +43,7 @@ impl Accelerator for Brute {
     }
 
     fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
+        work::add(0, self.triangles.positions.len() as u64);
         if skip == u32::MAX {
             return brute_force(&self.triangles, origin, dir).filter(|h| h.t < tmax);
         }
@@ -48,11 +60,13 @@ impl Accelerator for Brute {
     }
 
     fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
-        self.triangles
-            .positions
-            .iter()
-            .enumerate()
-            .any(|(i, tri)| i as u32 != skip && intersect(origin, dir, tri).is_some_and(|t| t > 0.0 && t < tmax))
+        let mut tests = 0;
+        let hit = self.triangles.positions.iter().enumerate().any(|(i, tri)| {
+            tests += 1;
+            i as u32 != skip && intersect(origin, dir, tri).is_some_and(|t| t > 0.0 && t < tmax)
+        });
+        work::add(0, tests);
+        hit
     }
 
     fn stats(&self) -> BuildStats {
@@ -79,5 +93,13 @@ impl Accelerator for Brute {
             buffers: vec![("brute-force triangle buffer", bytemuck::cast_slice(&tris).to_vec())],
             walk_iterations: tris.len() as u32 + 1,
         })
+    }
+
+    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
+        match method {
+            "rebuild" => *self = Brute::build(moved),
+            m => return Err(super::unknown_update(self, m)),
+        }
+        Ok(())
     }
 }

@@ -8,7 +8,7 @@
 
 mod gpu;
 
-use super::{intersect, Accelerator, BuildStats, GpuStructure, TriHit};
+use super::{intersect, work, Accelerator, BuildStats, GpuStructure, TriHit};
 use crate::geometry::LocalFrame;
 use crate::mesh::Triangles;
 use glam::{DVec3, Vec3, Vec3A};
@@ -17,12 +17,12 @@ use obvhs::bvh2::Bvh2;
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// obvhs build presets, fastest build to best tree. `medium` is obvhs' recommended default;
 /// `slow` and `very-slow` add spatial pre-splits of large triangles (duplicated references).
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Preset {
     /// One triangle per leaf, no reinsertion.
@@ -73,6 +73,20 @@ impl Preset {
         Preset::Slow,
         Preset::VerySlow,
     ];
+}
+
+/// The BVH's parameters (`[accel.bvh]`): obvhs' build preset.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BvhSettings {
+    /// Build preset.
+    pub preset: Preset,
+}
+
+impl super::settings::Params for BvhSettings {
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        Ok(())
+    }
 }
 
 /// A built BVH with its triangles.
@@ -235,23 +249,103 @@ impl Bvh {
         Some((ray, s))
     }
 
+    /// Walks the CPU tree along `ray`, near child first, calling `test(slot)` for each
+    /// primitive slot of every leaf the ray's current segment meets: `Some(t)` shortens the
+    /// segment to `t`, `Some(NEG_INFINITY)` ends the walk. Counts box tests and primitive tests
+    /// ([`crate::accel::work`]).
+    #[inline]
+    fn walk(&self, mut ray: Ray, mut test: impl FnMut(usize) -> Option<f32>) {
+        let nodes = &self.cpu_tree.nodes;
+        let (mut boxes, mut prims) = (1u64, 0u64);
+        let mut leaf = |node: &obvhs::bvh2::node::Bvh2Node, ray: &mut Ray, prims: &mut u64| -> bool {
+            for slot in node.first_index..node.first_index + node.prim_count {
+                *prims += 1;
+                if let Some(t) = test(slot as usize) {
+                    if t == f32::NEG_INFINITY {
+                        return false;
+                    }
+                    ray.tmax = ray.tmax.min(t);
+                }
+            }
+            true
+        };
+        let root = &nodes[0];
+        if root.aabb().intersect_ray(&ray) >= ray.tmax {
+            work::add(boxes, prims);
+            return;
+        }
+        if root.is_leaf() {
+            leaf(root, &mut ray, &mut prims);
+            work::add(boxes, prims);
+            return;
+        }
+        let mut small = [0u32; 128];
+        let mut large = Vec::new();
+        let stack: &mut [u32] = if self.depth < small.len() {
+            &mut small
+        } else {
+            large.resize(self.depth + 1, 0);
+            &mut large
+        };
+        let mut top = 0;
+        let mut current = root.first_index as usize;
+        loop {
+            let (mut near, mut far) = (&nodes[current], &nodes[current + 1]);
+            let (mut tn, mut tf) = (near.aabb().intersect_ray(&ray), far.aabb().intersect_ray(&ray));
+            boxes += 2;
+            if tn > tf {
+                std::mem::swap(&mut tn, &mut tf);
+                std::mem::swap(&mut near, &mut far);
+            }
+            let mut next = [None, None];
+            for (slot, (node, t)) in [(near, tn), (far, tf)].into_iter().enumerate() {
+                if t >= ray.tmax {
+                    continue;
+                }
+                if node.is_leaf() {
+                    if !leaf(node, &mut ray, &mut prims) {
+                        work::add(boxes, prims);
+                        return;
+                    }
+                } else {
+                    next[slot] = Some(node.first_index as usize);
+                }
+            }
+            current = match next {
+                [Some(a), Some(b)] => {
+                    stack[top] = b as u32;
+                    top += 1;
+                    a
+                }
+                [Some(a), None] | [None, Some(a)] => a,
+                [None, None] => {
+                    if top == 0 {
+                        work::add(boxes, prims);
+                        return;
+                    }
+                    top -= 1;
+                    stack[top] as usize
+                }
+            };
+        }
+    }
+
     /// Closest triangle hit with 0 < t < `tmax` along unit `dir`, skipping triangle `skip`.
     pub fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
         if self.world.is_empty() {
             return None;
         }
         let mut best: Option<TriHit> = None;
-        let mut hit = obvhs::ray::RayHit::none();
         let (ray, s) = self.ray(origin, dir, tmax)?;
-        self.cpu_tree.ray_traverse(ray, &mut hit, |_, i| {
+        self.walk(ray, |i| {
             let tri = self.cpu_tree.primitive_indices[i];
             match intersect(origin, dir, &self.world[tri as usize]) {
                 Some(t) if tri != skip && t > 0.0 && t < tmax && best.is_none_or(|b| t < b.t) => {
                     best = Some(TriHit { t, triangle: tri });
                     // The walk's new far end, in its shifted parameter, rounded outwards.
-                    ((t - s) + (t - s).abs() * 1e-6 + 1e-30) as f32
+                    Some(((t - s) + (t - s).abs() * 1e-6 + 1e-30) as f32)
                 }
-                _ => f32::INFINITY,
+                _ => None,
             }
         });
         best
@@ -265,14 +359,18 @@ impl Bvh {
         let Some((ray, _)) = self.ray(origin, dir, tmax) else {
             return false;
         };
-        !self.cpu_tree.ray_traverse_miss(ray, |_, i| {
+        let mut hit = false;
+        self.walk(ray, |i| {
             let tri = self.cpu_tree.primitive_indices[i];
             match intersect(origin, dir, &self.world[tri as usize]) {
-                // Below any far end the shifted walk may have.
-                Some(t) if tri != skip && t > 0.0 && t < tmax => f32::NEG_INFINITY,
-                _ => f32::INFINITY,
+                Some(t) if tri != skip && t > 0.0 && t < tmax => {
+                    hit = true;
+                    Some(f32::NEG_INFINITY)
+                }
+                _ => None,
             }
-        })
+        });
+        hit
     }
 
     /// Number of nodes.
@@ -322,6 +420,25 @@ impl Accelerator for Bvh {
 
     fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
         gpu::structure(self, frame)
+    }
+
+    /// A refit keeps the tree's topology (cheap; the tree decays as things move); a rebuild
+    /// with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
+    /// frame (the fastest tree to build, slower to walk).
+    fn updates(&self) -> &'static [&'static str] {
+        &["refit", "rebuild", "rebuild-fastest"]
+    }
+
+    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
+        match method {
+            "refit" => {
+                self.refit(moved);
+            }
+            "rebuild" => *self = Bvh::build(moved, self.preset),
+            "rebuild-fastest" => *self = Bvh::build(moved, Preset::Fastest),
+            m => return Err(super::unknown_update(self, m)),
+        }
+        Ok(())
     }
 }
 

@@ -36,8 +36,9 @@ pub const GPU_BUFFERS: u32 = 4;
 /// Deepest tree the walk's stack (64 entries on the CPU and the GPU) allows.
 pub const MAX_DEPTH: u32 = 60;
 
-/// The paper's tuning knobs for its CRT baseline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The paper's tuning knobs for its CRT baseline (`[accel.kdtree]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct KdSettings {
     /// Deepest split level (the paper's best: 16-23 for AO, 23 for the walkthrough).
     pub max_depth: u32,
@@ -53,6 +54,32 @@ impl Default for KdSettings {
         KdSettings {
             max_depth: 22,
             leaf_size: 8,
+        }
+    }
+}
+
+impl crate::accel::settings::Params for KdSettings {
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        if self.max_depth > MAX_DEPTH {
+            return Err((
+                "max_depth",
+                format!("must lie in 0..={MAX_DEPTH} (the walk's stack), got {}", self.max_depth),
+            ));
+        }
+        if self.leaf_size > 1 << 16 {
+            return Err((
+                "leaf_size",
+                format!("must lie in 0..={}, got {}", 1 << 16, self.leaf_size),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The paper's CRT depths (16-23) and deeper, at three leaf sizes.
+    fn tuning() -> toml::Table {
+        toml::toml! {
+            max_depth = [16, 18, 22, 26, 30]
+            leaf_size = [4, 8, 16]
         }
     }
 }
@@ -275,5 +302,13 @@ impl Accelerator for KdTree {
 
     fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
         gpu::structure(self, &self.triangles, frame)
+    }
+
+    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
+        match method {
+            "rebuild" => *self = KdTree::build(moved, self.settings),
+            m => return Err(crate::accel::unknown_update(self, m)),
+        }
+        Ok(())
     }
 }

@@ -4,7 +4,7 @@
 //! walks the same way in f32 with its own `delta`.
 
 use super::KdTree;
-use crate::accel::{intersect, TriHit};
+use crate::accel::{intersect, work, TriHit};
 use crate::mesh::Triangles;
 use glam::DVec3;
 
@@ -80,7 +80,11 @@ pub fn walk(
         .max(origin.abs())
         .max_element();
     let delta = DELTA * scale.max(f64::MIN_POSITIVE);
-    let (t0, t1) = clip(tree.bounds, origin, dir, tmax, delta)?;
+    let Some((t0, t1)) = clip(tree.bounds, origin, dir, tmax, delta) else {
+        work::add(1, 0);
+        return None;
+    };
+    let (mut nodes, mut prims) = (1u64, 0u64);
     let mut stack = [(0usize, 0.0f64, 0.0f64); STACK];
     let mut top = 0;
     let mut current = Some((0usize, t0, t1));
@@ -88,6 +92,7 @@ pub fn walk(
     loop {
         let Some((mut node, mut tn, mut tf)) = current.take() else {
             if top == 0 {
+                work::add(nodes, prims);
                 return best;
             }
             top -= 1;
@@ -101,6 +106,7 @@ pub fn walk(
             continue;
         };
         while let Some((axis, split, left)) = tree.split(node) {
+            nodes += 1;
             let [near, far] = children(axis, split, left, origin, dir, (tn, tf), delta);
             match (near, far) {
                 (Some(n), Some(f)) => {
@@ -120,12 +126,14 @@ pub fn walk(
             if i == skip {
                 continue;
             }
+            prims += 1;
             let Some(t) = intersect(origin, dir, &triangles.positions[i as usize]) else {
                 continue;
             };
             if t > 0.0 && t < tmax && best.is_none_or(|b| t < b.t || (t == b.t && i < b.triangle)) {
                 best = Some(TriHit { t, triangle: i });
                 if any {
+                    work::add(nodes, prims);
                     return best;
                 }
             }

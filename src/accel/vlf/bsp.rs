@@ -10,7 +10,7 @@
 use serde::Deserialize;
 
 /// How a tile's depth range is cut into leaves.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Split {
     /// Equal slabs between the tile's nearest and farthest depth: a leaf index is one

@@ -68,7 +68,8 @@ pub const DEAD: u32 = u32::MAX;
 /// Build parameters (paper Section 6 fixes 513 directions and 128 x 128 tiles; tile-BSP depth
 /// 3-5 was best there). With the per-entry footprint boxes, depth 2 was faster still on the
 /// body (0.93-1.05 against 0.84-0.92 Mrays/s AO any-hit, 370 MB against 445 MB).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct VlfSettings {
     /// Direction subdivision level `L`: `2 L^2 + 1` directions (16 gives the paper's 513).
     pub level: u32,
@@ -92,6 +93,28 @@ impl Default for VlfSettings {
             // Measured on the body (513 dirs, 128^2, depth 4): 32 gives 445 MB and 0.92 Mrays/s
             // AO any-hit where 8 gave 600 MB and 0.84 (fewer split tiles, fewer duplicates).
             leaf_size: 32,
+        }
+    }
+}
+
+impl crate::accel::settings::Params for VlfSettings {
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        for (key, value, (lo, hi)) in [
+            ("level", self.level, (1, 64)),
+            ("tiles", self.tiles, (1, 1024)),
+            ("depth", self.depth, (0, 6)),
+        ] {
+            if !(lo..=hi).contains(&value) {
+                return Err((key, format!("must lie in {lo}..={hi}, got {value}")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Tile-BSP depths around the paper's best (3-5).
+    fn tuning() -> toml::Table {
+        toml::toml! {
+            depth = [2, 3, 4, 5]
         }
     }
 }
@@ -291,5 +314,18 @@ impl Accelerator for VisibilityField {
 
     fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
         gpu::structure(self, frame)
+    }
+
+    /// Its own update (paper Section 8): the object's ids removed from every tile it covered
+    /// and inserted again where it now is.
+    fn updates(&self) -> &'static [&'static str] {
+        &["update"]
+    }
+
+    fn update(&mut self, method: &str, _moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<()> {
+        match method {
+            "update" => self.move_object(object, |p| p + step).map(|_| ()),
+            m => Err(crate::accel::unknown_update(self, m)),
+        }
     }
 }

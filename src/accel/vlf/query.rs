@@ -13,7 +13,9 @@ use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
 use super::layer::{Layer, SPLIT};
 use super::raster::sub_range;
 use super::{VisibilityField, EPS};
+use crate::accel::work;
 use glam::DVec3;
+use std::cell::Cell;
 
 /// A ray in one direction's tile space: `x, y` in tiles, `z` in ball units, per unit of world t.
 #[derive(Clone, Copy, Debug)]
@@ -312,26 +314,32 @@ impl VisibilityField {
         false
     }
 
-    /// Any-hit over one layer.
+    /// Any-hit over one layer; counts tiles and tile-BSP leaves as traversal steps.
     #[inline]
     pub(super) fn any_in(&self, layer: &Layer, ray: &TileRay, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
         let tri = &self.tri;
         let mask = bsp::id_mask(self.settings.depth);
-        self.walk(
+        let (nodes, prims) = (Cell::new(0u64), Cell::new(0u64));
+        let hit = self.walk(
             ray,
             || f64::INFINITY,
             |tile, ta, tb| {
+                nodes.set(nodes.get() + 1);
                 self.leaves(layer, ray, tile, ta, tb, |leaf| {
+                    nodes.set(nodes.get() + 1);
                     leaf.each(mask, |id| {
                         if id == skip {
                             return false;
                         }
+                        prims.set(prims.get() + 1);
                         let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
                         t > 0.0 && t < tmax
                     })
                 })
             },
-        )
+        );
+        work::add(nodes.get(), prims.get());
+        hit
     }
 
     /// Closest hit over one layer, improving on `best` (t, triangle).
@@ -349,17 +357,21 @@ impl VisibilityField {
     ) {
         let tri = &self.tri;
         let mask = bsp::id_mask(self.settings.depth);
-        let cell = std::cell::Cell::new(*best);
+        let cell = Cell::new(*best);
+        let (nodes, prims) = (Cell::new(0u64), Cell::new(0u64));
         self.walk(
             ray,
             || cell.get().0,
             |tile, ta, tb| {
+                nodes.set(nodes.get() + 1);
                 self.leaves(layer, ray, tile, ta, tb, |leaf| {
+                    nodes.set(nodes.get() + 1);
                     let mut b = cell.get();
                     leaf.each(mask, |id| {
                         if id == skip {
                             return false;
                         }
+                        prims.set(prims.get() + 1);
                         let t = exact_t(origin, dir, &tri[9 * id as usize..9 * id as usize + 9]);
                         if t > 0.0 && t < tmax && (t < b.0 || (t == b.0 && id < b.1)) {
                             b = (t, id);
@@ -372,6 +384,7 @@ impl VisibilityField {
                 false
             },
         );
+        work::add(nodes.get(), prims.get());
         *best = cell.get();
     }
 }

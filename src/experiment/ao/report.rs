@@ -1,9 +1,10 @@
-//! Outputs of an ambient-occlusion experiment: ao.csv, the AO images, a plot of frame time
-//! against triangle count, and report.md with the paper's Table 1 beside ours and a verdict
-//! computed from the rows.
+//! Outputs of an ambient-occlusion experiment: ao.csv, tuning.csv, the AO images, a plot of
+//! frame time per mesh, and report.md with the paper's Table 1 beside ours and a verdict
+//! computed from the rows by the one timing rule.
 
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
+use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{grey, write_png};
@@ -18,21 +19,45 @@ struct CsvRow<'a> {
     mesh: &'a str,
     triangles: usize,
     structure: &'a str,
-    parameters: &'a str,
+    parameters: String,
     #[serde(with = "float")]
     build_s: f64,
-    memory_mb: String,
-    frames: usize,
+    memory_bytes: u64,
+    timed_frames: usize,
     #[serde(with = "float")]
-    frame_s_median: f64,
+    frame_s: f64,
+    #[serde(with = "float")]
+    frame_s_lo: f64,
+    #[serde(with = "float")]
+    frame_s_hi: f64,
     primary_rays: u64,
     ao_rays: u64,
+    queries: u64,
+    nodes_visited: u64,
+    primitive_tests: u64,
     #[serde(with = "float")]
-    mrays_per_s: f64,
+    rays_per_s: f64,
     receivers: usize,
     #[serde(with = "float")]
     mean_ao: f64,
     same_image_as_first: bool,
+}
+
+/// A row of tuning.csv.
+#[derive(Serialize)]
+struct TuningCsv<'a> {
+    mesh: &'a str,
+    structure: &'a str,
+    parameters: String,
+    #[serde(with = "float")]
+    frame_s: f64,
+    #[serde(with = "float")]
+    frame_s_lo: f64,
+    #[serde(with = "float")]
+    frame_s_hi: f64,
+    nodes_visited: u64,
+    primitive_tests: u64,
+    chosen: bool,
 }
 
 /// The row of `structure` on `mesh`.
@@ -40,69 +65,82 @@ fn find<'a>(rows: &'a [AoRow], mesh: &str, structure: &str) -> Option<&'a AoRow>
     rows.iter().find(|r| r.mesh == mesh && r.structure == structure)
 }
 
-/// The verdict on the paper's claims, from the rows: VLF-RT against the CRT-like kd-tree and
-/// against the BVH, with the memory and build time it costs.
+/// Speed-up of `subject` over `other` on one mesh: `other`'s time over `subject`'s (median of
+/// per-round ratios with its interval), and the rule's word for `subject`.
+fn speedup(subject: &AoRow, other: &AoRow, seed: u32) -> (Estimate, Comparison) {
+    if subject.frame_seconds.len() != other.frame_seconds.len() || subject.frame_seconds.is_empty() {
+        return (Estimate::NAN, Comparison::Equal);
+    }
+    let ratio = paired_ratio(&subject.frame_seconds, &other.frame_seconds, seed);
+    (ratio.recip(), Comparison::of(&ratio))
+}
+
+/// The verdict on the paper's claim, from the rows: the subject against its baseline and every
+/// other structure, per mesh by the rule, with the work and memory behind each time.
 pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     let mut out = String::new();
-    // (mesh, speed-up of `a` over `b`, whether their frame times' interquartile ranges are
-    // disjoint: a difference beyond the noise of the rounds)
-    let ratio = |a: &str, b: &str| -> Vec<(String, f64, bool)> {
-        spec.meshes
-            .iter()
-            .filter_map(|m| {
-                let (x, y) = (find(rows, &m.name, a)?, find(rows, &m.name, b)?);
-                let ((x1, x3), (y1, y3)) = (x.quartile_seconds(), y.quartile_seconds());
-                Some((
-                    m.name.clone(),
-                    y.median_seconds() / x.median_seconds(),
-                    x3 < y1 || y3 < x1,
-                ))
-            })
-            .collect()
-    };
+    let seed = spec.header.schedule.seed;
     let identical = rows.iter().all(|r| r.same_image);
     out += &format!(
         "- **Exactness**: every structure's AO image {} the first structure's, bit for bit, on every mesh.\n",
         if identical { "equals" } else { "does NOT equal" }
     );
-    for (baseline, label, paper) in [
-        (
-            "kdtree",
-            "the CRT-like kd-tree (the paper's baseline)",
-            Some("1.45-2.51x"),
-        ),
-        (
-            "bvh",
-            "obvhs' BVH2 (very-slow build, the project's f64 traversal)",
-            None,
-        ),
-    ] {
-        let r = ratio("vlf", baseline);
-        if r.is_empty() {
+    let subject = spec.claim.subject.as_str();
+    for (other, _) in spec.structures.iter().filter(|(s, _)| *s != subject) {
+        let per_mesh: Vec<(String, Estimate, Comparison)> = spec
+            .meshes
+            .iter()
+            .filter_map(|m| {
+                let (a, b) = (find(rows, &m.name, subject)?, find(rows, &m.name, other)?);
+                let (e, c) = speedup(a, b, seed);
+                Some((m.name.clone(), e, c))
+            })
+            .collect();
+        if per_mesh.is_empty() || per_mesh.iter().all(|m| m.1.median.is_nan()) {
             continue;
         }
-        let faster = r.iter().filter(|(_, x, apart)| *x > 1.0 && *apart).count();
-        let slower = r.iter().filter(|(_, x, apart)| *x < 1.0 && *apart).count();
-        let listed: Vec<String> = r
+        let count = |c: Comparison| per_mesh.iter().filter(|m| m.2 == c).count();
+        let listed: Vec<String> = per_mesh
             .iter()
-            .map(|(m, x, apart)| format!("{m} {x:.2}x{}", if *apart { "" } else { " (within noise)" }))
+            .map(|(m, e, c)| format!("{m} {}x ({})", e.show(2), c.word()))
             .collect();
+        let claim = if *other == spec.claim.baseline {
+            let paper: Vec<f64> = spec
+                .meshes
+                .iter()
+                .filter_map(|m| m.paper.as_ref().map(|p| p.crt_seconds / p.vlf_seconds))
+                .collect();
+            let range = if paper.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; the paper: {:.2}-{:.2}x",
+                    paper.iter().cloned().fold(f64::INFINITY, f64::min),
+                    paper.iter().cloned().fold(0.0, f64::max)
+                )
+            };
+            format!(" (the paper's claim: faster than its baseline{range})")
+        } else {
+            String::new()
+        };
         out += &format!(
-            "- **VLF-RT vs {label}**: faster on {faster} of {} meshes and slower on {slower}, counting only frame times whose interquartile ranges are disjoint; speed-up (their median frame time / VLF-RT's) {}, median {:.2}x{}.\n",
-            r.len(),
+            "- **`{subject}` vs `{other}`**{claim}: faster on {} of {} meshes, slower on {}, equal within noise on {}; speed-up (`{other}`'s time / `{subject}`'s, 95 % interval): {}; median over meshes {:.2}x.\n",
+            count(Comparison::Faster),
+            per_mesh.len(),
+            count(Comparison::Slower),
+            count(Comparison::Equal),
             listed.join(", "),
-            median(&r.iter().map(|x| x.1).collect::<Vec<_>>()),
-            paper.map_or(String::new(), |p| format!(" (the paper: {p})"))
+            median(&per_mesh.iter().map(|m| m.1.median).collect::<Vec<_>>()),
         );
     }
     let cost: Vec<String> = spec
         .meshes
         .iter()
         .filter_map(|m| {
-            let v = find(rows, &m.name, "vlf")?;
-            let others: Vec<String> = ["kdtree", "bvh"]
+            let v = find(rows, &m.name, subject)?;
+            let others: Vec<String> = rows
                 .iter()
-                .filter_map(|s| find(rows, &m.name, s))
+                .filter(|o| o.mesh == m.name && o.structure != subject)
                 .map(|o| {
                     format!(
                         "{} {:.2} MB / {:.2} s",
@@ -122,24 +160,15 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
         })
         .collect();
     if !cost.is_empty() {
-        out += &format!("- **What VLF-RT costs** (memory / build time): {}.\n", cost.join("; "));
+        out += &format!(
+            "- **What `{subject}` costs** (memory / build time): {}.\n",
+            cost.join("; ")
+        );
     }
     out
 }
 
-/// A row of tuning.csv.
-#[derive(Serialize)]
-struct TuningCsv<'a> {
-    mesh: &'a str,
-    structure: &'a str,
-    parameters: &'a str,
-    #[serde(with = "float")]
-    frame_s_median: f64,
-    chosen: bool,
-}
-
-/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png, report.md and manifest.toml under
-/// `out`.
+/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png and report.md under `out`.
 pub fn write_ao(
     spec: &AoSpec,
     (rows, tuning): (&[AoRow], &[TuningRow]),
@@ -152,8 +181,12 @@ pub fn write_ao(
         tuning.iter().map(|t| TuningCsv {
             mesh: &t.mesh,
             structure: t.structure,
-            parameters: &t.parameters,
-            frame_s_median: t.frame_seconds,
+            parameters: t.settings.describe(),
+            frame_s: t.frame.median,
+            frame_s_lo: t.frame.lo,
+            frame_s_hi: t.frame.hi,
+            nodes_visited: t.work.nodes,
+            primitive_tests: t.work.primitives,
             chosen: t.chosen,
         }),
     )?;
@@ -161,14 +194,19 @@ pub fn write_ao(
         mesh: &r.mesh,
         triangles: r.triangles,
         structure: r.structure,
-        parameters: &r.parameters,
+        parameters: r.settings.describe(),
         build_s: r.build_seconds,
-        memory_mb: format!("{:.3}", r.memory_bytes as f64 / 1e6),
-        frames: r.frame_seconds.len(),
-        frame_s_median: r.median_seconds(),
+        memory_bytes: r.memory_bytes,
+        timed_frames: r.frame_seconds.len(),
+        frame_s: r.frame.median,
+        frame_s_lo: r.frame.lo,
+        frame_s_hi: r.frame.hi,
         primary_rays: r.rays.0,
         ao_rays: r.rays.1,
-        mrays_per_s: r.mrays_per_s(),
+        queries: r.work.queries,
+        nodes_visited: r.work.nodes,
+        primitive_tests: r.work.primitives,
+        rays_per_s: r.mrays_per_s() * 1e6,
         receivers: r.receivers,
         mean_ao: r.mean_ao,
         same_image_as_first: r.same_image,
@@ -177,7 +215,7 @@ pub fn write_ao(
     for m in &spec.meshes {
         if let Some(r) = rows.iter().find(|r| r.mesh == m.name) {
             write_png(
-                &out.join(format!("images/{}.png", m.name)),
+                &out.join("images").join(format!("{}.png", m.name)),
                 &grey(&r.image, spec.width, spec.height),
             )?;
         }
@@ -186,11 +224,11 @@ pub fn write_ao(
         .structures
         .iter()
         .enumerate()
-        .map(|(i, s)| {
+        .map(|(i, (s, _))| {
             let points = rows
                 .iter()
                 .filter(|r| r.structure == *s)
-                .map(|r| (r.triangles as f64, r.median_seconds(), f64::NAN))
+                .map(|r| (r.triangles as f64, r.frame.median, f64::NAN))
                 .collect();
             (
                 i,
@@ -217,17 +255,29 @@ pub fn write_ao(
         &series,
         &[],
     )?;
-    write_atomic(&out.join("report.md"), report(spec, rows, threads, seconds).as_bytes())?;
-    crate::output::write_cpu_manifest(out, &spec.path, seconds, threads)
+    write_atomic(&out.join("report.md"), report(spec, rows, threads, seconds).as_bytes())
 }
 
 fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {
+    let schedule = spec.header.schedule;
+    let tuned: Vec<String> = spec
+        .structures
+        .iter()
+        .filter(|(_, c)| c.len() > 1)
+        .map(|(s, c)| {
+            format!(
+                "`{s}` over {} candidates ({})",
+                c.len(),
+                c.iter().map(|x| x.describe()).collect::<Vec<_>>().join("; ")
+            )
+        })
+        .collect();
     let mut md = format!(
         "# {}: ambient occlusion, the visibility-field paper's Table 1 measured\n\n",
         spec.name
     );
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each method is first tuned per mesh, as the paper tuned both (the kd-tree over maximum depths {:?} and leaf sizes {:?}, the field over tile-BSP depths {:?}; {} timed frames each at {}x{}, `tuning.csv`), then the kept settings render one untimed frame, which gives the image, and every structure of a mesh is timed in {} interleaved rounds (a fresh seeded order each); the frame time is their median (quartiles beside it), rays/s count camera and AO rays.\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each structure is first tuned per mesh, as the paper tuned both methods ({}; each candidate timed in {} interleaved rounds at {}x{}, the fastest median kept, `tuning.csv`); then the kept settings render one untimed frame, which gives the image and the work counts, and every structure of a mesh is timed in {} interleaved rounds (order seed {}). Rays/s count camera and AO rays. {RULE}\n\n",
         spec.path.display(),
         seconds,
         spec.width,
@@ -235,44 +285,37 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
         spec.ao.rays,
         spec.ao.weighting.name(),
         spec.ao.max_distance,
-        spec.tuning.kdtree_depths,
-        spec.tuning.kdtree_leaves,
-        spec.tuning.vlf_depths,
-        spec.tuning.frames,
+        if tuned.is_empty() { "nothing to tune".to_string() } else { tuned.join("; ") },
+        spec.tuning.repeats,
         spec.tuning.width,
         spec.tuning.height,
-        spec.repeats
+        schedule.repeats,
+        schedule.seed,
     );
     md += "## Verdict\n\n";
     md += &verdict(spec, rows);
-    md += "\n## Ours\n\n| mesh | triangles | structure | parameters | build s | MB | frame s (q1-q3) | Mrays/s | vs kdtree | vs bvh | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
-        let vs = |s: &str| {
-            find(rows, &r.mesh, s).map_or("n/a".to_string(), |b| {
-                format!("{:.2}x", b.median_seconds() / r.median_seconds())
-            })
-        };
         md += &format!(
-            "| {} | {} | {} | {} | {:.2} | {:.1} | {:.3} ({:.3}-{:.3}) | {:.2} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {:.2} | {:.1} | {} | {:.2} | {:.3e} | {:.3e} | {} |\n",
             r.mesh,
             r.triangles,
             r.structure,
-            r.parameters,
+            r.settings.describe(),
             r.build_seconds,
             r.memory_bytes as f64 / 1e6,
-            r.median_seconds(),
-            r.quartile_seconds().0,
-            r.quartile_seconds().1,
+            r.frame.show(3),
             r.mrays_per_s(),
-            vs("kdtree"),
-            vs("bvh"),
+            r.work.nodes as f64,
+            r.work.primitives as f64,
             if r.same_image { "yes" } else { "NO" }
         );
     }
-    md += "\n## The paper's Table 1 beside ours\n\nThe paper (2.8 GHz Pentium 4, 256x256, 513 rays per point): CRT and VLF-RT seconds at each one's best depth. Ours: the same ratio, CRT-like kd-tree frame time over VLF-RT's.\n\n| mesh | paper CRT s (depth) | paper VLF-RT s (depth) | paper speed-up | our speed-up |\n|---|---|---|---|---|\n";
+    let (subject, baseline) = (&spec.claim.subject, &spec.claim.baseline);
+    md += &format!("\n## The paper's Table 1 beside ours\n\nThe paper (2.8 GHz Pentium 4, 256x256, 513 rays per point): CRT and VLF-RT seconds at each one's best depth. Ours: `{baseline}`'s frame time over `{subject}`'s (median of per-round ratios, 95 % interval).\n\n| mesh | paper CRT s (depth) | paper VLF-RT s (depth) | paper speed-up | our speed-up |\n|---|---|---|---|---|\n");
     for m in &spec.meshes {
-        let ours = match (find(rows, &m.name, "kdtree"), find(rows, &m.name, "vlf")) {
-            (Some(k), Some(v)) => format!("{:.2}x", k.median_seconds() / v.median_seconds()),
+        let ours = match (find(rows, &m.name, subject), find(rows, &m.name, baseline)) {
+            (Some(a), Some(b)) => format!("{}x", speedup(a, b, schedule.seed).0.show(2)),
             _ => "n/a".into(),
         };
         match &m.paper {

@@ -1,16 +1,16 @@
 //! Runs an ambient-occlusion experiment on the f64 CPU backend, where every structure answers
-//! exactly (the GPU's f32 walks may decide a grazing ray differently): per mesh, each structure is tuned (the kd-tree's depth and leaf size, the field's
-//! tile-BSP depth, timed at a small size), built at the settings kept and renders the AO image
-//! once (untimed; every structure's image must equal the first's bit for bit); then the mesh's
-//! structures are timed in `repeats` interleaved rounds.
+//! exactly (the GPU's f32 walks may decide a grazing ray differently): per mesh, each structure
+//! is tuned over its candidates (timed at a small size in interleaved rounds), built at the
+//! settings kept, and renders the AO image once (untimed; its rays and work counted; every
+//! structure's image must equal the first's bit for bit); then the mesh's structures are timed
+//! in the experiment's interleaved rounds.
 
-use super::spec::{best_settings, AoMesh, AoSpec};
-use crate::accel::kdtree::KdSettings;
-use crate::accel::vlf::VlfSettings;
+use super::spec::{AoMesh, AoSpec};
+use crate::accel::work::Work;
 use crate::accel::AccelSettings;
-use crate::render::cpu::CpuBackend;
+use crate::experiment::progress::Progress;
+use crate::experiment::timing::{median_interval, Estimate, Schedule};
 use crate::render::{Backend, Sampling, View};
-use crate::sampling::rng::pcg;
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Mesh, Scene};
@@ -27,15 +27,19 @@ pub struct AoRow {
     /// Structure name.
     pub structure: &'static str,
     /// Its build parameters.
-    pub parameters: String,
+    pub settings: AccelSettings,
     /// Build time, seconds.
     pub build_seconds: f64,
     /// Structure bytes beyond the triangles.
     pub memory_bytes: u64,
-    /// Timed frames, seconds.
+    /// Timed frames, seconds, one per round.
     pub frame_seconds: Vec<f64>,
+    /// Median frame seconds with its 95 % interval.
+    pub frame: Estimate,
     /// Camera rays and AO rays of a frame.
     pub rays: (u64, u64),
+    /// What a frame's queries cost.
+    pub work: Work,
     /// Pixels that see the mesh.
     pub receivers: usize,
     /// Mean AO over those pixels.
@@ -47,20 +51,9 @@ pub struct AoRow {
 }
 
 impl AoRow {
-    /// Median frame time, seconds.
-    pub fn median_seconds(&self) -> f64 {
-        crate::metrics::stats::median(&self.frame_seconds)
-    }
-
-    /// First and third quartiles of the frame time, seconds.
-    pub fn quartile_seconds(&self) -> (f64, f64) {
-        let (q1, _, q3) = crate::metrics::stats::quartiles(&self.frame_seconds);
-        (q1, q3)
-    }
-
     /// Rays (camera and AO) per second at the median frame time, millions.
     pub fn mrays_per_s(&self) -> f64 {
-        (self.rays.0 + self.rays.1) as f64 / self.median_seconds() / 1e6
+        (self.rays.0 + self.rays.1) as f64 / self.frame.median / 1e6
     }
 }
 
@@ -86,79 +79,13 @@ pub struct TuningRow {
     /// Structure name.
     pub structure: &'static str,
     /// Its parameters.
-    pub parameters: String,
-    /// Median frame seconds at the tuning size.
-    pub frame_seconds: f64,
+    pub settings: AccelSettings,
+    /// Median frame seconds at the tuning size, with its interval.
+    pub frame: Estimate,
+    /// What a frame at the tuning size cost.
+    pub work: Work,
     /// Whether this candidate was kept.
     pub chosen: bool,
-}
-
-/// The candidates the tuning sweep tries for `structure` (one, untuned, for the others).
-fn candidates(spec: &AoSpec, structure: &'static str) -> Vec<AccelSettings> {
-    let base = best_settings(structure);
-    match structure {
-        "kdtree" => spec
-            .tuning
-            .kdtree_depths
-            .iter()
-            .flat_map(|&max_depth| {
-                spec.tuning.kdtree_leaves.iter().map(move |&leaf_size| AccelSettings {
-                    kdtree: KdSettings { max_depth, leaf_size },
-                    ..best_settings(structure)
-                })
-            })
-            .collect(),
-        "vlf" => spec
-            .tuning
-            .vlf_depths
-            .iter()
-            .map(|&depth| AccelSettings {
-                vlf: VlfSettings { depth, ..base.vlf },
-                ..best_settings(structure)
-            })
-            .collect(),
-        _ => vec![base],
-    }
-}
-
-/// The fastest of `structure`'s candidates on `mesh` at the tuning size, and every candidate's
-/// row (a single candidate is not timed).
-fn tune(
-    spec: &AoSpec,
-    mesh: &AoMesh,
-    structure: &'static str,
-    backend: &mut CpuBackend,
-) -> anyhow::Result<(AccelSettings, Vec<TuningRow>)> {
-    let all = candidates(spec, structure);
-    if all.len() == 1 {
-        return Ok((all[0].clone(), vec![]));
-    }
-    let mut rows = Vec::new();
-    let mut best: Option<(f64, AccelSettings)> = None;
-    for settings in all {
-        let scene = ao_scene(spec, mesh, settings.clone())?;
-        let view = View {
-            camera: &scene.cameras["ao"],
-            width: spec.tuning.width,
-            height: spec.tuning.height,
-        };
-        let t = crate::metrics::stats::median(&backend.time(&scene, view, SAMPLING, 1, spec.tuning.frames)?.seconds);
-        rows.push(TuningRow {
-            mesh: mesh.name.clone(),
-            structure,
-            parameters: scene.accel.as_ref().expect("a structure").stats().parameters,
-            frame_seconds: t,
-            chosen: false,
-        });
-        if best.as_ref().is_none_or(|b| t < b.0) {
-            best = Some((t, settings));
-        }
-    }
-    let (t, settings) = best.expect("at least one candidate");
-    if let Some(r) = rows.iter_mut().find(|r| r.frame_seconds == t) {
-        r.chosen = true;
-    }
-    Ok((settings, rows))
 }
 
 /// The AO frames' sampling (the grid needs none; fixed for the record).
@@ -185,28 +112,108 @@ pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, settings: AccelSettings) -> anyhow
     Ok(scene)
 }
 
+/// Times `scenes` at `width` x `height` in `schedule`'s interleaved rounds: per scene, its
+/// frames in round order.
+fn time_scenes(
+    scenes: &[Scene],
+    (width, height): (u32, u32),
+    schedule: &Schedule,
+    backend: &mut dyn Backend,
+    tick: &dyn Fn(),
+) -> anyhow::Result<Vec<Vec<f64>>> {
+    schedule.run(scenes.len(), |i| -> anyhow::Result<f64> {
+        let view = View {
+            camera: &scenes[i].cameras["ao"],
+            width,
+            height,
+        };
+        let t = backend.time(&scenes[i], view, SAMPLING, schedule.warmup, 1)?;
+        tick();
+        Ok(t.seconds[0])
+    })
+}
+
+/// The fastest of `structure`'s candidates on `mesh` at the tuning size (by median, all
+/// candidates timed in interleaved rounds), and every candidate's row; a single candidate is
+/// not timed.
+fn tune(
+    spec: &AoSpec,
+    mesh: &AoMesh,
+    (structure, candidates): (&'static str, &[AccelSettings]),
+    backend: &mut dyn Backend,
+) -> anyhow::Result<(AccelSettings, Vec<TuningRow>)> {
+    if candidates.len() == 1 {
+        return Ok((candidates[0].clone(), vec![]));
+    }
+    let scenes = candidates
+        .iter()
+        .map(|s| ao_scene(spec, mesh, s.clone()))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let size = (spec.tuning.width, spec.tuning.height);
+    let mut work = Vec::new();
+    for scene in &scenes {
+        let view = View {
+            camera: &scene.cameras["ao"],
+            width: size.0,
+            height: size.1,
+        };
+        work.push(backend.render(scene, view, SAMPLING)?.work);
+    }
+    let schedule = Schedule {
+        repeats: spec.tuning.repeats,
+        ..spec.header.schedule
+    };
+    let times = time_scenes(&scenes, size, &schedule, backend, &|| {})?;
+    let mut rows: Vec<TuningRow> = candidates
+        .iter()
+        .zip(&times)
+        .zip(work)
+        .map(|((settings, t), work)| TuningRow {
+            mesh: mesh.name.clone(),
+            structure,
+            settings: settings.clone(),
+            frame: median_interval(t, schedule.seed),
+            work,
+            chosen: false,
+        })
+        .collect();
+    let best = (0..rows.len())
+        .min_by(|&a, &b| rows[a].frame.median.total_cmp(&rows[b].frame.median))
+        .expect("at least one candidate");
+    rows[best].chosen = true;
+    Ok((candidates[best].clone(), rows))
+}
+
 /// Every mesh x structure of the experiment, in file order, each structure tuned per mesh
-/// first; `progress` hears each as it starts.
-pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(Vec<AoRow>, Vec<TuningRow>)> {
-    let mut backend = CpuBackend::default();
-    let sampling = SAMPLING;
+/// first.
+pub fn run_ao(
+    spec: &AoSpec,
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<(Vec<AoRow>, Vec<TuningRow>)> {
+    let schedule = spec.header.schedule;
+    let bar = progress.bar(
+        "meshes x structures",
+        (spec.meshes.len() * spec.structures.len()) as u64,
+    );
     let mut rows = Vec::new();
     let mut tuning = Vec::new();
     for mesh in &spec.meshes {
         let mut first: Option<Vec<f32>> = None;
         let mut scenes = Vec::new();
-        for &structure in &spec.structures {
-            progress(&mesh.name, structure);
-            let (settings, tried) = tune(spec, mesh, structure, &mut backend)?;
+        for (structure, candidates) in &spec.structures {
+            bar.message(format!("{}: {structure}", mesh.name));
+            let (settings, tried) = tune(spec, mesh, (structure, candidates), backend)?;
             tuning.extend(tried);
-            let scene = ao_scene(spec, mesh, settings)?;
+            let scene = ao_scene(spec, mesh, settings.clone())?;
             let stats = scene.accel.as_ref().expect("a mesh scene has a structure").stats();
             let view = View {
                 camera: &scene.cameras["ao"],
                 width: spec.width,
                 height: spec.height,
             };
-            let frame = backend.render(&scene, view, sampling)?;
+            let frame = backend.render(&scene, view, SAMPLING)?;
+            let work = frame.work;
             let image = frame.ambient.expect("the scene asks for ambient occlusion");
             let seen: Vec<f64> = image.iter().filter(|&&v| v >= 0.0).map(|&v| v as f64).collect();
             let same_image = first.as_ref().is_none_or(|f| *f == image);
@@ -215,34 +222,31 @@ pub fn run_ao(spec: &AoSpec, progress: &dyn Fn(&str, &str)) -> anyhow::Result<(V
                 mesh: mesh.name.clone(),
                 triangles: mesh.triangles.positions.len(),
                 structure,
-                parameters: stats.parameters.clone(),
+                settings,
                 build_seconds: stats.build_time.as_secs_f64(),
                 memory_bytes: stats.memory_bytes,
                 frame_seconds: Vec::new(),
+                frame: Estimate::NAN,
                 rays: (frame.rays.primary, frame.rays.ambient),
+                work,
                 receivers: seen.len(),
                 mean_ao: seen.iter().sum::<f64>() / seen.len().max(1) as f64,
                 same_image,
                 image,
             });
             scenes.push(scene);
+            bar.inc(1);
         }
-        // Timed in interleaved rounds, each visiting the structures in a fresh seeded order, so a
-        // change of machine load falls on all of them alike.
-        let base = rows.len() - scenes.len();
-        for round in 0..spec.repeats {
-            let mut order: Vec<usize> = (0..scenes.len()).collect();
-            order.sort_by_key(|&i| pcg(pcg(round) ^ i as u32));
-            for i in order {
-                let view = View {
-                    camera: &scenes[i].cameras["ao"],
-                    width: spec.width,
-                    height: spec.height,
-                };
-                let t = backend.time(&scenes[i], view, sampling, 0, 1)?;
-                rows[base + i].frame_seconds.extend(t.seconds);
+        if schedule.repeats > 0 {
+            bar.message(format!("{}: timing", mesh.name));
+            let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {})?;
+            let base = rows.len() - scenes.len();
+            for (row, t) in rows[base..].iter_mut().zip(times) {
+                row.frame = median_interval(&t, schedule.seed);
+                row.frame_seconds = t;
             }
         }
     }
+    bar.finish();
     Ok((rows, tuning))
 }

@@ -2,36 +2,52 @@
 //! into the unit ball and seen by a camera that frames the ball, AO along the visibility field's
 //! grid lines from every camera hit (the visibility-field paper's Table 1 set-up).
 
-use crate::accel::{kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
+use crate::accel::settings::{candidates, read_tables};
+use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Source};
-use crate::experiment::kind::Kind;
+use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
 use crate::mesh::{clean, Triangles};
 use crate::scene::ambient::{grid_level, AmbientOcclusion, AoDirections, Weighting};
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-#[derive(Debug, Deserialize)]
+crate::experiment_file! {
+    /// An ambient-occlusion experiment's file: the shared header and these keys.
+    struct File {
+        width: u32,
+        height: u32,
+        rays: u32,
+        #[serde(default)]
+        weighting: Weighting,
+        max_distance: f64,
+        structures: Vec<String>,
+        tuning: Tuning,
+        claim: Claim,
+        #[serde(default)]
+        accel: BTreeMap<String, toml::Table>,
+        meshes: Vec<MeshEntry>,
+    }
+}
+
+/// The paper's claim the verdict answers: `subject` renders faster than `baseline` (both among
+/// `structures`); every other structure is set against `subject` too.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
-struct File {
-    kind: Kind,
-    name: String,
-    width: u32,
-    height: u32,
-    rays: u32,
-    #[serde(default)]
-    weighting: Weighting,
-    max_distance: f64,
-    repeats: u32,
-    structures: Vec<String>,
-    tuning: Tuning,
-    meshes: Vec<MeshEntry>,
+pub struct Claim {
+    /// The structure the paper proposes.
+    pub subject: String,
+    /// The paper's baseline.
+    pub baseline: String,
 }
 
 /// The small tuning sweep run per mesh before the timed frames, as the paper tuned each method
-/// per scene (CRT: BSP depth and leaf size; VLF-RT: tile-BSP depth): every candidate renders
-/// `frames` frames at `width` x `height`, and the fastest median is kept.
+/// per scene (CRT: BSP depth and leaf size; VLF-RT: tile-BSP depth): a structure's candidates
+/// are the lists of its `[accel.NAME]` table, or its own grid where the file gives no table;
+/// each is timed at `width` x `height` in `repeats` interleaved rounds, and the fastest median
+/// is kept.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Tuning {
@@ -39,14 +55,8 @@ pub struct Tuning {
     pub width: u32,
     /// Tuning image size.
     pub height: u32,
-    /// Timed frames per candidate.
-    pub frames: u32,
-    /// kd-tree maximum depths tried.
-    pub kdtree_depths: Vec<u32>,
-    /// kd-tree leaf sizes tried.
-    pub kdtree_leaves: Vec<u32>,
-    /// Visibility-field tile-BSP depths tried.
-    pub vlf_depths: Vec<u32>,
+    /// Interleaved rounds per candidate.
+    pub repeats: u32,
 }
 
 #[derive(Debug, Deserialize)]
@@ -94,6 +104,8 @@ pub struct AoMesh {
 /// A validated ambient-occlusion experiment.
 #[derive(Clone, Debug)]
 pub struct AoSpec {
+    /// The shared keys (`[timing]`: the timed frames of every mesh and structure).
+    pub header: Header,
     /// Results folder name.
     pub name: String,
     /// The experiment file.
@@ -104,27 +116,14 @@ pub struct AoSpec {
     pub height: u32,
     /// The pass every frame runs.
     pub ao: AmbientOcclusion,
-    /// Timed frames per mesh and structure (after one untimed frame that also gives the image).
-    pub repeats: u32,
-    /// Registered structures to compare, each at its best settings ([`best_settings`], then
-    /// the tuning sweep's pick per mesh).
-    pub structures: Vec<&'static str>,
+    /// Registered structures to compare, each with its tuning candidates (one: not tuned).
+    pub structures: Vec<(&'static str, Vec<AccelSettings>)>,
     /// The per-mesh tuning sweep.
     pub tuning: Tuning,
+    /// The claim the verdict answers.
+    pub claim: Claim,
     /// The meshes.
     pub meshes: Vec<AoMesh>,
-}
-
-/// Each structure at its best settings before the per-mesh tuning: obvhs' slowest, best BVH
-/// build, the kd-tree's best on the cow and bull (`KdSettings::default`) and the paper's
-/// visibility field (513 lines, 128 x 128 tiles, depth 4).
-pub fn best_settings(structure: &'static str) -> AccelSettings {
-    AccelSettings {
-        name: structure,
-        bvh_preset: Preset::VerySlow,
-        vlf: VlfSettings::default(),
-        kdtree: KdSettings::default(),
-    }
 }
 
 /// `positions` centred on their bounding box and scaled into the unit ball.
@@ -151,25 +150,17 @@ pub fn into_unit_ball(positions: Vec<[DVec3; 3]>) -> Triangles {
 impl AoSpec {
     /// Reads and validates an ambient-occlusion experiment and its meshes.
     pub fn load(path: &Path) -> Result<AoSpec, ConfigError> {
-        AoSpec::from_source(&Source::read(path)?)
+        let source = Source::read(path)?;
+        AoSpec::from_source(&source, Header::read(&source)?)
     }
 
-    /// Validates an ambient-occlusion experiment read from `source` and loads its meshes.
-    pub fn from_source(source: &Source) -> Result<AoSpec, ConfigError> {
+    /// Validates an ambient-occlusion experiment read from `source` (shared keys `header`) and
+    /// loads its meshes.
+    pub fn from_source(source: &Source, header: Header) -> Result<AoSpec, ConfigError> {
         let path = source.path.as_path();
         let f: File = source.parse()?;
         let err = |p: &[crate::config::Seg], m: String| source.error(p, m);
-        if f.kind != Kind::Ao {
-            return Err(err(
-                &key_path!["kind"],
-                "an ambient-occlusion experiment has kind = \"ao\"".into(),
-            ));
-        }
-        for (k, v) in [("width", f.width), ("height", f.height)] {
-            if !(1..=16384).contains(&v) {
-                return Err(err(&key_path![k], format!("must be in 1..=16384, got {v}")));
-            }
-        }
+        source.image_size(&key_path!["width"], &key_path!["height"], f.width, f.height)?;
         let level = grid_level(f.rays).ok_or_else(|| {
             err(
                 &key_path!["rays"],
@@ -185,37 +176,69 @@ impl AoSpec {
                 format!("must be positive, got {}", f.max_distance),
             ));
         }
-        if f.repeats == 0 {
-            return Err(err(&key_path!["repeats"], "at least one timed frame".into()));
-        }
         let t = &f.tuning;
-        for (k, v) in [("width", t.width), ("height", t.height)] {
-            if !(1..=16384).contains(&v) {
-                return Err(err(&key_path!["tuning", k], format!("must be in 1..=16384, got {v}")));
+        source.image_size(
+            &key_path!["tuning", "width"],
+            &key_path!["tuning", "height"],
+            t.width,
+            t.height,
+        )?;
+        if !(1..=crate::experiment::header::MAX_REPEATS).contains(&t.repeats) {
+            return Err(err(
+                &key_path!["tuning", "repeats"],
+                format!("must be in 1..={}", crate::experiment::header::MAX_REPEATS),
+            ));
+        }
+        let mut given = read_tables(source, &key_path!["accel"], &f.accel, true)?;
+        let names = crate::experiment::structure_names(source, &f.structures)?;
+        if let Some(extra) = given.keys().find(|k| !names.contains(k)) {
+            return Err(err(
+                &key_path!["accel", *extra],
+                format!("`{extra}` is not among `structures`"),
+            ));
+        }
+        for (k, v) in [("subject", &f.claim.subject), ("baseline", &f.claim.baseline)] {
+            if !names.contains(&v.as_str()) {
+                return Err(err(&key_path!["claim", k], format!("`{v}` is not among `structures`")));
             }
         }
-        if t.frames == 0 {
-            return Err(err(&key_path!["tuning", "frames"], "at least one timed frame".into()));
+        if f.claim.subject == f.claim.baseline {
+            return Err(err(
+                &key_path!["claim", "baseline"],
+                "must differ from `subject`".into(),
+            ));
         }
-        for (k, values, lo, hi) in [
-            ("kdtree_depths", &t.kdtree_depths, 0, crate::accel::kdtree::MAX_DEPTH),
-            ("kdtree_leaves", &t.kdtree_leaves, 0, 1 << 16),
-            ("vlf_depths", &t.vlf_depths, 0, 6),
-        ] {
-            if values.is_empty() {
-                return Err(err(&key_path!["tuning", k], "list at least one value".into()));
-            }
-            if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !(lo..=hi).contains(*v)) {
-                return Err(err(
-                    &key_path!["tuning", k, i],
-                    format!("must lie in {lo}..={hi}, got {v}"),
-                ));
-            }
-        }
-        let structures = crate::experiment::structure_names(source, &f.structures)?;
+        let structures = names
+            .into_iter()
+            .map(|name| {
+                let r = crate::accel::registered(name).expect("a registered name");
+                let all = match given.remove(name) {
+                    Some(listed) => listed,
+                    None => candidates(r, &(r.tuning)()).expect("a structure's own grid is valid"),
+                };
+                (name, all)
+            })
+            .collect();
         let dir = path.parent().unwrap_or(Path::new("."));
         let mut meshes = Vec::new();
         for (i, m) in f.meshes.iter().enumerate() {
+            plain_name(&m.name).map_err(|e| err(&key_path!["meshes", i, "name"], e))?;
+            if f.meshes[..i].iter().any(|o| o.name == m.name) {
+                return Err(err(
+                    &key_path!["meshes", i, "name"],
+                    format!("`{}` is listed twice", m.name),
+                ));
+            }
+            if let Some(p) = &m.paper {
+                for (k, v) in [("crt_seconds", p.crt_seconds), ("vlf_seconds", p.vlf_seconds)] {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(err(
+                            &key_path!["meshes", i, "paper", k],
+                            format!("the paper's seconds must be positive, got {v}"),
+                        ));
+                    }
+                }
+            }
             let file = dir.join(&m.path);
             let at = key_path!["meshes", i, "path"];
             let raw = crate::mesh::load(&file)
@@ -239,7 +262,8 @@ impl AoSpec {
             return Err(err(&key_path!["meshes"], "list at least one mesh".into()));
         }
         Ok(AoSpec {
-            name: f.name,
+            name: header.name.clone(),
+            header,
             path: path.to_path_buf(),
             width: f.width,
             height: f.height,
@@ -249,9 +273,9 @@ impl AoSpec {
                 weighting: f.weighting,
                 max_distance: f.max_distance,
             },
-            repeats: f.repeats,
             structures,
             tuning: f.tuning,
+            claim: f.claim,
             meshes,
         })
     }

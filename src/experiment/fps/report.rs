@@ -1,7 +1,8 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
-//! numbers, report.md and the manifest.
+//! numbers, and report.md.
 
 use super::{FpsRow, FpsSpec};
+use crate::experiment::timing::RULE;
 use crate::files::write_atomic;
 use crate::output::plots::{line_plot, Axes, Reference, Series};
 use crate::output::table::{float, write_rows};
@@ -9,7 +10,7 @@ use crate::render::AdapterInfo;
 use serde::Serialize;
 use std::path::Path;
 
-/// Writes fps.csv, plots/fps.png, report.md and manifest.toml under `out`.
+/// Writes fps.csv, plots/fps.png and report.md under `out`.
 pub fn write_fps(
     spec: &FpsSpec,
     rows: &[FpsRow],
@@ -34,7 +35,7 @@ pub fn write_fps(
             .collect();
         let points = of
             .iter()
-            .map(|r| ((r.width * r.height) as f64 / 1e6, r.fps(), f64::NAN))
+            .map(|r| ((r.width * r.height) as f64 / 1e6, r.fps().median, f64::NAN))
             .collect();
         series.push((
             i,
@@ -64,7 +65,7 @@ pub fn write_fps(
     )?;
     let mut md = format!("# {}: the soft-shadow paper's Table 1, measured\n\n", spec.name);
     md += &format!(
-        "Experiment `{}` on **{}** ({}, {}, {}), {:.0} s. Each configuration renders {} shadow rays per pixel per light with the `{}` scheme ({} pattern) on 4 cm disk lights; {} untimed frames, then up to {} timed frames within {} s (at least 3); frame time is the median, from {}.\n\n",
+        "Experiment `{}` on **{}** ({}, {}, {}), {:.0} s. Each configuration renders {} shadow rays per pixel per light with the `{}` scheme ({} pattern) on 4 cm disk lights; every configuration is timed once per round in {} interleaved rounds ({} untimed frames before each timed one; clock: {}). {RULE}\n\n",
         spec.path.display(),
         adapter.name,
         adapter.backend,
@@ -74,40 +75,33 @@ pub fn write_fps(
         spec.samples,
         spec.sampling.scheme,
         spec.sampling.pattern,
-        spec.warmup,
-        spec.frames,
-        spec.max_seconds,
+        spec.header.schedule.repeats,
+        spec.header.schedule.warmup,
         rows.first().map_or("-", |r| r.clock.name())
     );
     md += "The paper (Vassilev 2012, Table 1) timed 100 frames with OptiX on a GTX 560M laptop GPU at an unstated resolution: sphere 15.95 / 9.39 fps, dressed body 8.36 / 6.13 fps with one / two lights.\n\n";
-    md += "| scene | lights | resolution | frames timed | median ms | fps (ours) | fps (paper) | shadow rays/s |\n|---|---|---|---|---|---|---|---|\n";
+    md += "| scene | lights | resolution | frame ms [95 %] | fps (ours) [95 %] | fps (paper) | rays per frame | nodes per frame | tests per frame | shadow rays/s |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
+        let count = |f: fn(&crate::accel::work::Work) -> u64| {
+            r.work.as_ref().map_or("n/a".into(), |w| format!("{:.3e}", f(w) as f64))
+        };
         md += &format!(
-            "| {} | {} | {}x{} | {} | {:.1} | {:.3} | {} | {:.3e} |\n",
+            "| {} | {} | {}x{} | {} | {} | {} | {:.3e} | {} | {} | {:.3e} |\n",
             r.scene,
             r.lights,
             r.width,
             r.height,
-            r.frames,
-            r.median_s * 1e3,
-            r.fps(),
+            r.frame.scaled(1e3).show(1),
+            r.fps().show(3),
             r.paper_fps,
+            (r.primary_rays + r.shadow_rays) as f64,
+            count(|w| w.nodes),
+            count(|w| w.primitives),
             r.shadow_rays_per_s()
         );
     }
-    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`.\n";
-    write_atomic(&out.join("report.md"), md.as_bytes())?;
-    let manifest = format!(
-        "# Provenance of the results in this folder.\ngit_commit = {:?}\nexperiment = {:?}\nseconds = {:.1}\n[adapter]\nbackend = {:?}\nname = {:?}\ndriver = {:?}\napi = {:?}\n",
-        crate::output::git_commit(),
-        spec.path.display().to_string(),
-        seconds,
-        adapter.backend,
-        adapter.name,
-        adapter.driver,
-        adapter.api
-    );
-    write_atomic(&out.join("manifest.toml"), manifest.as_bytes())
+    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`; nodes and tests are counted on the CPU backend only (n/a on the GPU).\n";
+    write_atomic(&out.join("report.md"), md.as_bytes())
 }
 
 /// A row of fps.csv: one timed configuration, with the device.
@@ -118,19 +112,22 @@ struct CsvRow<'a> {
     width: u32,
     height: u32,
     samples: u32,
-    frames: usize,
+    timed_frames: usize,
     #[serde(with = "float")]
-    median_ms: f64,
+    frame_s: f64,
     #[serde(with = "float")]
-    min_ms: f64,
+    frame_s_lo: f64,
     #[serde(with = "float")]
-    max_ms: f64,
+    frame_s_hi: f64,
     #[serde(with = "float")]
     fps: f64,
     #[serde(with = "float")]
     paper_fps: f64,
     primary_rays: u64,
     shadow_rays: u64,
+    queries: Option<u64>,
+    nodes_visited: Option<u64>,
+    primitive_tests: Option<u64>,
     #[serde(with = "float")]
     shadow_rays_per_s: f64,
     clock: &'a str,
@@ -147,14 +144,17 @@ impl<'a> CsvRow<'a> {
             width: r.width,
             height: r.height,
             samples: spec.samples,
-            frames: r.frames,
-            median_ms: r.median_s * 1e3,
-            min_ms: r.min_s * 1e3,
-            max_ms: r.max_s * 1e3,
-            fps: r.fps(),
+            timed_frames: r.frame_seconds.len(),
+            frame_s: r.frame.median,
+            frame_s_lo: r.frame.lo,
+            frame_s_hi: r.frame.hi,
+            fps: r.fps().median,
             paper_fps: r.paper_fps,
             primary_rays: r.primary_rays,
             shadow_rays: r.shadow_rays,
+            queries: r.work.map(|w| w.queries),
+            nodes_visited: r.work.map(|w| w.nodes),
+            primitive_tests: r.work.map(|w| w.primitives),
             shadow_rays_per_s: r.shadow_rays_per_s(),
             clock: r.clock.name(),
             adapter: &a.name,

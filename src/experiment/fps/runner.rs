@@ -1,10 +1,13 @@
-//! Timing a frame-rate experiment: each configuration's frames over the same GPU resources.
+//! Timing a frame-rate experiment: every configuration rendered once (its rays and work counted),
+//! then timed one frame per interleaved round, the one way every kind times.
 
 use super::spec::{timed_scene, FpsSpec};
-use crate::metrics::stats::median;
+use crate::accel::work::Work;
+use crate::experiment::progress::Progress;
+use crate::experiment::timing::{median_interval, Estimate};
 use crate::render::{Backend, Clock, RenderPlan, View};
+use crate::scene::Scene;
 use anyhow::Context;
-use std::time::Instant;
 
 /// One timed configuration: a row of fps.csv.
 #[derive(Clone, Debug)]
@@ -17,18 +20,16 @@ pub struct FpsRow {
     pub width: u32,
     /// Image size.
     pub height: u32,
-    /// Frames timed.
-    pub frames: usize,
-    /// Median seconds per frame.
-    pub median_s: f64,
-    /// Fastest and slowest frame.
-    pub min_s: f64,
-    /// Slowest frame.
-    pub max_s: f64,
+    /// Seconds of each timed frame, one per round.
+    pub frame_seconds: Vec<f64>,
+    /// Median frame seconds with its 95 % interval.
+    pub frame: Estimate,
     /// Shadow rays per frame.
     pub shadow_rays: u64,
     /// Camera rays per frame.
     pub primary_rays: u64,
+    /// What a frame's queries cost, where the backend counts it.
+    pub work: Option<Work>,
     /// The clock.
     pub clock: Clock,
     /// The paper's frames per second for this scene and light count (its resolution unknown).
@@ -36,26 +37,28 @@ pub struct FpsRow {
 }
 
 impl FpsRow {
-    /// Frames per second from the median frame time.
-    pub fn fps(&self) -> f64 {
-        1.0 / self.median_s
+    /// Frames per second with its interval, from the frame time's.
+    pub fn fps(&self) -> Estimate {
+        self.frame.recip()
     }
 
-    /// Shadow rays per second.
+    /// Shadow rays per second at the median frame time.
     pub fn shadow_rays_per_s(&self) -> f64 {
-        self.shadow_rays as f64 / self.median_s
+        self.shadow_rays as f64 / self.frame.median
     }
 }
 
-/// Timed frames for a configuration whose frames take `per_frame` seconds: as many as fit in
-/// `max_seconds`, at least 3, at most `frames`.
-fn frames_within(spec: &FpsSpec, per_frame: f64) -> u32 {
-    let fit = (spec.max_seconds / per_frame.max(1e-9)).floor().min(u32::MAX as f64) as u32;
-    fit.clamp(3.min(spec.frames), spec.frames)
+/// One configuration: its scene and view size.
+struct Unit {
+    scene: Scene,
+    camera: String,
+    width: u32,
+    height: u32,
 }
 
-/// Times every configuration; one row each.
-pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend) -> anyhow::Result<Vec<FpsRow>> {
+/// Renders every configuration once, then times them all in the schedule's interleaved rounds.
+pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<Vec<FpsRow>> {
+    let mut units = Vec::new();
     let mut rows = Vec::new();
     for s in &spec.scenes {
         for (&lights, &paper_fps) in s.lights.iter().zip(&s.paper_fps) {
@@ -66,35 +69,51 @@ pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend) -> anyhow::Result<Vec<
                     width,
                     height,
                 };
-                tracing::info!("timing {} with {lights} light(s) at {width}x{height}", s.name);
                 let frame = backend
                     .render(&scene, view, spec.sampling)
                     .with_context(|| format!("rendering {}", s.name))?;
-                // One call times every frame over the same resources; a first frame sizes the
-                // run to the time budget.
-                let start = Instant::now();
-                let first = backend.time(&scene, view, spec.sampling, spec.warmup, 1)?;
-                let per_frame = start.elapsed().as_secs_f64() / (spec.warmup + 1) as f64;
-                let more = frames_within(spec, per_frame).saturating_sub(1);
-                let rest = backend.time(&scene, view, spec.sampling, 1, more)?;
-                let clock = rest.clock;
-                let seconds: Vec<f64> = first.seconds.into_iter().chain(rest.seconds).collect();
                 rows.push(FpsRow {
                     scene: s.name.clone(),
                     lights,
                     width,
                     height,
-                    frames: seconds.len(),
-                    median_s: median(&seconds),
-                    min_s: seconds.iter().copied().fold(f64::INFINITY, f64::min),
-                    max_s: seconds.iter().copied().fold(0.0, f64::max),
+                    frame_seconds: Vec::new(),
+                    frame: Estimate::NAN,
                     shadow_rays: frame.rays.shadow_total(),
                     primary_rays: frame.rays.primary,
-                    clock,
+                    work: frame.work(),
+                    clock: Clock::WallClock,
                     paper_fps,
+                });
+                units.push(Unit {
+                    scene: scene.clone(),
+                    camera: s.camera.clone(),
+                    width,
+                    height,
                 });
             }
         }
+    }
+    let schedule = spec.header.schedule;
+    let bar = progress.bar("timed frames", units.len() as u64 * schedule.repeats as u64);
+    let mut clocks = vec![Clock::WallClock; units.len()];
+    let times = schedule.run(units.len(), |i| -> anyhow::Result<f64> {
+        let u = &units[i];
+        let view = View {
+            camera: &u.scene.cameras[&u.camera],
+            width: u.width,
+            height: u.height,
+        };
+        let t = backend.time(&u.scene, view, spec.sampling, schedule.warmup, 1)?;
+        clocks[i] = t.clock;
+        bar.inc(1);
+        Ok(t.seconds[0])
+    })?;
+    bar.finish();
+    for ((row, seconds), clock) in rows.iter_mut().zip(times).zip(clocks) {
+        row.frame = median_interval(&seconds, schedule.seed);
+        row.frame_seconds = seconds;
+        row.clock = clock;
     }
     Ok(rows)
 }

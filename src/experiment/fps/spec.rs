@@ -1,7 +1,7 @@
 //! The frame-rate experiment file: scenes x light counts x resolutions, timed at one sampling.
 
 use crate::config::{ConfigError, Source};
-use crate::experiment::kind::Kind;
+use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
 use crate::render::Sampling;
 use crate::sampling::{DiskScheme, Pattern};
@@ -9,20 +9,16 @@ use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct File {
-    kind: Kind,
-    name: String,
-    frames: u32,
-    warmup: u32,
-    max_seconds: f64,
-    samples: u32,
-    light_radius: f64,
-    scheme: DiskScheme,
-    pattern: Pattern,
-    resolutions: Vec<[u32; 2]>,
-    scenes: Vec<SceneEntry>,
+crate::experiment_file! {
+    /// A frame-rate experiment's file: the shared header and these keys.
+    struct File {
+        samples: u32,
+        light_radius: f64,
+        scheme: DiskScheme,
+        pattern: Pattern,
+        resolutions: Vec<[u32; 2]>,
+        scenes: Vec<SceneEntry>,
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -53,16 +49,15 @@ pub struct FpsScene {
 /// A validated frame-rate experiment.
 #[derive(Clone, Debug)]
 pub struct FpsSpec {
+    /// The shared keys; `[timing] repeats` are the interleaved rounds, one timed frame of every
+    /// configuration each (the paper timed 100 frames of one).
+    pub header: Header,
     /// Results folder name.
     pub name: String,
     /// The experiment file.
     pub path: PathBuf,
-    /// Frames timed per configuration (the paper: 100), unless `max_seconds` runs out first.
-    pub frames: u32,
-    /// Untimed frames first.
-    pub warmup: u32,
-    /// Time budget per configuration; at least 3 frames are timed whatever it says.
-    pub max_seconds: f64,
+    /// Every scene file read.
+    pub scene_paths: Vec<PathBuf>,
     /// Shadow rays per pixel per light (the paper: 16).
     pub samples: u32,
     /// Disk light radius (the paper: 0.02 m).
@@ -78,40 +73,65 @@ pub struct FpsSpec {
 impl FpsSpec {
     /// Reads and validates a frame-rate experiment and its scenes.
     pub fn load(path: &Path) -> Result<FpsSpec, ConfigError> {
-        FpsSpec::from_source(&Source::read(path)?)
+        let source = Source::read(path)?;
+        FpsSpec::from_source(&source, Header::read(&source)?)
     }
 
-    /// Validates a frame-rate experiment read from its file (`source`) and loads its scenes.
-    pub fn from_source(source: &Source) -> Result<FpsSpec, ConfigError> {
+    /// Validates a frame-rate experiment read from its file (`source`, shared keys `header`)
+    /// and loads its scenes.
+    pub fn from_source(source: &Source, header: Header) -> Result<FpsSpec, ConfigError> {
         let path = source.path.as_path();
         let f: File = source.parse()?;
-        if f.kind != Kind::Fps {
-            return Err(source.error(&key_path!["kind"], "a frame-rate experiment has kind = \"fps\""));
-        }
-        for (k, v) in [("frames", f.frames), ("samples", f.samples)] {
-            if !(1..=MAX_SAMPLES).contains(&v) {
-                return Err(source.error(&key_path![k], format!("must be in 1..={MAX_SAMPLES}, got {v}")));
-            }
-        }
-        if !(f.max_seconds.is_finite() && f.max_seconds > 0.0) {
-            return Err(source.error(&key_path!["max_seconds"], "must be positive"));
+        if !(1..=MAX_SAMPLES).contains(&f.samples) {
+            return Err(source.error(
+                &key_path!["samples"],
+                format!("must be in 1..={MAX_SAMPLES}, got {}", f.samples),
+            ));
         }
         if !(f.light_radius.is_finite() && f.light_radius > 0.0) {
             return Err(source.error(&key_path!["light_radius"], "must be positive"));
         }
+        if f.resolutions.is_empty() {
+            return Err(source.error(&key_path!["resolutions"], "list at least one [width, height]"));
+        }
         for (i, r) in f.resolutions.iter().enumerate() {
-            if r.iter().any(|&x| !(1..=16384).contains(&x)) {
-                return Err(source.error(&key_path!["resolutions", i], "width and height must be in 1..=16384"));
+            source.image_size(
+                &key_path!["resolutions", i, 0usize],
+                &key_path!["resolutions", i, 1usize],
+                r[0],
+                r[1],
+            )?;
+            if f.resolutions[..i].contains(r) {
+                return Err(source.error(&key_path!["resolutions", i], "is listed twice"));
             }
         }
+        if f.scenes.is_empty() {
+            return Err(source.error(&key_path!["scenes"], "list at least one [[scenes]] table"));
+        }
         let mut scenes = Vec::new();
+        let mut scene_paths = Vec::new();
         for (i, e) in f.scenes.iter().enumerate() {
-            let scene = Scene::load(&path.parent().unwrap_or(Path::new(".")).join(&e.scene))?;
+            plain_name(&e.name).map_err(|m| source.error(&key_path!["scenes", i, "name"], m))?;
+            if f.scenes[..i].iter().any(|o| o.name == e.name) {
+                return Err(source.error(&key_path!["scenes", i, "name"], format!("`{}` is listed twice", e.name)));
+            }
+            let scene_path = path.parent().unwrap_or(Path::new(".")).join(&e.scene);
+            let scene_source = Source::read(&scene_path).map_err(|err| {
+                source.error(
+                    &key_path!["scenes", i, "scene"],
+                    format!("{}: {}", scene_path.display(), err.message),
+                )
+            })?;
+            let scene = Scene::from_source(&scene_source)?;
+            scene_paths.push(scene_path);
             if !scene.cameras.contains_key(&e.camera) {
                 return Err(source.error(
                     &key_path!["scenes", i, "camera"],
                     format!("no camera `{}` in {}", e.camera, e.scene.display()),
                 ));
+            }
+            if e.lights.is_empty() {
+                return Err(source.error(&key_path!["scenes", i, "lights"], "list at least one light count"));
             }
             if e.lights.iter().any(|&k| k == 0 || k as usize > scene.lights.len()) {
                 return Err(source.error(
@@ -125,6 +145,12 @@ impl FpsSpec {
                     "needs one value per entry of `lights`",
                 ));
             }
+            if let Some(k) = e.paper_fps.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(source.error(
+                    &key_path!["scenes", i, "paper_fps", k],
+                    format!("the paper's frames per second must be positive, got {}", e.paper_fps[k]),
+                ));
+            }
             scenes.push(FpsScene {
                 name: e.name.clone(),
                 scene,
@@ -134,11 +160,10 @@ impl FpsSpec {
             });
         }
         Ok(FpsSpec {
-            name: f.name,
+            name: header.name.clone(),
+            header,
             path: path.to_path_buf(),
-            frames: f.frames,
-            warmup: f.warmup,
-            max_seconds: f.max_seconds,
+            scene_paths,
             samples: f.samples,
             light_radius: f.light_radius,
             sampling: Sampling {

@@ -6,8 +6,9 @@
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{FramesSpec, Generator};
 use super::verdict::{label, labels, median_at, verdict};
+use crate::experiment::timing::{series_median, RULE};
 use crate::files::write_atomic;
-use crate::metrics::stats::{median, quartiles};
+use crate::metrics::stats::median;
 use crate::output::images::tonemap;
 use crate::output::plots::{image_grid, line_plot, Axes, Series};
 use crate::output::table::{float, write_rows};
@@ -25,9 +26,13 @@ struct FrameCsv<'a> {
     frame: u32,
     #[serde(with = "float")]
     frame_s: f64,
+    timed_renders: usize,
     #[serde(with = "float")]
     update_s: f64,
     rays: u64,
+    queries: u64,
+    nodes_visited: u64,
+    primitive_tests: u64,
     differing_pixels: usize,
 }
 
@@ -35,10 +40,10 @@ struct FrameCsv<'a> {
 struct BuildCsv<'a> {
     triangles: usize,
     structure: &'a str,
-    parameters: &'a str,
+    parameters: String,
     #[serde(with = "float")]
     build_s: f64,
-    memory_mb: String,
+    memory_bytes: u64,
 }
 
 /// Writes frames.csv, builds.csv, plots/, images/ and report.md under `out`.
@@ -60,8 +65,12 @@ pub fn write_frames(
             viewpoint: &r.viewpoint,
             frame: r.frame,
             frame_s: r.seconds,
+            timed_renders: r.renders,
             update_s: r.update_seconds.unwrap_or(f64::NAN),
             rays: r.rays,
+            queries: r.work.queries,
+            nodes_visited: r.work.nodes,
+            primitive_tests: r.work.primitives,
             differing_pixels: r.differing_pixels,
         }),
     )?;
@@ -70,9 +79,9 @@ pub fn write_frames(
         outcome.builds.iter().map(|b: &BuildRow| BuildCsv {
             triangles: b.triangles,
             structure: b.structure,
-            parameters: &b.parameters,
+            parameters: b.settings.describe(),
             build_s: b.build_seconds,
-            memory_mb: format!("{:.3}", b.memory_bytes as f64 / 1e6),
+            memory_bytes: b.memory_bytes,
         }),
     )?;
     let all = labels(rows);
@@ -220,15 +229,14 @@ pub fn write_frames(
     write_atomic(
         &out.join("report.md"),
         report(spec, outcome, threads, seconds).as_bytes(),
-    )?;
-    crate::output::write_cpu_manifest(out, &spec.path, seconds, threads)
+    )
 }
 
 fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f64) -> String {
     let rows = &outcome.frames;
     let mut md = format!("# {}: frame times per acceleration structure\n\n", spec.name);
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}; every frame is rendered by every structure in a fresh seeded order, {} timed render(s) each (median kept), and compared pixel for pixel with the first structure's.{}\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (each a fresh seeded order of the structures; order seed {}), the median kept, and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
         spec.path.display(),
         seconds,
         outcome.scenes.join("; "),
@@ -237,11 +245,14 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
         spec.width,
         spec.height,
         spec.shadings.iter().map(|s| s.0.name()).collect::<Vec<_>>().join(", "),
-        spec.repeats,
+        spec.header.schedule.repeats,
+        spec.header.schedule.seed,
+        spec.header.schedule.warmup,
         spec.motion.as_ref().map_or(String::new(), |m| format!(
-            " Before each frame the part `{}` moves by {:?} m and each structure is brought up to date (the field by its own update, the BVH by a refit and by rebuilds with its own preset and with obvhs' fastest, the kd-tree by a rebuild), the update timed.",
+            " Before each frame the part `{}` moves by {:?} m and each structure is brought up to date in every way it offers ({}); an update changes the structure, so each is timed once per frame and its interval comes from the frames.",
             m.part,
-            m.step.to_array()
+            m.step.to_array(),
+            labels(rows).join(", ")
         ))
     );
     md += &match spec.generator {
@@ -250,7 +261,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
     };
     md += "## Verdict\n\n";
     md += &verdict(spec, outcome);
-    md += "\n## Medians\n\n| triangles | shading | structure | frame s (q1-q3) | update s | rays per frame | frames |\n|---|---|---|---|---|---|---|\n";
+    md += "\n## Medians\n\nFrame seconds: the median over the path's frames with its 95 % moving-block interval; rays, nodes visited and primitive tests: per-frame medians (deterministic).\n\n| triangles | shading | structure | frame s | update s | rays per frame | nodes per frame | tests per frame | frames |\n|---|---|---|---|---|---|---|---|---|\n";
     let mut sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
     sizes.dedup();
     for &t in &sizes {
@@ -264,17 +275,21 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
                     continue;
                 }
                 let secs: Vec<f64> = sel.iter().map(|r| r.seconds).collect();
-                let (q1, m, q3) = quartiles(&secs);
+                let (frame, _) = series_median(&secs, spec.header.schedule.seed);
                 let upd: Vec<f64> = sel.iter().filter_map(|r| r.update_seconds).collect();
+                let of = |f: fn(&FrameRow) -> u64| median(&sel.iter().map(|r| f(r) as f64).collect::<Vec<_>>());
                 md += &format!(
-                    "| {t} | {} | {l} | {m:.4} ({q1:.4}-{q3:.4}) | {} | {:.0} | {} |\n",
+                    "| {t} | {} | {l} | {} | {} | {:.0} | {:.3e} | {:.3e} | {} |\n",
                     shading.name(),
+                    frame.show(4),
                     if upd.is_empty() {
                         "-".into()
                     } else {
-                        format!("{:.4}", median(&upd))
+                        series_median(&upd, spec.header.schedule.seed).0.show(4)
                     },
-                    median(&sel.iter().map(|r| r.rays as f64).collect::<Vec<_>>()),
+                    of(|r| r.rays),
+                    of(|r| r.work.nodes),
+                    of(|r| r.work.primitives),
                     sel.len()
                 );
             }
@@ -286,7 +301,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
             "| {} | {} | {} | {:.3} | {:.1} |\n",
             b.triangles,
             b.structure,
-            b.parameters,
+            b.settings.describe(),
             b.build_seconds,
             b.memory_bytes as f64 / 1e6
         );

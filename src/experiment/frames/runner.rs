@@ -1,22 +1,22 @@
 //! Runs a frame-time experiment on the f64 CPU backend, where every structure answers exactly
 //! and frames can be compared pixel for pixel: per scene, each structure is built once (its
 //! build time and memory recorded); then, for each shading and viewpoint, every frame of the
-//! path is rendered by every structure in a fresh seeded order (so a change of machine load
-//! falls on all alike), each render timed, and each structure's frame compared with the first
-//! structure's. With a `[motion]`, one part moves by a step before each frame and each
-//! structure is first updated its own way: the field in place (paper Section 8), the BVH by a
-//! refit and by rebuilds (its own preset and obvhs' fastest), the kd-tree by a rebuild; the
-//! update is timed too. Before each shading and viewpoint every structure renders the first
-//! frame once, untimed (warm caches).
+//! path is rendered by every structure in the schedule's interleaved rounds (each round a fresh
+//! seeded order of the structures, so a change of machine load falls on all alike; the median
+//! of the rounds is kept, with the frame's rays and work), and each structure's frame is compared
+//! with the first structure's. With a `[motion]`, one part moves by a step before each frame and
+//! each structure is first brought up to date in every way it offers
+//! ([`crate::accel::Accelerator::updates`]); an update changes the structure, so it is timed
+//! once per frame. Before each shading and viewpoint every structure renders the path's first
+//! frame `warmup` times, untimed (warm caches).
 
 use super::spec::{FramesSpec, ShadingName};
-use crate::accel::bvh::Bvh;
-use crate::accel::vlf::VisibilityField;
-use crate::accel::{self, AccelSettings, Accelerator, Preset};
+use crate::accel::work::Work;
+use crate::accel::AccelSettings;
+use crate::experiment::progress::Progress;
 use crate::mesh::Triangles;
-use crate::render::cpu::CpuBackend;
+use crate::metrics::stats::median;
 use crate::render::{Backend, Frame, Sampling, View};
-use crate::sampling::rng::pcg;
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::procedural::Generated;
 use crate::scene::Scene;
@@ -47,12 +47,16 @@ pub struct FrameRow {
     pub viewpoint: String,
     /// Frame index on the path.
     pub frame: u32,
-    /// Median render seconds over the repeats.
+    /// Median render seconds over the rounds.
     pub seconds: f64,
+    /// Timed renders behind the median.
+    pub renders: usize,
     /// Seconds the update before this frame took (dynamic scenes).
     pub update_seconds: Option<f64>,
     /// Rays the frame traced.
     pub rays: u64,
+    /// What the frame's queries cost.
+    pub work: Work,
     /// Pixels whose object or radiance differs from the first structure's frame.
     pub differing_pixels: usize,
 }
@@ -65,7 +69,7 @@ pub struct BuildRow {
     /// Structure name.
     pub structure: &'static str,
     /// Its parameters.
-    pub parameters: String,
+    pub settings: AccelSettings,
     /// Build seconds.
     pub build_seconds: f64,
     /// Bytes beyond the triangles.
@@ -96,46 +100,23 @@ pub struct FramesOutcome {
     pub scenes: Vec<String>,
 }
 
-/// How one structure follows the moving part.
-enum Follow {
-    /// Never (static scenes).
-    Static,
-    /// The field's own update: remove, move, insert.
-    Field(Arc<VisibilityField>),
-    /// obvhs' refit of the BVH as built.
-    Refit(Arc<Bvh>),
-    /// A rebuild from scratch with the structure's settings.
-    Rebuild(AccelSettings),
-}
-
-/// One structure's scene and how it follows motion.
+/// One structure's scene, and how it follows motion.
 struct Variant {
     structure: &'static str,
+    /// An update method of the structure, or `none` for static scenes.
     update: &'static str,
-    follow: Follow,
     scene: Scene,
 }
 
 impl Variant {
     /// Moves part `object` by `step` in this variant's scene (the scene's triangles become
-    /// `moved`) and brings the structure up to date; returns the update's time.
+    /// `moved`) and brings its structure up to date its own way; returns the update's time.
     fn update(&mut self, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<Duration> {
-        self.scene.accel = None;
+        let mut accel = self.scene.accel.take().expect("generated scenes have triangles");
         let start = Instant::now();
-        let accel: Arc<dyn Accelerator> = match &mut self.follow {
-            Follow::Static => unreachable!("static variants are not updated"),
-            Follow::Field(f) => {
-                Arc::get_mut(f)
-                    .expect("the scene's handle was dropped")
-                    .move_object(object, |p| p + step)?;
-                f.clone()
-            }
-            Follow::Refit(b) => {
-                Arc::get_mut(b).expect("the scene's handle was dropped").refit(moved);
-                b.clone()
-            }
-            Follow::Rebuild(settings) => accel::build(moved, settings)?.expect("the scene has triangles"),
-        };
+        Arc::get_mut(&mut accel)
+            .expect("a variant's structure is its own")
+            .update(self.update, moved, object, step)?;
         let took = start.elapsed();
         self.scene.accel = Some(accel);
         self.scene.triangles.positions.clone_from(&moved.positions);
@@ -143,17 +124,19 @@ impl Variant {
     }
 }
 
-/// The variants of `generated`: one per structure, or with motion, the ways each follows it.
+/// The variants of `generated`: one per structure, or with motion, one per way each structure
+/// follows it (each with a structure of its own); and each structure's build.
 fn variants(spec: &FramesSpec, generated: &Generated) -> anyhow::Result<(Vec<Variant>, Vec<BuildRow>)> {
     let mut out = Vec::new();
     let mut builds = Vec::new();
     for settings in &spec.structures {
         let scene = generated.scene(BTreeMap::new(), settings.clone())?;
-        let stats = scene.accel.as_ref().expect("generated scenes have triangles").stats();
+        let accel = scene.accel.as_ref().expect("generated scenes have triangles");
+        let stats = accel.stats();
         builds.push(BuildRow {
             triangles: generated.triangle_count(),
             structure: settings.name,
-            parameters: stats.parameters,
+            settings: settings.clone(),
             build_seconds: stats.build_time.as_secs_f64(),
             memory_bytes: stats.memory_bytes,
         });
@@ -161,45 +144,20 @@ fn variants(spec: &FramesSpec, generated: &Generated) -> anyhow::Result<(Vec<Var
             out.push(Variant {
                 structure: settings.name,
                 update: "none",
-                follow: Follow::Static,
                 scene,
             });
             continue;
         }
-        let triangles = generated.triangles();
-        let mut follow = vec![("rebuild", Follow::Rebuild(settings.clone()))];
-        match settings.name {
-            "vlf" => {
-                follow = vec![(
-                    "update",
-                    Follow::Field(Arc::new(VisibilityField::build(&triangles, settings.vlf)?)),
-                )]
-            }
-            "bvh" => {
-                // obvhs' fastest build too: the rebuild an engine would choose per frame.
-                let fastest = AccelSettings {
-                    bvh_preset: Preset::Fastest,
-                    ..settings.clone()
-                };
-                follow.push(("rebuild-fastest", Follow::Rebuild(fastest)));
-                follow.push((
-                    "refit",
-                    Follow::Refit(Arc::new(Bvh::build(&triangles, settings.bvh_preset))),
-                ));
-            }
-            _ => {}
-        }
-        for (update, follow) in follow {
-            let mut scene = scene.clone();
-            scene.accel = match &follow {
-                Follow::Field(f) => Some(f.clone() as Arc<dyn Accelerator>),
-                Follow::Refit(b) => Some(b.clone() as Arc<dyn Accelerator>),
-                _ => scene.accel,
+        let methods = accel.updates();
+        for (k, &update) in methods.iter().enumerate() {
+            let scene = if k + 1 == methods.len() {
+                scene.clone()
+            } else {
+                generated.scene(BTreeMap::new(), settings.clone())?
             };
             out.push(Variant {
                 structure: settings.name,
                 update,
-                follow,
                 scene,
             });
         }
@@ -220,14 +178,18 @@ pub fn strip_frames(count: u32, frames: u32) -> Vec<u32> {
     (0..count).map(|k| k * frames / count.max(1)).collect()
 }
 
-/// Runs the experiment; `progress` hears each scene and shading as it starts.
-pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<FramesOutcome> {
-    let mut backend = CpuBackend::default();
+/// Runs the experiment.
+pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<FramesOutcome> {
+    let schedule = spec.header.schedule;
     let mut outcome = FramesOutcome::default();
     let scenes = spec.scenes();
     let strip = strip_frames(spec.strip, spec.frames);
+    let bar = progress.bar(
+        "frames",
+        (scenes.len() * spec.shadings.len() * spec.viewpoints.len()) as u64 * spec.frames as u64,
+    );
     for (s, generated) in scenes.iter().enumerate() {
-        progress(&format!(
+        bar.message(format!(
             "{}: building {} structures",
             generated.description,
             spec.structures.len()
@@ -244,17 +206,11 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
             (index as u32, m.step)
         });
         for &(name, shading) in &spec.shadings {
-            progress(&format!(
-                "{}: {} frames, {} shading",
-                generated.description,
-                spec.frames,
-                name.name()
-            ));
+            bar.message(format!("{}, {} shading", generated.description, name.name()));
             for v in &mut variants {
                 v.scene.shading = shading;
             }
             for (vp, viewpoint) in spec.viewpoints.iter().enumerate() {
-                // One untimed render per structure first, so no timed frame pays for cold caches.
                 let first_camera = spec.camera(viewpoint, 0);
                 let first_view = View {
                     camera: &first_camera,
@@ -262,7 +218,9 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                     height: spec.height,
                 };
                 for v in &variants {
-                    backend.render(&v.scene, first_view, SAMPLING)?;
+                    for _ in 0..schedule.warmup {
+                        backend.render(&v.scene, first_view, SAMPLING)?;
+                    }
                 }
                 for frame in 0..spec.frames {
                     let camera = spec.camera(viewpoint, frame);
@@ -271,42 +229,34 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                         width: spec.width,
                         height: spec.height,
                     };
+                    let mut updates = vec![None; variants.len()];
                     if let Some((object, step)) = moving {
                         for (t, &o) in current.positions.iter_mut().zip(&current.object_of) {
                             if o == object {
                                 *t = t.map(|p| p + step);
                             }
                         }
-                    }
-                    let mut order: Vec<usize> = (0..variants.len()).collect();
-                    order.sort_by_key(|&i| pcg(pcg(frame ^ ((vp as u32) << 20)) ^ i as u32));
-                    let mut rendered: Vec<Option<(Frame, f64, Option<f64>)>> = vec![None; variants.len()];
-                    for i in order {
-                        let v = &mut variants[i];
-                        let update = match moving {
-                            Some((object, step)) => Some(v.update(&current, object, step)?.as_secs_f64()),
-                            None => None,
-                        };
-                        let mut times = Vec::new();
-                        let mut kept = None;
-                        for _ in 0..spec.repeats {
-                            let start = Instant::now();
-                            let f = backend.render(&v.scene, view, SAMPLING)?;
-                            times.push(start.elapsed().as_secs_f64());
-                            kept.get_or_insert(f);
+                        for (v, u) in variants.iter_mut().zip(&mut updates) {
+                            *u = Some(v.update(&current, object, step)?.as_secs_f64());
                         }
-                        rendered[i] = Some((
-                            kept.expect("one repeat at least"),
-                            crate::metrics::stats::median(&times),
-                            update,
-                        ));
                     }
-                    let rendered: Vec<(Frame, f64, Option<f64>)> = rendered
+                    // Every round renders each variant once, in the round's own order; the
+                    // first render of each gives the frame compared and counted.
+                    let mut frames: Vec<Option<Frame>> = vec![None; variants.len()];
+                    let rounds = frame_rounds(&schedule, (s, vp, frame));
+                    let times = rounds.run(variants.len(), |i| -> anyhow::Result<f64> {
+                        let start = Instant::now();
+                        let f = backend.render(&variants[i].scene, view, SAMPLING)?;
+                        let took = start.elapsed().as_secs_f64();
+                        frames[i].get_or_insert(f);
+                        Ok(took)
+                    })?;
+                    let frames: Vec<Frame> = frames
                         .into_iter()
-                        .map(|r| r.expect("every variant rendered"))
+                        .map(|f| f.expect("a frame experiment times every frame at least once"))
                         .collect();
-                    let first = &rendered[0].0;
-                    for (v, (f, seconds, update_seconds)) in variants.iter().zip(&rendered) {
+                    let first = &frames[0];
+                    for (i, v) in variants.iter().enumerate() {
                         outcome.frames.push(FrameRow {
                             triangles,
                             structure: v.structure,
@@ -314,10 +264,12 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                             shading: name,
                             viewpoint: viewpoint.clone(),
                             frame,
-                            seconds: *seconds,
-                            update_seconds: *update_seconds,
-                            rays: f.rays.total(),
-                            differing_pixels: differing(first, f),
+                            seconds: median(&times[i]),
+                            renders: times[i].len(),
+                            update_seconds: updates[i],
+                            rays: frames[i].rays.total(),
+                            work: frames[i].work,
+                            differing_pixels: differing(first, &frames[i]),
                         });
                     }
                     if s + 1 == scenes.len() && vp == 0 && strip.contains(&frame) {
@@ -327,9 +279,24 @@ pub fn run_frames(spec: &FramesSpec, progress: &dyn Fn(&str)) -> anyhow::Result<
                             radiance: first.radiance.clone(),
                         });
                     }
+                    bar.inc(1);
                 }
             }
         }
     }
+    bar.finish();
     Ok(outcome)
+}
+
+/// The schedule of one frame's interleaved rounds: the experiment's seed, varied by scene,
+/// viewpoint and frame so every frame's rounds visit the structures in their own orders.
+fn frame_rounds(
+    schedule: &crate::experiment::timing::Schedule,
+    (scene, viewpoint, frame): (usize, usize, u32),
+) -> crate::experiment::timing::Schedule {
+    let key = (scene as u32) << 28 ^ (viewpoint as u32) << 20 ^ frame;
+    crate::experiment::timing::Schedule {
+        seed: crate::sampling::rng::pcg(schedule.seed ^ crate::sampling::rng::pcg(key)),
+        ..*schedule
+    }
 }

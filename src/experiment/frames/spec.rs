@@ -5,41 +5,53 @@
 //! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part
 //! moves every frame and each structure is updated before rendering it).
 
-use crate::accel::{kdtree::KdSettings, vlf::VlfSettings, AccelSettings, Preset};
+use crate::accel::settings::read_tables;
+use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
-use crate::experiment::kind::Kind;
+use crate::experiment::header::Header;
 use crate::key_path;
-use crate::scene::description::{KdDesc, VlfDesc};
-use crate::scene::load::{kd_settings, vlf_settings};
 use crate::scene::procedural::{classroom, random, Generated};
 use crate::scene::Shading;
 use glam::DVec3;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct File {
-    kind: Kind,
-    name: String,
-    width: u32,
-    height: u32,
-    structures: Vec<String>,
-    shadings: Vec<ShadingName>,
-    #[serde(default = "three")]
-    mirror_depth: u32,
-    #[serde(default = "one")]
-    repeats: u32,
-    scene: SceneEntry,
-    path: PathEntry,
-    motion: Option<MotionEntry>,
-    #[serde(default)]
-    kdtree: KdDesc,
-    #[serde(default)]
-    vlf: VlfDesc,
-    #[serde(default = "six")]
-    strip: u32,
+crate::experiment_file! {
+    /// A frame-time experiment's file: the shared header and these keys.
+    struct File {
+        width: u32,
+        height: u32,
+        structures: Vec<String>,
+        shadings: Vec<ShadingName>,
+        #[serde(default = "three")]
+        mirror_depth: u32,
+        scene: SceneEntry,
+        path: PathEntry,
+        motion: Option<MotionEntry>,
+        claim: Claim,
+        #[serde(default)]
+        accel: BTreeMap<String, toml::Table>,
+        #[serde(default = "six")]
+        strip: u32,
+    }
 }
+
+/// The paper's claim the verdict answers: `subject` renders (or, with motion, updates) faster
+/// than `baseline`; every other structure is set against `subject` too.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Claim {
+    /// The structure the paper proposes.
+    pub subject: String,
+    /// The paper's baseline.
+    pub baseline: String,
+}
+
+/// Most frames per viewpoint a path may have.
+pub const MAX_FRAMES: u32 = 100_000;
+/// Most triangles a random-triangle scene may ask for.
+pub const MAX_TRIANGLES: usize = 16 << 20;
 
 fn one() -> u32 {
     1
@@ -125,6 +137,9 @@ pub struct Motion {
 /// A validated frame-time experiment.
 #[derive(Clone, Debug)]
 pub struct FramesSpec {
+    /// The shared keys (`[timing]`: timed renders of every frame, in interleaved rounds; warm-up
+    /// renders of each path's first frame).
+    pub header: Header,
     /// Results folder name.
     pub name: String,
     /// The experiment file.
@@ -137,8 +152,8 @@ pub struct FramesSpec {
     pub structures: Vec<AccelSettings>,
     /// Shadings rendered, each over the whole path.
     pub shadings: Vec<(ShadingName, Shading)>,
-    /// Timed renders per frame (the median is kept).
-    pub repeats: u32,
+    /// The claim the verdict answers.
+    pub claim: Claim,
     /// The scene generator.
     pub generator: Generator,
     /// Frames per viewpoint.
@@ -154,51 +169,49 @@ pub struct FramesSpec {
     pub strip: u32,
 }
 
-/// The registered structures the experiment compares at the file's parameters; obvhs' BVH at
-/// its slowest, best build.
-fn structure(name: &'static str, kdtree: KdSettings, vlf: VlfSettings) -> AccelSettings {
-    AccelSettings {
-        name,
-        bvh_preset: Preset::VerySlow,
-        vlf,
-        kdtree,
-    }
-}
-
 impl FramesSpec {
     /// Reads and validates a frame-time experiment.
     pub fn load(path: &Path) -> Result<FramesSpec, ConfigError> {
-        FramesSpec::from_source(&Source::read(path)?)
+        let source = Source::read(path)?;
+        FramesSpec::from_source(&source, Header::read(&source)?)
     }
 
-    /// Validates a frame-time experiment read from `source`.
-    pub fn from_source(source: &Source) -> Result<FramesSpec, ConfigError> {
+    /// Validates a frame-time experiment read from `source` (shared keys `header`).
+    pub fn from_source(source: &Source, header: Header) -> Result<FramesSpec, ConfigError> {
         let f: File = source.parse()?;
         let err = |p: &[Seg], m: String| source.error(p, m);
-        if f.kind != Kind::Frames {
-            return Err(err(
-                &key_path!["kind"],
-                "a frame-time experiment has kind = \"frames\"".into(),
-            ));
-        }
-        for (k, v) in [("width", f.width), ("height", f.height)] {
-            if !(1..=16384).contains(&v) {
-                return Err(err(&key_path![k], format!("must be in 1..=16384, got {v}")));
-            }
-        }
-        if f.repeats == 0 {
-            return Err(err(&key_path!["repeats"], "at least one timed render per frame".into()));
-        }
+        source.image_size(&key_path!["width"], &key_path!["height"], f.width, f.height)?;
         if f.mirror_depth == 0 || f.mirror_depth > Shading::MAX_MIRROR_DEPTH {
             return Err(err(
                 &key_path!["mirror_depth"],
                 format!("must be in 1..={}, got {}", Shading::MAX_MIRROR_DEPTH, f.mirror_depth),
             ));
         }
-        let (kdtree, vlf) = (kd_settings(&f.kdtree, source)?, vlf_settings(&f.vlf, source)?);
-        let structures = crate::experiment::structure_names(source, &f.structures)?
+        let given = read_tables(source, &key_path!["accel"], &f.accel, false)?;
+        let names = crate::experiment::structure_names(source, &f.structures)?;
+        if let Some(extra) = given.keys().find(|k| !names.contains(k)) {
+            return Err(err(
+                &key_path!["accel", *extra],
+                format!("`{extra}` is not among `structures`"),
+            ));
+        }
+        for (k, v) in [("subject", &f.claim.subject), ("baseline", &f.claim.baseline)] {
+            if !names.contains(&v.as_str()) {
+                return Err(err(&key_path!["claim", k], format!("`{v}` is not among `structures`")));
+            }
+        }
+        if f.claim.subject == f.claim.baseline {
+            return Err(err(
+                &key_path!["claim", "baseline"],
+                "must differ from `subject`".into(),
+            ));
+        }
+        let structures: Vec<AccelSettings> = names
             .into_iter()
-            .map(|name| structure(name, kdtree, vlf))
+            .map(|name| match given.get(name) {
+                Some(one) => one[0].clone(),
+                None => AccelSettings::default_for(crate::accel::registered(name).expect("registered")),
+            })
             .collect();
         if f.shadings.is_empty() {
             return Err(err(&key_path!["shadings"], "name at least one shading".into()));
@@ -243,6 +256,12 @@ impl FramesSpec {
                         "counts must be positive and ascending".into(),
                     ));
                 }
+                if let Some(i) = counts.iter().position(|&n| n > MAX_TRIANGLES) {
+                    return Err(err(
+                        &key_path!["scene", "triangles", i],
+                        format!("at most {MAX_TRIANGLES} triangles"),
+                    ));
+                }
                 Generator::RandomTriangles {
                     counts,
                     seed: f.scene.seed,
@@ -255,8 +274,11 @@ impl FramesSpec {
                 ))
             }
         };
-        if f.path.frames == 0 {
-            return Err(err(&key_path!["path", "frames"], "at least one frame".into()));
+        if !(1..=MAX_FRAMES).contains(&f.path.frames) {
+            return Err(err(
+                &key_path!["path", "frames"],
+                format!("must be in 1..={MAX_FRAMES}"),
+            ));
         }
         let viewpoints = match generator {
             Generator::Classroom => {
@@ -323,13 +345,14 @@ impl FramesSpec {
             ));
         }
         let spec = FramesSpec {
-            name: f.name,
+            name: header.name.clone(),
+            header,
             path: source.path.clone(),
             width: f.width,
             height: f.height,
             structures,
             shadings,
-            repeats: f.repeats,
+            claim: f.claim,
             generator,
             frames: f.path.frames,
             viewpoints,
@@ -364,34 +387,41 @@ impl FramesSpec {
             }
         }
         let Some(m) = &self.motion else { return Ok(()) };
-        if !self.structures.iter().any(|s| s.name == "vlf") {
+        let bounded: Vec<_> = self
+            .structures
+            .iter()
+            .filter_map(|s| Some((s.name, crate::accel::registered(s.name)?.follows_within?)))
+            .collect();
+        if bounded.is_empty() {
             return Ok(());
         }
         let travel = m.step * self.moving_frames() as f64;
         for g in self.scenes() {
             let t = g.triangles();
-            let (centre, radius) = crate::accel::vlf::ball(&t.positions);
             let (index, _) = g.part(&m.part).expect("validated part");
-            let out = t
-                .positions
-                .iter()
-                .zip(&t.object_of)
-                .filter(|(_, &o)| o as usize == index)
-                .flat_map(|(p, _)| p.iter())
-                .map(|p| (*p + travel).distance(centre))
-                .fold(0.0, f64::max);
-            if out > radius {
-                return Err(source.error(
-                    &key_path!["motion", "step"],
-                    format!(
-                        "over {} frames (every shading and viewpoint) `{}` travels {:?} m and leaves the ball the visibility field is built in ({:.3} m from its centre, radius {:.3} m): shorten the step",
-                        self.moving_frames(),
-                        m.part,
-                        travel.to_array(),
-                        out,
-                        radius
-                    ),
-                ));
+            for (name, within) in &bounded {
+                let (centre, radius) = within(&t.positions);
+                let out = t
+                    .positions
+                    .iter()
+                    .zip(&t.object_of)
+                    .filter(|(_, &o)| o as usize == index)
+                    .flat_map(|(p, _)| p.iter())
+                    .map(|p| (*p + travel).distance(centre))
+                    .fold(0.0, f64::max);
+                if out > radius {
+                    return Err(source.error(
+                        &key_path!["motion", "step"],
+                        format!(
+                            "over {} frames (every shading and viewpoint) `{}` travels {:?} m and leaves the ball `{name}` is built in ({:.3} m from its centre, radius {:.3} m), where it cannot follow: shorten the step",
+                            self.moving_frames(),
+                            m.part,
+                            travel.to_array(),
+                            out,
+                            radius
+                        ),
+                    ));
+                }
             }
         }
         Ok(())

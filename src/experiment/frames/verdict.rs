@@ -1,11 +1,13 @@
 //! The verdict of a frame-time experiment, computed from its rows: the paper's claim, whether
-//! every structure rendered the same frames, speed-ups as medians and quartiles of per-frame
-//! ratios with a yes / no / not clearly answer, log-log scaling slopes, what updates cost, and
-//! the memory and build time paid.
+//! every structure rendered the same frames, speed-ups as the median of per-frame ratios with a
+//! 95 % moving-block interval over frames (consecutive frames are correlated) and the one rule's
+//! yes / no / not clearly, the work behind each time, log-log scaling slopes, what updates cost,
+//! and the memory and build time paid.
 
 use super::runner::{FrameRow, FramesOutcome};
 use super::spec::{FramesSpec, Generator, ShadingName};
-use crate::metrics::stats::{median, quartiles};
+use crate::experiment::timing::{series_median, Comparison, Estimate};
+use crate::metrics::stats::median;
 
 /// A structure and the way it follows motion, as rows and plots label it.
 pub fn label(r: &FrameRow) -> String {
@@ -27,9 +29,15 @@ pub fn labels(rows: &[FrameRow]) -> Vec<String> {
     out
 }
 
-/// Per frame (scene size, viewpoint, frame) of one shading, the ratio of `b`'s frame time to
-/// `a`'s: above 1 where `a` is faster.
-fn per_frame_ratios(rows: &[FrameRow], shading: ShadingName, triangles: Option<usize>, a: &str, b: &str) -> Vec<f64> {
+/// Per frame (scene size, viewpoint, frame, in path order) of one shading, the ratio
+/// `value(b) / value(a)`: above 1 where `a` is faster.
+fn per_frame_ratios(
+    rows: &[FrameRow],
+    shading: ShadingName,
+    triangles: Option<usize>,
+    (a, b): (&str, &str),
+    value: &dyn Fn(&FrameRow) -> f64,
+) -> Vec<f64> {
     let pick = |l: &str| -> Vec<&FrameRow> {
         rows.iter()
             .filter(|r| r.shading == shading && triangles.is_none_or(|t| r.triangles == t) && label(r) == l)
@@ -41,19 +49,45 @@ fn per_frame_ratios(rows: &[FrameRow], shading: ShadingName, triangles: Option<u
             let y = ys
                 .iter()
                 .find(|y| y.triangles == x.triangles && y.viewpoint == x.viewpoint && y.frame == x.frame)?;
-            Some(y.seconds / x.seconds)
+            Some(value(y) / value(x))
         })
         .collect()
 }
 
-/// "median M (q1-q3), faster on K of N frames" for ratios of `b` over `a`.
-fn ratio_summary(r: &[f64]) -> String {
-    let (q1, m, q3) = quartiles(r);
-    format!(
-        "median {m:.2}x (quartiles {q1:.2}-{q3:.2}x), faster on {} of {} frames",
-        r.iter().filter(|&&x| x > 1.0).count(),
-        r.len()
-    )
+/// A speed-up over frames: the median of per-frame ratios (theirs / ours) with its 95 %
+/// moving-block interval, and the rule's word for "ours is faster".
+struct Speedup {
+    estimate: Estimate,
+    block: usize,
+    faster_frames: usize,
+    frames: usize,
+}
+
+impl Speedup {
+    fn of(ratios: &[f64], seed: u32) -> Speedup {
+        let (estimate, block) = series_median(ratios, seed);
+        Speedup {
+            estimate,
+            block,
+            faster_frames: ratios.iter().filter(|&&x| x > 1.0).count(),
+            frames: ratios.len(),
+        }
+    }
+
+    fn comparison(&self) -> Comparison {
+        Comparison::of_speedup(&self.estimate)
+    }
+
+    /// "1.14x [1.07, 1.23] (blocks of 8 frames), faster on 384 of 420 frames".
+    fn summary(&self) -> String {
+        format!(
+            "{}x (95 % interval over frames in blocks of {}), faster on {} of {} frames",
+            self.estimate.show(2),
+            self.block,
+            self.faster_frames,
+            self.frames
+        )
+    }
 }
 
 /// A time ratio (theirs / ours) in words: "2.00x faster" or "3.00x slower".
@@ -87,19 +121,6 @@ pub fn median_at(rows: &[FrameRow], shading: ShadingName, l: &str, triangles: us
         .map(|r| r.seconds)
         .collect();
     (!v.is_empty()).then(|| median(&v))
-}
-
-/// Whether per-frame speed-ups `r` (theirs / VLF-RT's) answer "is VLF-RT faster" with yes (at
-/// least three frames in four faster), no (at least three in four slower) or neither.
-fn answer(r: &[f64]) -> &'static str {
-    let (q1, _, q3) = quartiles(r);
-    if q1 > 1.0 {
-        "**yes**"
-    } else if q3 < 1.0 {
-        "**no**"
-    } else {
-        "**not clearly**"
-    }
 }
 
 /// What the paper claims for this experiment's set-up (its Fig. 5 and 6 survive as curves only).
@@ -150,29 +171,52 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         }
         v
     });
-    let has = |l: &str| all.iter().any(|x| x == l);
+    let seed = spec.header.schedule.seed;
+    let subject = spec.claim.subject.as_str();
+    let work = |l: &str, shading: ShadingName| {
+        let of = |f: fn(&FrameRow) -> u64| {
+            median(
+                &rows
+                    .iter()
+                    .filter(|r| r.shading == shading && label(r) == l)
+                    .map(|r| f(r) as f64)
+                    .collect::<Vec<_>>(),
+            )
+        };
+        format!(
+            "{:.3e} nodes, {:.3e} tests per frame",
+            of(|r| r.work.nodes),
+            of(|r| r.work.primitives)
+        )
+    };
     if spec.motion.is_none() {
         for &(shading, _) in &spec.shadings {
-            for (baseline, what) in [
-                ("kdtree", "the CRT-like kd-tree (the paper's baseline)"),
-                ("bvh", "obvhs' BVH2 (very-slow build)"),
-            ] {
-                if !has(baseline) || !has("vlf") {
+            for other in all.iter().filter(|l| l.as_str() != subject) {
+                let r = per_frame_ratios(rows, shading, None, (subject, other), &|r| r.seconds);
+                if r.is_empty() {
                     continue;
                 }
-                let r = per_frame_ratios(rows, shading, None, "vlf", baseline);
+                let sp = Speedup::of(&r, seed);
+                let role = if *other == spec.claim.baseline {
+                    " (the paper's baseline)"
+                } else {
+                    ""
+                };
                 out += &format!(
-                    "- **Is VLF-RT faster than {what}, {} shading?** {}: speed-up per frame (its time / VLF-RT's) {}.",
+                    "- **Is `{subject}` faster than `{other}`{role}, {} shading?** **{}**: speed-up per frame (its time / `{subject}`'s) {}. Work: `{subject}` {}; `{other}` {}.",
                     shading.name(),
-                    answer(&r),
-                    ratio_summary(&r)
+                    sp.comparison().answer(),
+                    sp.summary(),
+                    work(subject, shading),
+                    work(other, shading),
                 );
                 if sizes.len() > 1 {
                     let per: Vec<String> = sizes
                         .iter()
                         .map(|&t| {
-                            let r = per_frame_ratios(rows, shading, Some(t), "vlf", baseline);
-                            format!("{}K {:.2}x", t as f64 / 1e3, median(&r))
+                            let r = per_frame_ratios(rows, shading, Some(t), (subject, other), &|r| r.seconds);
+                            let sp = Speedup::of(&r, seed);
+                            format!("{}K {}x", t as f64 / 1e3, sp.estimate.show(2))
                         })
                         .collect();
                     out += &format!(" By size: {}.", per.join(", "));
@@ -201,6 +245,8 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
             }
         }
     } else {
+        // The subject's own update: the first way it offers.
+        let own = all.iter().find(|l| l.starts_with(subject)).cloned();
         for &(shading, _) in &spec.shadings {
             let of = |l: &str, f: &dyn Fn(&FrameRow) -> f64| -> Vec<f64> {
                 rows.iter()
@@ -219,29 +265,34 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
                 shading.name(),
                 listed.join("; ")
             );
-            if !has("vlf (update)") {
-                continue;
-            }
-            let field = update("vlf (update)");
-            for other in all.iter().filter(|l| !l.starts_with("vlf")) {
-                let per_frame = |f: &dyn Fn(&FrameRow) -> f64| -> Vec<f64> {
-                    let (a, b) = (of(other, f), of("vlf (update)", f));
-                    a.iter().zip(&b).map(|(x, y)| x / y).collect()
-                };
-                let updates = per_frame(&|r| r.update_seconds.unwrap_or(f64::NAN));
-                let totals = per_frame(&|r| r.seconds + r.update_seconds.unwrap_or(0.0));
+            let Some(own) = &own else { continue };
+            let field = update(own);
+            for other in all.iter().filter(|l| *l != own) {
+                let updates = Speedup::of(
+                    &per_frame_ratios(rows, shading, None, (own, other), &|r| {
+                        r.update_seconds.unwrap_or(f64::NAN)
+                    }),
+                    seed,
+                );
+                let totals = Speedup::of(
+                    &per_frame_ratios(rows, shading, None, (own, other), &|r| {
+                        r.seconds + r.update_seconds.unwrap_or(0.0)
+                    }),
+                    seed,
+                );
                 out += &format!(
-                    "- **Is VLF-RT's update cheaper than {other}'s?** {}: {} to update (median of per-frame ratios {:.3}x); update + render: {} ({:.3}x).\n",
-                    answer(&updates),
-                    faster(median(&updates)),
-                    median(&updates),
-                    faster(median(&totals)),
-                    median(&totals)
+                    "- **Is `{own}` cheaper than `{other}`?** **{}**: to update, {} ({}); update + render: **{}**, {} ({}).\n",
+                    updates.comparison().answer(),
+                    faster(updates.estimate.median),
+                    updates.summary(),
+                    totals.comparison().answer(),
+                    faster(totals.estimate.median),
+                    totals.summary(),
                 );
             }
-            if let Some(b) = outcome.builds.iter().find(|b| b.structure == "vlf") {
+            if let Some(b) = outcome.builds.iter().find(|b| b.structure == subject) {
                 out += &format!(
-                    "- **VLF-RT's update vs building the field**: {:.4} s against {:.2} s ({}).\n",
+                    "- **`{own}` vs building `{subject}` again**: {:.4} s against {:.2} s ({}).\n",
                     field,
                     b.build_seconds,
                     faster(b.build_seconds / field)

@@ -1,7 +1,7 @@
 //! One run measured: render it, compare it with its reference, and assemble its record (its frame
 //! time stays unmeasured until the timing phase fills it in).
 
-use super::record::{BvhColumns, Device, FrameTime, Metrics, Radial, RayCounts, Record, Status};
+use super::record::{Device, FrameTime, Metrics, Radial, RayCounts, Record, Status, StructureColumns};
 use super::reference::{shadow_image, Reference};
 use super::run::Run;
 use super::spec::Spec;
@@ -19,7 +19,7 @@ fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, stat
         metrics: Metrics::NONE,
         rays: RayCounts::default(),
         time: FrameTime::UNTIMED,
-        bvh: BvhColumns::NONE,
+        structure: StructureColumns::NONE,
         device: Device::of(backend.adapter()),
         image_fnv1a: String::new(),
         error: error.to_string(),
@@ -67,15 +67,19 @@ pub fn measure_run(
     let m = &mut r.metrics;
     (m.rmse, m.relmse, m.bias, m.rmse_exact) = (vs_gt.rmse, vs_gt.relmse, vs_gt.bias, rmse_exact);
     (m.penumbra_area_ratio, m.penumbra_lost_share) = (area_ratio, lost);
+    let work = frame.work();
     r.rays = RayCounts {
         primary_rays: Some(rays.primary),
         shadow_rays: Some(rays.shadow_total()),
+        queries: work.map(|w| w.queries),
+        nodes_visited: work.map(|w| w.nodes),
+        primitive_tests: work.map(|w| w.primitives),
     };
     if let Some(a) = &scene.accel {
         let stats = a.stats();
-        r.bvh = BvhColumns {
-            bvh_preset: Some(stats.parameters),
-            bvh_build_ms: stats.build_time.as_secs_f64() * 1e3,
+        r.structure = StructureColumns {
+            parameters: Some(scene.accel_settings.describe()),
+            build_s: stats.build_time.as_secs_f64(),
             gpu_bytes_per_triangle: stats.gpu_bytes as f64 / stats.triangles as f64,
         };
     }

@@ -158,6 +158,7 @@ pub fn merge_shards(
     backend: &mut dyn Backend,
     plan: &MergePlan,
     results: &Path,
+    progress: &crate::experiment::progress::Progress,
 ) -> anyhow::Result<Outcome> {
     let (dirs, rerun) = (plan.dirs, plan.rerun);
     let context = context_key(spec, backend.adapter());
@@ -308,6 +309,6 @@ pub fn merge_shards(
         out.references.push(reference);
     }
     let mut journal = Journal::open(&results.join(".journal"), plan.fresh)?;
-    time_phase(spec, backend, &groups, &mut out, &context, &mut journal)?;
+    time_phase(spec, backend, &groups, &mut out, &context, &mut journal, progress)?;
     Ok(out)
 }

@@ -4,6 +4,7 @@
 //! big for one machine runs as shares ([`shard`]) merged back into one result ([`merge`]).
 
 pub mod axes;
+pub mod experiment;
 pub mod filter;
 pub mod journal;
 pub mod measure;

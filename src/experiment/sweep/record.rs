@@ -39,8 +39,8 @@ pub struct Record {
     pub rays: RayCounts,
     /// Its configuration's frame time, from the timing phase.
     pub time: FrameTime,
-    /// The scene's BVH, on mesh scenes.
-    pub bvh: BvhColumns,
+    /// The scene's acceleration structure, on mesh scenes.
+    pub structure: StructureColumns,
     /// The device that rendered it.
     pub device: Device,
     /// FNV-1a of the shadow image's f32 bits: runs that differ only in the acceleration
@@ -71,7 +71,7 @@ type Parts = (
     Metrics,
     RayCounts,
     FrameTime,
-    BvhColumns,
+    StructureColumns,
     Device,
     Tail,
 );
@@ -93,7 +93,7 @@ impl Serialize for Record {
             &self.metrics,
             &self.rays,
             &self.time,
-            &self.bvh,
+            &self.structure,
             &self.device,
             tail,
         )
@@ -103,7 +103,7 @@ impl Serialize for Record {
 
 impl<'de> Deserialize<'de> for Record {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Record, D::Error> {
-        let (head, run, radial, metrics, rays, time, bvh, device, tail) = Parts::deserialize(d)?;
+        let (head, run, radial, metrics, rays, time, structure, device, tail) = Parts::deserialize(d)?;
         Ok(Record {
             run_key: head.run_key,
             status: head.status,
@@ -112,7 +112,7 @@ impl<'de> Deserialize<'de> for Record {
             metrics,
             rays,
             time,
-            bvh,
+            structure,
             device,
             image_fnv1a: tail.image_fnv1a,
             error: tail.error,
@@ -227,27 +227,34 @@ aggregated_metrics! {
     penumbra_lost_share,
 }
 
-/// Rays one frame of the run traced.
+/// Rays one frame of the run traced, and what their queries cost where the backend counts it
+/// (the CPU; empty on the GPU): deterministic work that does not move between runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RayCounts {
     /// Camera rays.
     pub primary_rays: Option<u64>,
     /// Shadow rays, all lights.
     pub shadow_rays: Option<u64>,
+    /// Queries asked of the scene.
+    pub queries: Option<u64>,
+    /// Traversal steps (nodes, tiles) of the structure.
+    pub nodes_visited: Option<u64>,
+    /// Primitive intersection tests (triangles and analytic shapes).
+    pub primitive_tests: Option<u64>,
 }
 
 /// The frame time of the run's configuration (timed once, with its first seed).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameTime {
-    /// Median frame time (ms).
+    /// Median frame time (s).
     #[serde(with = "float")]
-    pub frame_ms: f64,
-    /// First quartile (ms).
+    pub frame_s: f64,
+    /// Lower end of its 95 % interval (s).
     #[serde(with = "float")]
-    pub frame_ms_q1: f64,
-    /// Third quartile (ms).
+    pub frame_s_lo: f64,
+    /// Upper end of its 95 % interval (s).
     #[serde(with = "float")]
-    pub frame_ms_q3: f64,
+    pub frame_s_hi: f64,
     /// Frames timed.
     pub timed_frames: Option<usize>,
     /// All rays per second at the median frame time.
@@ -266,9 +273,9 @@ pub struct FrameTime {
 impl FrameTime {
     /// Not timed.
     pub const UNTIMED: FrameTime = FrameTime {
-        frame_ms: f64::NAN,
-        frame_ms_q1: f64::NAN,
-        frame_ms_q3: f64::NAN,
+        frame_s: f64::NAN,
+        frame_s_lo: f64::NAN,
+        frame_s_hi: f64::NAN,
         timed_frames: None,
         rays_per_s: f64::NAN,
         primary_rays_per_s: f64::NAN,
@@ -277,24 +284,24 @@ impl FrameTime {
     };
 }
 
-/// The scene's BVH: its build preset and time, and its GPU memory per triangle.
+/// The scene's acceleration structure: its parameters, build time and GPU memory per triangle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BvhColumns {
-    /// obvhs build preset.
-    pub bvh_preset: Option<String>,
-    /// Build time (ms).
+pub struct StructureColumns {
+    /// Its parameters (`key=value` pairs).
+    pub parameters: Option<String>,
+    /// Build time (s).
     #[serde(with = "float")]
-    pub bvh_build_ms: f64,
+    pub build_s: f64,
     /// GPU bytes per triangle (nodes and triangles).
     #[serde(with = "float")]
     pub gpu_bytes_per_triangle: f64,
 }
 
-impl BvhColumns {
-    /// No BVH (no meshes).
-    pub const NONE: BvhColumns = BvhColumns {
-        bvh_preset: None,
-        bvh_build_ms: f64::NAN,
+impl StructureColumns {
+    /// No structure (no meshes).
+    pub const NONE: StructureColumns = StructureColumns {
+        parameters: None,
+        build_s: f64::NAN,
         gpu_bytes_per_triangle: f64::NAN,
     };
 }

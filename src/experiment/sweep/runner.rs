@@ -10,6 +10,7 @@ use super::reference::Reference;
 use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
 use super::timing::{self, ConfigTiming, Timings};
+use crate::experiment::progress::{Bar, Progress};
 use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::render::{Backend, RenderPlan, View};
@@ -80,13 +81,6 @@ pub fn verdict_radius(spec: &Spec) -> f64 {
         .expect("validated non-empty")
 }
 
-fn progress(total: u64) -> indicatif::ProgressBar {
-    indicatif::ProgressBar::new(total).with_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}, {elapsed} elapsed, ~{eta} left")
-            .expect("valid template"),
-    )
-}
-
 /// Runs the sweep. `journal_dir` holds the resumable journal; `fresh` discards it first.
 pub fn run_sweep(
     spec: &Spec,
@@ -94,12 +88,13 @@ pub fn run_sweep(
     journal_dir: &Path,
     cache: &Path,
     fresh: bool,
+    progress: &Progress,
 ) -> anyhow::Result<Outcome> {
     let context = context_key(spec, backend.adapter());
     let groups = expand(spec);
     let mut journal = Journal::open(journal_dir, fresh)?;
-    let mut out = render_groups(spec, backend, &groups, &mut journal, cache, &context)?;
-    time_phase(spec, backend, &groups, &mut out, &context, &mut journal)?;
+    let mut out = render_groups(spec, backend, &groups, &mut journal, cache, &context, progress)?;
+    time_phase(spec, backend, &groups, &mut out, &context, &mut journal, progress)?;
     Ok(out)
 }
 
@@ -128,12 +123,13 @@ pub(super) fn render_groups(
     journal: &mut Journal,
     cache: &Path,
     context: &str,
+    progress: &Progress,
 ) -> anyhow::Result<Outcome> {
     let fig_n = figure_samples(spec);
-    let bar = progress(groups.iter().map(|g| g.runs.len() as u64).sum());
+    let bar = progress.bar("runs", groups.iter().map(|g| g.runs.len() as u64).sum());
     let mut out = empty_outcome(spec)?;
     for ((lights, radius), share) in by_reference(groups) {
-        bar.set_message(format!("runs; reference for {lights} light(s) of radius {radius} m"));
+        bar.message(format!("reference for {lights} light(s) of radius {radius} m"));
         let reference = Reference::build(spec, backend, lights, radius, cache, context)?;
         for warning in reference.warnings() {
             // `println` on a hidden bar (stderr not a terminal, as in CI logs) prints nothing.
@@ -152,7 +148,7 @@ pub(super) fn render_groups(
                 bar.inc(group.runs.len() as u64);
                 continue;
             }
-            bar.set_message(format!("runs; {}", group.config()));
+            bar.message(group.config().to_string());
             let (records, stats, images) = run_group(spec, backend, group, &reference, context, &bar);
             if figure.is_some() {
                 if let Some(f) = figure_of(&reference, &images) {
@@ -172,7 +168,7 @@ pub(super) fn render_groups(
         }
         out.references.push(reference);
     }
-    bar.finish_and_clear();
+    bar.finish();
     Ok(out)
 }
 
@@ -215,10 +211,11 @@ pub(super) fn time_phase(
     out: &mut Outcome,
     context: &str,
     journal: &mut Journal,
+    progress: &Progress,
 ) -> anyhow::Result<()> {
     if spec.timing.repeats > 0 {
-        out.timings = time_sweep(spec, backend, groups, out, context, journal)?;
-        fill_timing_columns(out, groups, context);
+        out.timings = time_sweep(spec, backend, groups, out, context, journal, progress)?;
+        fill_timing_columns(out, groups, context, spec.timing.seed);
     }
     Ok(())
 }
@@ -232,6 +229,7 @@ fn time_sweep(
     out: &Outcome,
     context: &str,
     journal: &mut Journal,
+    progress: &Progress,
 ) -> anyhow::Result<Timings> {
     let settings = timing::settings_key(&spec.timing);
     let rendered: Vec<&Group> = groups
@@ -242,7 +240,10 @@ fn time_sweep(
         })
         .collect();
     let probe = timing::noise_probe(&rendered, figure_samples(spec), verdict_radius(spec));
-    let mut result = Timings::default();
+    let mut result = Timings {
+        seed: spec.timing.seed,
+        ..Timings::default()
+    };
     let mut todo = Vec::new();
     for g in &rendered {
         let key = g.head().key(context);
@@ -266,13 +267,10 @@ fn time_sweep(
     if !todo.is_empty() || noise_todo.is_some() {
         let visits =
             (todo.len() as u64 + noise_todo.map_or(0, |_| timing::NOISE_VISITS as u64)) * spec.timing.repeats as u64;
-        let bar = progress(visits);
-        bar.set_message(format!(
-            "timed frames ({} warm-up each, interleaved rounds)",
-            spec.timing.warmup
-        ));
+        let bar = progress.bar("timed frames", visits);
+        bar.message(format!("{} warm-up each, interleaved rounds", spec.timing.warmup));
         let (timed, noise) = timing::time_groups(spec, backend, &todo, noise_todo, &|| bar.inc(1))?;
-        bar.finish_and_clear();
+        bar.finish();
         let mut new: Vec<(String, ConfigTiming)> = todo.iter().map(|g| g.head().key(context)).zip(timed).collect();
         if let (Some(k), Some(n)) = (&noise_key, &noise) {
             new.push((k.clone(), n.clone()));
@@ -290,9 +288,9 @@ fn time_sweep(
 }
 
 /// Writes each configuration's timing into the records of all its seeds (a configuration is
-/// timed once, with its first seed): median and quartiles of the frame time, frames timed, the
+/// timed once, with its first seed): median frame time and its 95 % interval, frames timed, the
 /// clock, and rays per second from the median and the timed run's ray counts.
-fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
+fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str, seed: u32) {
     let group_of: HashMap<String, String> = groups
         .iter()
         .flat_map(|g| {
@@ -316,14 +314,14 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
             continue;
         };
         let Some(t) = out.timings.configs.get(gk) else { continue };
-        let (q1, med, q3) = t.frame_ms();
+        let frame = t.frame(seed);
         let (primary, shadow) = rays[gk];
         let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] =
-            rays_per_second(primary, shadow, med * 1e-3, t.primary_median());
+            rays_per_second(primary, shadow, frame.median, t.primary_median());
         r.time = FrameTime {
-            frame_ms: med,
-            frame_ms_q1: q1,
-            frame_ms_q3: q3,
+            frame_s: frame.median,
+            frame_s_lo: frame.lo,
+            frame_s_hi: frame.hi,
             timed_frames: Some(t.frame_seconds.len()),
             rays_per_s,
             primary_rays_per_s,
@@ -364,7 +362,7 @@ fn run_group(
     group: &Group,
     reference: &Reference,
     context: &str,
-    bar: &indicatif::ProgressBar,
+    bar: &Bar,
 ) -> (Vec<Record>, GroupStats, Vec<Vec<f32>>) {
     let mut records = Vec::new();
     let mut images = Vec::new();

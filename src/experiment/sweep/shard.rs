@@ -33,6 +33,9 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+/// Most shards a sweep splits into.
+pub const MAX_SHARDS: u32 = 10_000;
+
 /// A finished shard's manifest, written last.
 pub const MANIFEST: &str = "shard.toml";
 /// A finished shard's records, every run of its share (failed ones included).
@@ -53,11 +56,11 @@ impl FromStr for Shard {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Shard, String> {
-        let bad = || format!("expected K/N with 1 <= K <= N (e.g. 2/8), got `{s}`");
+        let bad = || format!("expected K/N with 1 <= K <= N <= {MAX_SHARDS} (e.g. 2/8), got `{s}`");
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let (index, count) = (k.trim().parse::<u32>(), n.trim().parse::<u32>());
         match (index, count) {
-            (Ok(index), Ok(count)) if (1..=count).contains(&index) => Ok(Shard { index, count }),
+            (Ok(index), Ok(count)) if (1..=count).contains(&index) && count <= MAX_SHARDS => Ok(Shard { index, count }),
             _ => Err(bad()),
         }
     }
@@ -199,6 +202,7 @@ pub fn run_shard(
     shard: Shard,
     results: &Path,
     fresh: bool,
+    progress: &crate::experiment::progress::Progress,
 ) -> anyhow::Result<ShardOutcome> {
     let started = std::time::Instant::now();
     let dir = shard.dir(results);
@@ -210,7 +214,15 @@ pub fn run_shard(
     let context = context_key(spec, backend.adapter());
     let groups = share(spec, shard);
     let mut journal = Journal::open(&dir.join(".journal"), fresh)?;
-    let out = render_groups(spec, backend, &groups, &mut journal, &results.join("cache"), &context)?;
+    let out = render_groups(
+        spec,
+        backend,
+        &groups,
+        &mut journal,
+        &results.join("cache"),
+        &context,
+        progress,
+    )?;
     let hash =
         |file: &str| -> anyhow::Result<String> { Ok(format!("{:016x}", fnv1a(&std::fs::read(dir.join(file))?))) };
     write_rows(&dir.join(RECORDS), &out.records)?;

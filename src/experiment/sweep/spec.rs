@@ -2,9 +2,10 @@
 //! [`Spec`] with every error located in the file.
 
 pub use super::axes::Axes;
-use crate::accel::{AccelSettings, Accelerator};
+use crate::accel::Accelerator;
 use crate::config::{ConfigError, Source};
-use crate::experiment::kind::Kind;
+use crate::experiment::header::Header;
+use crate::experiment::timing::Schedule;
 use crate::key_path;
 use crate::render::BackendChoice;
 use crate::scene::camera::Projection;
@@ -14,25 +15,15 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct File {
-    #[serde(default)]
-    kind: Kind,
-    name: String,
-    scene: PathBuf,
-    #[serde(default = "default_backend")]
-    backend: BackendChoice,
-    measure: Measure,
-    sweep: Axes,
-    ground_truth: GroundTruth,
-    #[serde(default)]
-    timing: TimingSpec,
-    figures: Option<Figures>,
-}
-
-fn default_backend() -> BackendChoice {
-    BackendChoice::Auto
+crate::experiment_file! {
+    /// A sweep's file: the shared header and these keys.
+    struct File {
+        scene: PathBuf,
+        measure: Measure,
+        sweep: Axes,
+        ground_truth: GroundTruth,
+        figures: Option<Figures>,
+    }
 }
 
 /// The measuring view: an orthographic camera over the receiver plane.
@@ -58,27 +49,6 @@ pub struct GroundTruth {
     pub samples: u32,
 }
 
-/// Frame timing (see [`super::timing`]).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct TimingSpec {
-    /// Untimed frames rendered right before each timed frame.
-    pub warmup: u32,
-    /// Interleaved rounds, one timed frame per configuration each; the median and quartiles
-    /// are reported. 0 disables timing (runs.csv is then byte-reproducible: times are the only
-    /// values that vary between identical runs); otherwise at least [`MIN_TIMED_REPEATS`].
-    pub repeats: u32,
-}
-
-/// Fewest timed frames per configuration that give a median and an interquartile range.
-pub const MIN_TIMED_REPEATS: u32 = 5;
-
-impl Default for TimingSpec {
-    fn default() -> Self {
-        TimingSpec { warmup: 1, repeats: 5 }
-    }
-}
-
 /// Fig. 2-style pictures: the same view rendered with several schemes at one shadow-ray count.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -98,6 +68,8 @@ pub struct Figures {
 /// A validated experiment.
 #[derive(Clone, Debug)]
 pub struct Spec {
+    /// The shared keys.
+    pub header: Header,
     /// Experiment name (the results folder's name).
     pub name: String,
     /// The experiment file.
@@ -119,8 +91,8 @@ pub struct Spec {
     pub structures: BTreeMap<String, Option<Arc<dyn Accelerator>>>,
     /// Ground-truth settings.
     pub ground_truth: GroundTruth,
-    /// Timing settings.
-    pub timing: TimingSpec,
+    /// How configurations are timed (`[timing]`; `repeats = 0` times nothing).
+    pub timing: Schedule,
     /// Optional pictures.
     pub figures: Option<Figures>,
 }
@@ -128,37 +100,21 @@ pub struct Spec {
 impl Spec {
     /// Reads and validates an experiment file and the scene it names (relative to it).
     pub fn load(path: &Path) -> Result<Spec, ConfigError> {
-        Spec::from_source(&Source::read(path)?)
+        let source = Source::read(path)?;
+        Spec::from_source(&source, Header::read(&source)?)
     }
 
-    /// Validates an experiment read from its file (`source`) and loads the scene it names.
-    pub fn from_source(source: &Source) -> Result<Spec, ConfigError> {
+    /// Validates a sweep read from its file (`source`, whose shared keys are `header`) and
+    /// loads the scene it names.
+    pub fn from_source(source: &Source, header: Header) -> Result<Spec, ConfigError> {
         let path = source.path.as_path();
-        let f: File = source.parse()?;
+        let f: File = source.parse().map_err(|e| read_as_sweep(e, &header))?;
         let err = |p: &[crate::config::Seg], m: String| source.error(p, m);
-        if f.kind != Kind::Sweep {
-            return Err(err(&key_path!["kind"], "a sweep has kind = \"sweep\" (or none)".into()));
-        }
         let scene_path = path.parent().unwrap_or(Path::new(".")).join(&f.scene);
-        if !scene_path.is_file() {
-            return Err(err(
-                &key_path!["scene"],
-                format!("scene file {} does not exist", scene_path.display()),
-            ));
-        }
-        let scene = Scene::load(&scene_path)?;
-        let scene_text = std::fs::read_to_string(&scene_path).unwrap_or_default();
-        if f.name.is_empty()
-            || !f
-                .name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-        {
-            return Err(err(
-                &key_path!["name"],
-                "must be non-empty letters, digits, '-' or '_'".into(),
-            ));
-        }
+        let scene_source = Source::read(&scene_path)
+            .map_err(|e| err(&key_path!["scene"], format!("{}: {}", scene_path.display(), e.message)))?;
+        let scene = Scene::from_source(&scene_source)?;
+        let scene_text = scene_source.text;
         let m = &f.measure;
         match scene.cameras.get(&m.camera) {
             None => {
@@ -175,11 +131,12 @@ impl Spec {
             }
             _ => {}
         }
-        for (k, v) in [("width", m.width), ("height", m.height)] {
-            if !(1..=16384).contains(&v) {
-                return Err(err(&key_path!["measure", k], format!("must be in 1..=16384, got {v}")));
-            }
-        }
+        source.image_size(
+            &key_path!["measure", "width"],
+            &key_path!["measure", "height"],
+            m.width,
+            m.height,
+        )?;
         let mut axes = f.sweep;
         if axes.light_counts.is_empty() {
             axes.light_counts = vec![scene.lights.len() as u32];
@@ -198,10 +155,7 @@ impl Spec {
                     ),
                 ));
             };
-            let settings = AccelSettings {
-                name: r.name,
-                ..scene.accel_settings.clone()
-            };
+            let settings = scene.settings_for(r);
             let built = if settings == scene.accel_settings {
                 scene.accel.clone()
             } else {
@@ -285,22 +239,6 @@ impl Spec {
                 format!("must be in 1..={MAX_SAMPLES}"),
             ));
         }
-        let t = &f.timing;
-        if t.repeats != 0 && !(MIN_TIMED_REPEATS..=1000).contains(&t.repeats) {
-            return Err(err(
-                &key_path!["timing", "repeats"],
-                format!(
-                    "must be 0 (no timing) or in {MIN_TIMED_REPEATS}..=1000 (a median and quartiles need at least {MIN_TIMED_REPEATS} frames), got {}",
-                    t.repeats
-                ),
-            ));
-        }
-        if t.warmup > 100 {
-            return Err(err(
-                &key_path!["timing", "warmup"],
-                format!("must be in 0..=100, got {}", t.warmup),
-            ));
-        }
         if let Some(fig) = &f.figures {
             if !scene.cameras.contains_key(&fig.camera) {
                 return Err(err(
@@ -308,11 +246,12 @@ impl Spec {
                     format!("no camera `{}` in the scene", fig.camera),
                 ));
             }
-            for (k, v) in [("width", fig.width), ("height", fig.height)] {
-                if !(1..=8192).contains(&v) {
-                    return Err(err(&key_path!["figures", k], format!("must be in 1..=8192, got {v}")));
-                }
-            }
+            source.image_size(
+                &key_path!["figures", "width"],
+                &key_path!["figures", "height"],
+                fig.width,
+                fig.height,
+            )?;
             for (k, v) in [
                 ("samples", fig.samples),
                 ("ground_truth_samples", fig.ground_truth_samples),
@@ -326,17 +265,18 @@ impl Spec {
             }
         }
         Ok(Spec {
-            name: f.name,
+            name: header.name.clone(),
             path: path.to_path_buf(),
             scene_path,
             scene_text,
             scene,
-            backend: f.backend,
+            backend: header.backend.unwrap_or(BackendChoice::Auto),
+            timing: header.schedule,
+            header,
             measure: f.measure,
             axes,
             structures,
             ground_truth: f.ground_truth,
-            timing: f.timing,
             figures: f.figures,
         })
     }
@@ -347,7 +287,7 @@ impl Spec {
         let mut scene = self.scene.clone();
         if let (Some(s), Some(r)) = (self.structures.get(accelerator), crate::accel::registered(accelerator)) {
             scene.accel = s.clone();
-            scene.accel_settings.name = r.name;
+            scene.accel_settings = self.scene.settings_for(r);
         }
         scene.lights.truncate(lights as usize);
         for l in &mut scene.lights {
@@ -358,4 +298,14 @@ impl Spec {
         }
         scene
     }
+}
+
+/// A key a sweep does not know, in a file without `kind`, may be another kind's: says how the
+/// file was read.
+fn read_as_sweep(mut e: ConfigError, header: &Header) -> ConfigError {
+    if !header.kind_declared && e.message.starts_with("unknown field") {
+        e.message +=
+            " (a file without `kind` is read as kind = \"sweep\"; a frame-rate experiment says kind = \"fps\")";
+    }
+    e
 }

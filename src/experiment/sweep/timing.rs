@@ -1,27 +1,22 @@
-//! Frame times you can rank by. Every configuration of a sweep (all axes but the seed) is timed
-//! once, with its first seed's sampling, over `repeats` rounds. Each round visits the
-//! configurations in a fresh seeded random order, so slow drift of the machine (clocks, other
-//! load) spreads over all of them instead of favouring whichever ran first; each visit renders
-//! `warmup` untimed frames and then one timed frame over resources already resident on the
-//! device. A noise probe, one configuration visited [`NOISE_VISITS`] extra times per round at
-//! random places in the order, measures the noise floor: the spread of one unchanging workload
-//! across the whole timing phase.
+//! Frame times you can rank by, timed the one way every kind times ([`crate::experiment::timing`]).
+//! Every configuration of a sweep (all axes but the seed) is timed with its first seed's sampling,
+//! once per interleaved round; each visit renders `warmup` untimed frames, then one timed frame
+//! over resources already resident on the device. An A/A control, one configuration visited a
+//! second time per round as if it were another, checks the rule on this machine: the two must
+//! read "equal within noise".
 
 use super::axes::Config;
 use super::run::{Group, Run};
-use super::spec::{Spec, TimingSpec};
+use super::spec::Spec;
+use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, Schedule};
 use crate::fingerprint::fnv1a;
-use crate::metrics::stats::{median, quartiles};
 use crate::render::{Backend, Sampling, View};
-use crate::sampling::rng::pcg;
 use std::collections::BTreeMap;
 
-/// Seed of the visiting order (recorded in the manifest).
-pub const ORDER_SEED: u32 = 0x510e_527f;
-/// Extra visits of the noise probe per round.
-pub const NOISE_VISITS: u32 = 3;
+/// Extra visits of the A/A control per round.
+pub const NOISE_VISITS: u32 = 1;
 
-/// The timed frames of one configuration.
+/// The timed frames of one configuration, one per round in round order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConfigTiming {
     /// Seconds per timed frame, in the order they were taken.
@@ -42,10 +37,9 @@ impl ConfigTiming {
         }
     }
 
-    /// First quartile, median and third quartile of the frame time, in milliseconds.
-    pub fn frame_ms(&self) -> (f64, f64, f64) {
-        let (a, b, c) = quartiles(&self.frame_seconds);
-        (a * 1e3, b * 1e3, c * 1e3)
+    /// Median frame time with its 95 % interval, seconds.
+    pub fn frame(&self, seed: u32) -> Estimate {
+        median_interval(&self.frame_seconds, seed)
     }
 
     /// Wall-clock frames of the given milliseconds: hand-made timings for tests.
@@ -60,39 +54,19 @@ impl ConfigTiming {
 
     /// Median seconds of the primary pass; NaN where the clock cannot split passes.
     pub fn primary_median(&self) -> f64 {
-        median(&self.primary_seconds)
+        crate::metrics::stats::median(&self.primary_seconds)
     }
 }
 
-/// Whether two timings can be ranked: their interquartile ranges are disjoint, and their medians
-/// differ by more than the noise probe's interquartile range (relative to the larger median),
-/// when there is a probe. With five frames each, disjoint ranges alone rank one pair of identical
-/// configurations in five; with the probe's fifteen frames as the floor, one in fifteen (the
-/// simulation in this module's tests).
-/// `Some(true)` when `a` is faster, `Some(false)` when slower, `None` when equal within timing
-/// noise (or untimed).
-pub fn faster(a: &ConfigTiming, b: &ConfigTiming, noise: Option<&ConfigTiming>) -> Option<bool> {
-    let ((a1, am, a3), (b1, bm, b3)) = (a.frame_ms(), b.frame_ms());
-    if am.is_nan() || bm.is_nan() {
-        return None;
+/// The time ratio `a / b` of two configurations timed in the same rounds (paired by round) with
+/// its interval, and the word the rule gives it; NaN and "equal" where either is untimed or
+/// they were not timed in the same rounds.
+pub fn compare(a: &ConfigTiming, b: &ConfigTiming, seed: u32) -> (Estimate, Comparison) {
+    if a.frame_seconds.is_empty() || a.frame_seconds.len() != b.frame_seconds.len() {
+        return (Estimate::NAN, Comparison::Equal);
     }
-    let floor = noise.map_or(0.0, |n| {
-        let (q1, m, q3) = n.frame_ms();
-        if m > 0.0 {
-            (q3 - q1) / m * am.max(bm)
-        } else {
-            0.0
-        }
-    });
-    if (am - bm).abs() <= floor {
-        None
-    } else if a3 < b1 {
-        Some(true)
-    } else if b3 < a1 {
-        Some(false)
-    } else {
-        None
-    }
+    let ratio = paired_ratio(&a.frame_seconds, &b.frame_seconds, seed);
+    (ratio, Comparison::of(&ratio))
 }
 
 /// The timing phase's result.
@@ -100,26 +74,28 @@ pub fn faster(a: &ConfigTiming, b: &ConfigTiming, noise: Option<&ConfigTiming>) 
 pub struct Timings {
     /// Per configuration, keyed by its group key.
     pub configs: BTreeMap<String, ConfigTiming>,
-    /// The noise probe's configuration and its frames.
+    /// The A/A control's configuration and its second series of frames.
     pub noise: Option<(Config, ConfigTiming)>,
+    /// Seed of the visiting order and of every bootstrap interval.
+    pub seed: u32,
 }
 
 /// Key of the timing settings: journaled timings are reused only under the same settings.
-pub fn settings_key(t: &TimingSpec) -> String {
+pub fn settings_key(t: &Schedule) -> String {
     let text = format!(
-        "warmup={};repeats={};order={ORDER_SEED:08x};noise={NOISE_VISITS}",
-        t.warmup, t.repeats
+        "warmup={};repeats={};order={:08x};control={NOISE_VISITS}",
+        t.warmup, t.repeats, t.seed
     );
     format!("{:016x}", fnv1a(text.as_bytes()))
 }
 
-/// Journal key of the noise probe's frames.
+/// Journal key of the A/A control's frames.
 pub fn noise_key(group_key: &str) -> String {
     format!("noise-{group_key}")
 }
 
-/// The configuration whose repeated frames give the noise floor: uniform sampling, per-pixel, at
-/// the figure ray count and the verdict's radius where swept, else the first configuration.
+/// The configuration timed twice as the A/A control: uniform sampling, per-pixel, at the figure
+/// ray count and the verdict's radius where swept, else the first configuration.
 pub fn noise_probe<'a>(groups: &'a [&'a Group], samples: u32, radius: f64) -> Option<&'a Group> {
     groups
         .iter()
@@ -134,19 +110,8 @@ pub fn noise_probe<'a>(groups: &'a [&'a Group], samples: u32, radius: f64) -> Op
         .copied()
 }
 
-/// A visiting order of `n` entries for `round`: Fisher-Yates over a counter-based stream.
-pub fn order(n: usize, round: u32) -> Vec<usize> {
-    let mut v: Vec<usize> = (0..n).collect();
-    let stream = pcg(ORDER_SEED ^ pcg(round));
-    for i in (1..n).rev() {
-        let j = pcg(stream ^ pcg(i as u32)) as usize % (i + 1);
-        v.swap(i, j);
-    }
-    v
-}
-
-/// Times `groups` (each by its first run) and, if `noise` is given, the noise probe, in
-/// interleaved rounds. `keys` are the journal keys of the entries (group keys, then the noise key).
+/// Times `groups` (each by its first run) and, if `noise` is given, the A/A control, in the
+/// schedule's interleaved rounds.
 pub fn time_groups(
     spec: &Spec,
     backend: &mut dyn Backend,
@@ -160,28 +125,27 @@ pub fn time_groups(
         entries.extend((0..NOISE_VISITS).map(|_| (groups.len(), g.head())));
     }
     let mut out = vec![ConfigTiming::empty(); groups.len() + 1];
-    for round in 0..t.repeats {
-        for k in order(entries.len(), round) {
-            let (slot, run) = entries[k];
-            let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
-            let view = View {
-                camera: &scene.cameras[&spec.measure.camera],
-                width: spec.measure.width,
-                height: spec.measure.height,
-            };
-            let sampling = Sampling {
-                scheme: run.scheme,
-                pattern: run.pattern,
-                seed: run.seed,
-            };
-            let timing = backend.time(&scene, view, sampling, t.warmup, 1)?;
-            let c = &mut out[slot];
-            c.frame_seconds.extend(&timing.seconds);
-            c.primary_seconds.extend(&timing.primary_seconds);
-            c.clock = timing.clock.name().to_string();
-            on_frame();
-        }
-    }
+    t.run(entries.len(), |k| -> anyhow::Result<f64> {
+        let (slot, run) = entries[k];
+        let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
+        let view = View {
+            camera: &scene.cameras[&spec.measure.camera],
+            width: spec.measure.width,
+            height: spec.measure.height,
+        };
+        let sampling = Sampling {
+            scheme: run.scheme,
+            pattern: run.pattern,
+            seed: run.seed,
+        };
+        let timing = backend.time(&scene, view, sampling, t.warmup, 1)?;
+        let c = &mut out[slot];
+        c.frame_seconds.extend(&timing.seconds);
+        c.primary_seconds.extend(&timing.primary_seconds);
+        c.clock = timing.clock.name().to_string();
+        on_frame();
+        Ok(timing.seconds.first().copied().unwrap_or(f64::NAN))
+    })?;
     let noise_timing = out.pop().filter(|_| noise.is_some());
     Ok((out, noise_timing))
 }
@@ -195,69 +159,21 @@ mod tests {
     }
 
     #[test]
-    fn ranks_only_disjoint_interquartile_ranges() {
+    fn comparisons_pair_by_round_and_follow_the_rule() {
         let a = timing(&[10.0, 11.0, 12.0, 13.0, 14.0]);
         let b = timing(&[15.0, 16.0, 17.0, 18.0, 19.0]);
-        let overlapping = timing(&[12.5, 13.0, 14.0, 15.0, 30.0]);
-        assert_eq!(faster(&a, &b, None), Some(true));
-        assert_eq!(faster(&b, &a, None), Some(false));
-        assert_eq!(faster(&a, &overlapping, None), None);
-        assert_eq!(faster(&a, &timing(&[]), None), None);
-        // Medians 5 ms apart: ranked under a 20 % noise floor, not under a 40 % one.
-        let probe = |rel: f64| timing(&[-1.0, -0.5, 0.0, 0.5, 1.0].map(|k| 100.0 * (1.0 + k * rel)));
-        assert_eq!(faster(&a, &b, Some(&probe(0.2))), Some(true));
-        assert_eq!(faster(&a, &b, Some(&probe(0.4))), None);
-        let (q1, med, q3) = a.frame_ms();
-        assert!((q1 - 11.0).abs() < 1e-9 && (med - 12.0).abs() < 1e-9 && (q3 - 13.0).abs() < 1e-9);
-        assert!(a.primary_median().is_nan());
-    }
-
-    /// Identical configurations (five frames each from one seeded noise distribution) against a
-    /// probe of fifteen: the noise floor cuts the false rankings that disjoint ranges alone make.
-    #[test]
-    fn identical_configurations_are_rarely_ranked() {
-        let mut draw = {
-            let stream = crate::sampling::Stream::new(11, 0, None);
-            let mut i = 0u32;
-            move || {
-                // Roughly normal (sum of four uniforms) around 50 ms, sd ~ 2.9 ms.
-                let u: f64 = (0..4)
-                    .map(|_| {
-                        i += 1;
-                        stream.unit(i)
-                    })
-                    .sum();
-                50.0 + 5.0 * (u - 2.0)
-            }
-        };
-        let mut frames = |n: usize| timing(&(0..n).map(|_| draw()).collect::<Vec<_>>());
-        let trials = 2000;
-        let (mut alone, mut gated) = (0, 0);
-        for _ in 0..trials {
-            let (a, b, probe) = (frames(5), frames(5), frames(15));
-            alone += faster(&a, &b, None).is_some() as usize;
-            gated += faster(&a, &b, Some(&probe)).is_some() as usize;
-        }
-        let (alone, gated) = (alone as f64 / trials as f64, gated as f64 / trials as f64);
-        eprintln!("identical pairs ranked: {alone} by disjoint ranges alone, {gated} with the floor");
-        assert!(alone > 0.1, "disjoint ranges alone ranked {alone}");
+        assert_eq!(compare(&a, &b, 1).1, Comparison::Faster);
+        assert_eq!(compare(&b, &a, 1).1, Comparison::Slower);
+        let drifting = timing(&[10.0, 20.0, 12.0, 13.0, 14.0]);
+        let same = timing(&[10.5, 19.0, 12.5, 12.5, 14.5]);
+        assert_eq!(compare(&drifting, &same, 1).1, Comparison::Equal);
+        assert_eq!(compare(&a, &timing(&[]), 1).1, Comparison::Equal);
         assert!(
-            gated < 0.08 && gated < alone / 2.0,
-            "with the noise floor {gated} were ranked"
+            compare(&a, &timing(&[1.0, 2.0]), 1).0.median.is_nan(),
+            "not timed in the same rounds"
         );
-    }
-
-    #[test]
-    fn orders_are_permutations_that_differ_between_rounds() {
-        let rounds: Vec<Vec<usize>> = (0..5).map(|r| order(50, r)).collect();
-        for o in &rounds {
-            let mut sorted = o.clone();
-            sorted.sort_unstable();
-            assert_eq!(sorted, (0..50).collect::<Vec<_>>());
-        }
-        assert!(rounds.windows(2).all(|w| w[0] != w[1]));
-        assert_eq!(order(50, 3), rounds[3], "seeded: the same round gives the same order");
-        // Interleaved: the first entry is not always first.
-        assert!(rounds.iter().any(|o| o[0] != 0));
+        let f = a.frame(1);
+        assert!((f.median - 0.012).abs() < 1e-12 && f.lo <= f.median && f.hi >= f.median);
+        assert!(a.primary_median().is_nan());
     }
 }

@@ -385,6 +385,8 @@ impl Backend for GpuBackend {
             hit,
             ambient,
             rays,
+            work: crate::accel::work::Work::ZERO,
+            counted: false,
         })
     }
 

@@ -5,8 +5,9 @@ use super::summary::{find, Summary};
 use super::verdict::Verdict;
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius, Outcome};
-use crate::experiment::sweep::timing::{faster, ConfigTiming};
+use crate::experiment::sweep::timing::{compare, ConfigTiming};
 use crate::experiment::sweep::Spec;
+use crate::experiment::timing::{Comparison, Estimate, RULE};
 use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
@@ -91,6 +92,9 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
             s += "\n";
         }
     }
+    if !outcome.timings.configs.is_empty() {
+        s += &timing_section(outcome);
+    }
     for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
         s += &cost_section(outcome, summaries, &slice, n, radius);
     }
@@ -101,45 +105,69 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     s
 }
 
-/// "12.3 ms [11.9, 12.8]": median and interquartile range of a frame time.
-fn ms_iqr((q1, med, q3): (f64, f64, f64)) -> String {
-    if med.is_finite() {
-        format!("{med:.2} ms [{q1:.2}, {q3:.2}]")
+/// "12.3 ms [11.9, 12.8]": a median frame time (seconds) and its 95 % interval, in ms.
+pub(super) fn ms_ci(frame: &Estimate) -> String {
+    if frame.median.is_finite() {
+        format!("{} ms", frame.scaled(1e3).show(2))
     } else {
         "n/a".into()
     }
 }
 
-/// The noise floor: one configuration's spread over the whole timing phase.
-fn noise_floor(outcome: &Outcome) -> String {
-    let Some((config, t)) = &outcome.timings.noise else {
-        return String::new();
-    };
-    let (q1, med, q3) = t.frame_ms();
-    format!(
-        "Timing: every configuration timed once, with its first seed, in {} interleaved rounds (seeded random order, warm-up frames before each timed frame; clock: {}). Noise floor: one configuration ({} {}, {} rays, light radius {} m) timed {} times across the rounds: median {}, interquartile range {:.1} % of the median. Two configurations are ranked by time only when their interquartile ranges are disjoint and their medians differ by more than this noise floor's interquartile range; otherwise they are equal within timing noise.\n\n",
-        t.frame_seconds.len() / crate::experiment::sweep::timing::NOISE_VISITS as usize,
-        t.clock,
-        config.scheme,
-        config.pattern,
-        config.samples,
-        config.light_radius,
-        t.frame_seconds.len(),
-        ms_iqr((q1, med, q3)),
-        100.0 * (q3 - q1) / med
-    )
+/// How times were taken, the rule that turns them into words, and the A/A control that checks
+/// the rule on this machine: stated once per report.
+fn timing_section(outcome: &Outcome) -> String {
+    let t = &outcome.timings;
+    let some = t.configs.values().next();
+    let mut s = format!(
+        "
+## Timing
+
+Every configuration timed with its first seed, once per round, in {} interleaved rounds (order seed {}, warm-up frames before each timed frame; clock: {}). {RULE}
+
+",
+        some.map_or(0, |c| c.frame_seconds.len()),
+        t.seed,
+        some.map_or("n/a", |c| c.clock.as_str()),
+    );
+    if let Some((config, twin)) = &t.noise {
+        if let Some(first) = outcome
+            .groups
+            .iter()
+            .find(|g| g.config == *config)
+            .and_then(|g| t.configs.get(&g.key))
+        {
+            let (ratio, word) = compare(twin, first, t.seed);
+            s += &format!(
+                "A/A control: one configuration ({} {}, {} rays, light radius {} m) visited twice per round as if it were two; the time ratio of its two series is {}: **{}**{}
+
+",
+                config.scheme,
+                config.pattern,
+                config.samples,
+                config.light_radius,
+                ratio.show(3),
+                word.word(),
+                if word == Comparison::Equal {
+                    ", as it must be."
+                } else {
+                    ". The rule called an unchanged workload different on this machine: read every time comparison below with that in mind."
+                }
+            );
+        }
+    }
+    s
 }
 
-/// How a configuration's frame time ranks against uniform sampling's, by [`faster`] with the
-/// noise probe's floor.
-fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, noise: Option<&ConfigTiming>) -> &'static str {
+/// How a configuration's frame time compares with uniform sampling's (time ratio with its
+/// interval and the rule's word).
+fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, seed: u32) -> String {
     match (x, uniform) {
-        (Some(a), Some(b)) => match faster(a, b, noise) {
-            Some(true) => "faster than uniform",
-            Some(false) => "slower than uniform",
-            None => "equal within timing noise",
-        },
-        _ => "untimed",
+        (Some(a), Some(b)) => {
+            let (ratio, word) = compare(a, b, seed);
+            format!("{}x uniform's time: {}", ratio.show(2), word.word())
+        }
+        _ => "untimed".into(),
     }
 }
 
@@ -175,9 +203,9 @@ fn verdicts(summaries: &[Summary], n: u32, radius: f64) -> Vec<(String, Verdict)
 /// The axes a cost section names; it is written once per value of the others.
 const COST_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
 
-/// What accuracy costs: error and frame time per scheme at the verdict's count, and for each
-/// scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count, ranked
-/// against uniform's time only where [`faster`] can tell them apart.
+/// What accuracy costs: error, frame time and work per scheme at the verdict's count, and for
+/// each scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count,
+/// compared with uniform's time by the rule.
 fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
     let lights = slice.config.lights;
     let more = match slice.label(&[Axis::Lights]) {
@@ -185,10 +213,9 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32,
         l => format!(", {l}"),
     };
     let mut s = format!(
-        "\n## What accuracy costs ({lights} light(s){more})\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [first, third quartile] of the timed frames. `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and how it ranks against uniform@{n}'s.\n\n"
+        "\n## What accuracy costs ({lights} light(s){more})\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [95 % interval] of the timed frames; rays, nodes visited and primitive tests of one frame (deterministic; nodes and tests where the backend counts them). `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and its time against uniform@{n}'s by the rule above.\n\n"
     );
-    s += &noise_floor(outcome);
-    s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays/s @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|---|\n");
+    s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays @{n} | nodes @{n} | tests @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|---|---|---|\n");
     let base = Config {
         pattern: Pattern::PerPixel,
         samples: n,
@@ -211,25 +238,28 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32,
             .filter(|x| x.config.agrees_except(&at.config, &[Axis::Samples]))
             .collect();
         rows.sort_by_key(|x| x.config.samples);
-        let noise = outcome.timings.noise.as_ref().map(|n| &n.1);
+        let seed = outcome.timings.seed;
         let matched = match uniform.filter(|u| u.metrics.rmse.mean.is_finite()) {
             None => "n/a".to_string(),
             Some(u) => rows.iter().find(|x| x.metrics.rmse.mean <= u.metrics.rmse.mean).map_or(
                 "not reached".to_string(),
                 |x| {
-                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), noise);
-                    format!("{} rays, {}, {rank}", x.config.samples, ms_iqr(x.frame_ms()))
+                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), seed);
+                    format!("{} rays, {}, {rank}", x.config.samples, ms_ci(&x.frame))
                 },
             ),
         };
+        let count = |v: Option<u64>| v.map_or("n/a".to_string(), |v| format!("{v:.3e}", v = v as f64));
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             scheme,
             or_na(at.metrics.rmse.mean, |x| format!("{x:.4}")),
             or_na(at.flip.mean, |x| format!("{x:.4}")),
             or_na(at.metrics.penumbra_lost_share.mean, |x| format!("{x:.3}")),
-            ms_iqr(at.frame_ms()),
-            or_na(at.rays_per_s[0], |x| format!("{x:.3e}")),
+            ms_ci(&at.frame),
+            count(at.rays),
+            count(at.work.map(|w| w.nodes)),
+            count(at.work.map(|w| w.primitives)),
             matched
         );
     }
@@ -245,17 +275,18 @@ mod tests {
     }
 
     #[test]
-    fn times_rank_only_beyond_the_noise_floor() {
-        // Disjoint interquartile ranges, medians 4 % apart.
-        let (a, b) = (
-            timing(&[99.0, 99.5, 100.0, 100.5, 101.0]),
-            timing(&[103.0, 103.5, 104.0, 104.5, 105.0]),
+    fn times_are_compared_by_the_rule() {
+        let a = timing(&[99.0, 99.5, 100.0, 100.5, 101.0]);
+        let b = timing(&[103.0, 103.5, 104.0, 104.5, 105.0]);
+        let noisy = timing(&[80.0, 120.0, 100.0, 90.0, 110.0]);
+        assert!(
+            time_rank(Some(&a), Some(&b), 1).ends_with(": faster"),
+            "{}",
+            time_rank(Some(&a), Some(&b), 1)
         );
-        let quiet = timing(&[99.0, 99.5, 100.0, 100.5, 101.0]);
-        let loud = timing(&[80.0, 90.0, 100.0, 110.0, 120.0]);
-        assert_eq!(time_rank(Some(&a), Some(&b), Some(&quiet)), "faster than uniform");
-        assert_eq!(time_rank(Some(&b), Some(&a), Some(&quiet)), "slower than uniform");
-        assert_eq!(time_rank(Some(&a), Some(&b), Some(&loud)), "equal within timing noise");
-        assert_eq!(time_rank(None, Some(&b), Some(&quiet)), "untimed");
+        assert!(time_rank(Some(&b), Some(&a), 1).ends_with(": slower"));
+        assert!(time_rank(Some(&a), Some(&noisy), 1).ends_with(": equal within noise"));
+        assert_eq!(time_rank(None, Some(&b), 1), "untimed");
+        assert_eq!(ms_ci(&Estimate::NAN), "n/a");
     }
 }

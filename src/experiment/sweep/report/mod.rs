@@ -1,6 +1,6 @@
 //! The sweep's outputs: CSV tables, plots, images, the markdown report with its verdict, and the
-//! regression thresholds checked against them. Each file is written atomically, the manifest
-//! last.
+//! regression thresholds checked against them, written into the run's staging folder (the
+//! driver adds the manifest and swaps the set in).
 
 pub mod images;
 pub mod manifest;
@@ -14,14 +14,15 @@ pub mod tables;
 pub mod thresholds;
 pub mod verdict;
 
+use crate::experiment::outputs::Outputs;
 use crate::files::write_atomic;
 use markdown::report;
 use pictures::picture_flip;
 pub use results::Results;
-use std::path::Path;
 
-/// Writes every output under `out`.
-pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
+/// Writes every output into `outputs`.
+pub fn write_all(r: &Results, outputs: &Outputs) -> anyhow::Result<()> {
+    let out = outputs.dir();
     let flip = match r.pictures {
         Some(p) => picture_flip(p)?,
         None => Default::default(),
@@ -33,6 +34,5 @@ pub fn write_all(r: &Results, out: &Path) -> anyhow::Result<()> {
     write_atomic(
         &out.join("report.md"),
         report(r.spec, r.outcome, &summaries, r.adapter, r.seconds).as_bytes(),
-    )?;
-    write_atomic(&out.join("manifest.toml"), manifest::manifest(r).as_bytes())
+    )
 }

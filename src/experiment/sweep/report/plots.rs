@@ -113,7 +113,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
                 true,
             )
         },
-        &series(summaries, at_radius, |s| s.frame_ms().1, |m| m.rmse, 1.0),
+        &series(summaries, at_radius, |s| s.frame.median * 1e3, |m| m.rmse, 1.0),
         &[],
     )?;
     let Some(reference) = r

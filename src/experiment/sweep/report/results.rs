@@ -15,8 +15,6 @@ pub struct Results<'a> {
     pub pictures: Option<&'a Pictures>,
     /// The device.
     pub adapter: &'a AdapterInfo,
-    /// Wall-clock seconds of the sweep.
+    /// Seconds the run has taken so far.
     pub seconds: f64,
-    /// Peak resident memory of the process, if known (bytes).
-    pub peak_rss: Option<u64>,
 }

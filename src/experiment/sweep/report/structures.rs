@@ -1,12 +1,12 @@
 //! "What the structure costs": with an `accelerators` axis, each configuration rendered by
 //! every structure other than the first is set beside the first structure's: whether every
 //! seed's shadow image is the same bit for bit (equal accuracy by construction, not by
-//! metric), and how their frame times compare (ranked only beyond timing noise).
+//! metric), how their frame times compare (by the one timing rule), and the work each did.
 
 use super::summary::{find, Summary};
 use crate::experiment::sweep::axes::Config;
 use crate::experiment::sweep::runner::Outcome;
-use crate::experiment::sweep::timing::faster;
+use crate::experiment::sweep::timing::compare;
 use crate::experiment::sweep::Spec;
 use crate::metrics::stats::median;
 use crate::output::numbers::or_na;
@@ -36,9 +36,8 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
         return String::new();
     }
     let base = &names[0];
-    let noise = outcome.timings.noise.as_ref().map(|(_, t)| t);
     let mut s = format!(
-        "\n## What the acceleration structure costs\n\nEvery configuration rendered with each structure beside `{base}`: seeds whose shadow images are identical bit for bit, and the frame times (median ms [quartiles]); a structure is called faster or slower only beyond timing noise, as above.\n\n| lights | scheme | pattern | rays | radius (m) | structure | same images | frame ms | `{base}` ms | time / `{base}`'s | ranked |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
+        "\n## What the acceleration structure costs\n\nEvery configuration rendered with each structure beside `{base}`: seeds whose shadow images are identical bit for bit, the frame times (median ms [95 % interval]), the time ratio with its interval and the rule's word (see Timing), and the nodes visited and primitives tested in one frame where the backend counts them.\n\n| lights | scheme | pattern | rays | radius (m) | structure | same images | frame ms | `{base}` ms | time / `{base}`'s | word | nodes | `{base}` nodes | tests | `{base}` tests |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let (mut identical, mut compared, mut ratios) = (0, 0, Vec::new());
     for other in summaries.iter().filter(|x| x.config.accelerator != *base) {
@@ -52,32 +51,36 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
         let (same, both) = same_images(outcome, &other.config, &reference);
         identical += same;
         compared += both;
-        let (o, f) = (other.frame_ms(), first.frame_ms());
-        let ratio = o.1 / f.1;
-        if ratio.is_finite() {
-            ratios.push(ratio);
-        }
-        let ranked = match (&other.timing, &first.timing) {
-            (Some(a), Some(b)) => match faster(a, b, noise) {
-                Some(true) => "faster",
-                Some(false) => "slower",
-                None => "equal within noise",
-            },
-            _ => "untimed",
+        let (ratio, word) = match (&other.timing, &first.timing) {
+            (Some(a), Some(b)) => {
+                let (r, w) = compare(a, b, outcome.timings.seed);
+                (r, w.word())
+            }
+            _ => (crate::experiment::timing::Estimate::NAN, "untimed"),
         };
+        if ratio.median.is_finite() {
+            ratios.push(ratio.median);
+        }
         let c = &other.config;
-        let ms = |(q1, m, q3): (f64, f64, f64)| or_na(m, |m| format!("{m:.2} [{q1:.2}, {q3:.2}]"));
+        let ms = |e: &crate::experiment::timing::Estimate| or_na(e.median, |_| e.scaled(1e3).show(2));
+        let count = |w: Option<crate::accel::work::Work>, f: fn(crate::accel::work::Work) -> u64| {
+            w.map_or("n/a".to_string(), |w| format!("{:.3e}", f(w) as f64))
+        };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {same}/{both} | {} | {} | {} | {ranked} |\n",
+            "| {} | {} | {} | {} | {} | {} | {same}/{both} | {} | {} | {} | {word} | {} | {} | {} | {} |\n",
             c.lights,
             c.scheme,
             c.pattern,
             c.samples,
             c.light_radius,
             c.accelerator,
-            ms(o),
-            ms(f),
-            or_na(ratio, |r| format!("{r:.2}x"))
+            ms(&other.frame),
+            ms(&first.frame),
+            or_na(ratio.median, |_| format!("{}x", ratio.show(2))),
+            count(other.work, |w| w.nodes),
+            count(first.work, |w| w.nodes),
+            count(other.work, |w| w.primitives),
+            count(first.work, |w| w.primitives),
         );
     }
     s += &format!(

@@ -1,5 +1,5 @@
 //! summary.csv: the runs of each configuration aggregated over seeds (means with 95 % CIs), its
-//! frame time (median and quartiles of its interleaved timed frames), the per-pixel bias/variance
+//! frame time (median and 95 % interval of its interleaved timed frames), the per-pixel bias/variance
 //! split of the group, and the perceptual error (FLIP) of its Fig. 2 picture where it has one.
 
 use crate::experiment::sweep::axes::Config;
@@ -7,6 +7,7 @@ use crate::experiment::sweep::record::{Aggregated, Metrics, Record, Status};
 use crate::experiment::sweep::run::GroupStats;
 use crate::experiment::sweep::runner::Outcome;
 use crate::experiment::sweep::timing::ConfigTiming;
+use crate::experiment::timing::Estimate;
 use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::table::float;
 use serde::{Serialize, Serializer};
@@ -33,19 +34,16 @@ pub struct Summary {
     pub stats: GroupStats,
     /// Timed frames of the configuration, if timed.
     pub timing: Option<ConfigTiming>,
+    /// Median frame time with its 95 % interval, seconds (NaN when untimed).
+    pub frame: Estimate,
+    /// Rays one frame traced (first seed), where it rendered.
+    pub rays: Option<u64>,
+    /// What one frame's queries cost (first seed), where the backend counts it.
+    pub work: Option<crate::accel::work::Work>,
     /// Rays per second at the median frame time: all, primary, shadow.
     pub rays_per_s: [f64; 3],
     /// FLIP of its pictures over seeds (NaN without pictures).
     pub flip: MeanCi,
-}
-
-impl Summary {
-    /// First quartile, median and third quartile of the frame time (ms); NaN when untimed.
-    pub fn frame_ms(&self) -> (f64, f64, f64) {
-        self.timing
-            .as_ref()
-            .map_or((f64::NAN, f64::NAN, f64::NAN), ConfigTiming::frame_ms)
-    }
 }
 
 /// Summaries of every group of the outcome, in canonical order; `flip` gives the picture errors
@@ -77,6 +75,20 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip) -> Vec<Summary> {
                     - radial(|r| r.radial.exact_umbra_radius).max(0.0),
                 stats: g.clone(),
                 timing: outcome.timings.configs.get(&g.key).cloned(),
+                frame: outcome
+                    .timings
+                    .configs
+                    .get(&g.key)
+                    .map_or(Estimate::NAN, |t| t.frame(outcome.timings.seed)),
+                rays: first.and_then(|r| Some(r.rays.primary_rays? + r.rays.shadow_rays?)),
+                work: first.and_then(|r| {
+                    let c = &r.rays;
+                    Some(crate::accel::work::Work {
+                        queries: c.queries?,
+                        nodes: c.nodes_visited?,
+                        primitives: c.primitive_tests?,
+                    })
+                }),
                 rays_per_s: [
                     radial(|r| r.time.rays_per_s),
                     radial(|r| r.time.primary_rays_per_s),
@@ -107,12 +119,15 @@ struct Head {
 #[derive(Serialize)]
 struct Tail {
     #[serde(with = "float")]
-    frame_ms_median: f64,
+    frame_s: f64,
     #[serde(with = "float")]
-    frame_ms_q1: f64,
+    frame_s_lo: f64,
     #[serde(with = "float")]
-    frame_ms_q3: f64,
+    frame_s_hi: f64,
     timed_frames: Option<usize>,
+    queries: Option<u64>,
+    nodes_visited: Option<u64>,
+    primitive_tests: Option<u64>,
     #[serde(with = "float")]
     rays_per_s: f64,
     #[serde(with = "float")]
@@ -141,14 +156,17 @@ impl Serialize for Summary {
             exact_extent_width: self.exact_extent_width,
             exact_width_10_90: self.exact_width_10_90,
         };
-        let (q1, med, q3) = self.frame_ms();
+        let frame = self.frame;
         let split = &self.stats.split;
         let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] = self.rays_per_s;
         let tail = Tail {
-            frame_ms_median: med,
-            frame_ms_q1: q1,
-            frame_ms_q3: q3,
+            frame_s: frame.median,
+            frame_s_lo: frame.lo,
+            frame_s_hi: frame.hi,
             timed_frames: self.timing.as_ref().map(|t| t.frame_seconds.len()),
+            queries: self.work.map(|w| w.queries),
+            nodes_visited: self.work.map(|w| w.nodes),
+            primitive_tests: self.work.map(|w| w.primitives),
             rays_per_s,
             primary_rays_per_s,
             shadow_rays_per_s,

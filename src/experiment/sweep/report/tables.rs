@@ -88,12 +88,13 @@ fn write_ground_truth(r: &Results, out: &Path) -> anyhow::Result<()> {
 /// A row of timings.csv after its configuration's columns: one timed frame.
 #[derive(Serialize)]
 struct TimedFrame {
-    noise_probe: bool,
-    frame: usize,
+    /// The A/A control's second series of the same configuration.
+    control: bool,
+    round: usize,
     #[serde(with = "float")]
-    frame_ms: f64,
+    frame_s: f64,
     #[serde(with = "float")]
-    primary_ms: f64,
+    primary_s: f64,
     clock: String,
 }
 
@@ -103,16 +104,16 @@ fn write_timings(r: &Results, out: &Path) -> anyhow::Result<()> {
     if t.configs.is_empty() {
         return Ok(());
     }
-    let frames = |config: &Config, noise_probe: bool, c: &ConfigTiming| {
+    let frames = |config: &Config, control: bool, c: &ConfigTiming| {
         c.frame_seconds
             .iter()
             .enumerate()
             .map(|(i, s)| {
                 let frame = TimedFrame {
-                    noise_probe,
-                    frame: i,
-                    frame_ms: s * 1e3,
-                    primary_ms: c.primary_seconds.get(i).map_or(f64::NAN, |p| p * 1e3),
+                    control,
+                    round: i,
+                    frame_s: *s,
+                    primary_s: c.primary_seconds.get(i).copied().unwrap_or(f64::NAN),
                     clock: c.clock.clone(),
                 };
                 (config.clone(), frame)

@@ -1,0 +1,94 @@
+//! The `sweep` command line, shared by every kind, and the errors that choose its exit status.
+
+use super::sweep::filter::{self, Filter};
+use super::sweep::shard::Shard;
+use crate::render::BackendChoice;
+use std::path::PathBuf;
+
+/// Exit statuses, stated in `--help`.
+pub const AFTER_HELP: &str = "Exit status: 0 when every run rendered and the results are written; 2 for bad \
+input (the experiment or scene file, a mesh, a command-line value, an output folder that holds something \
+else), before any work; 3 when some runs failed (their rows say why; the results, or the shard, are \
+written); 4 when --merge is refused (a shard missing, unfinished, duplicated or from another sweep, build \
+or device: the message lists the runs and the shards to rerun; nothing is written); 1 for any other error \
+(no GPU where one was required, a device lost, a file that could not be written). Outputs are written into \
+a staging folder beside the results folder and swapped in only when the run finishes, so a failed or \
+killed run leaves the earlier results whole. Logging: -v and -q raise and lower the level; RUST_LOG \
+(e.g. RUST_LOG=penumbra=debug) overrides both; off a terminal, log lines and progress carry timestamps.
+
+A sweep too big for one machine: run `--shard K/N` for K = 1..N (anywhere that shares the results \
+folder, or copy the shard folders and cache/ back), then `--merge RESULTS/shards/*-of-N` on the same \
+kind of device with the same binary; scripts/slurm/sweep.sbatch and scripts/parallel.sh do both.";
+
+/// Runs an experiment file of any kind (sweep, fps, ao, frames) and writes its results folder.
+#[derive(clap::Parser, Debug, Clone)]
+#[command(name = "sweep", version, after_help = AFTER_HELP)]
+pub struct Cli {
+    /// Experiment file, e.g. experiments/sphere.toml.
+    pub experiment: PathBuf,
+    /// Results folder (default: results/NAME, NAME from the experiment file; with --filter,
+    /// results/NAME--FILTERS, so a subset never replaces the whole sweep's results).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Discard the journal of an interrupted sweep and redo every run; replace a results folder
+    /// that holds another experiment's results.
+    #[arg(long)]
+    pub fresh: bool,
+    /// Override the experiment's backend.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendChoice>,
+    /// Print the expanded runs and the render plan, then exit without rendering.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Run only the K-th of N deterministic shares of the runs (balanced by expected rays) into
+    /// RESULTS/shards/K-of-N/, from which a killed shard resumes; no final outputs.
+    #[arg(long, value_name = "K/N", conflicts_with = "merge")]
+    pub shard: Option<Shard>,
+    /// Merge finished shards into the results, checking that every run is present exactly once:
+    /// N merges RESULTS/shards/1-of-N .. N-of-N, or name shard folders; times the configurations
+    /// and draws the figures here.
+    #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
+    pub merge: Vec<PathBuf>,
+    /// Subset filters; the help text names the axes from the axis list.
+    #[arg(long, value_name = "AXIS=VALUE", help = filter::help())]
+    pub filter: Vec<Filter>,
+    /// More log output (repeatable).
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+    /// Less log output (repeatable).
+    #[arg(short, long, action = clap::ArgAction::Count, conflicts_with = "verbose")]
+    pub quiet: u8,
+}
+
+impl Cli {
+    /// A command line running `experiment` with nothing else set (library callers, tests).
+    pub fn plain(experiment: impl Into<PathBuf>) -> Cli {
+        Cli {
+            experiment: experiment.into(),
+            out: None,
+            fresh: false,
+            backend: None,
+            dry_run: false,
+            shard: None,
+            merge: Vec::new(),
+            filter: Vec::new(),
+            verbose: 0,
+            quiet: 0,
+        }
+    }
+
+    /// Whether it asks for a subset (`--filter`, `--shard`, `--merge`).
+    pub fn asks_subsets(&self) -> bool {
+        !self.filter.is_empty() || self.shard.is_some() || !self.merge.is_empty()
+    }
+}
+
+/// Bad input: exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Some runs failed: exit status 3.
+#[derive(Debug, thiserror::Error)]
+#[error("{0} runs failed; see the `error` column of {1}")]
+pub struct RunsFailed(pub usize, pub String);

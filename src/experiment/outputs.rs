@@ -1,0 +1,274 @@
+//! A results folder replaced as one set. A run writes its outputs into a staging folder beside
+//! the results folder; only when it finishes does [`Outputs::commit`] move the state that
+//! outlives runs (a sweep's journal, ground-truth cache and shards) across and exchange the two
+//! folders in one step (`renameat2(RENAME_EXCHANGE)` on Linux). A failed or killed run leaves
+//! the earlier set whole; a folder never mixes two runs.
+//!
+//! Every output path is checked to stay under the staging folder ([`Outputs::path`]): names
+//! that become paths are plain names ([`super::header::plain_name`]), and this is the backstop.
+
+use anyhow::{bail, Context};
+use std::path::{Component, Path, PathBuf};
+
+/// Entries of a results folder that outlive a run and are carried into the new set.
+pub const KEPT: [&str; 3] = [".journal", "cache", "shards"];
+
+/// Where a run's outputs go until they replace the results folder.
+#[derive(Debug)]
+pub struct Outputs {
+    home: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+/// This host's name, for staging folders on file systems shared by several machines.
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|h| h.trim().to_string())
+        .unwrap_or_else(|_| "host".into())
+}
+
+impl Outputs {
+    /// A fresh staging folder for `home` (`.NAME.staging.HOST.PID` beside it); staging folders
+    /// that killed runs of this host left behind are removed.
+    pub fn begin(home: &Path) -> anyhow::Result<Outputs> {
+        let name = home
+            .file_name()
+            .and_then(|n| n.to_str())
+            .with_context(|| format!("{}: the results folder needs a name", home.display()))?;
+        let parent = home
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+        let prefix = format!(".{name}.staging.{}.", host());
+        if let Ok(entries) = std::fs::read_dir(parent) {
+            for e in entries.flatten() {
+                let n = e.file_name().to_string_lossy().into_owned();
+                let dead = n
+                    .strip_prefix(&prefix)
+                    .and_then(|pid| pid.parse::<u32>().ok())
+                    .is_some_and(|pid| pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists());
+                if dead {
+                    let _ = std::fs::remove_dir_all(e.path());
+                }
+            }
+        }
+        let staging = parent.join(format!("{prefix}{}", std::process::id()));
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).with_context(|| format!("clearing {}", staging.display()))?;
+        }
+        std::fs::create_dir(&staging).with_context(|| format!("creating {}", staging.display()))?;
+        Ok(Outputs {
+            home: home.to_path_buf(),
+            staging,
+            committed: false,
+        })
+    }
+
+    /// The staging folder.
+    pub fn dir(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The results folder this set will replace.
+    pub fn home(&self) -> &Path {
+        &self.home
+    }
+
+    /// `relative` under the staging folder, refused unless it is made of plain components (no
+    /// `..`, no root, no prefix): nothing is written outside the output folder.
+    pub fn path(&self, relative: impl AsRef<Path>) -> anyhow::Result<PathBuf> {
+        let r = relative.as_ref();
+        if r.as_os_str().is_empty() || !r.components().all(|c| matches!(c, Component::Normal(_))) {
+            bail!("refusing to write {}: outside the results folder", r.display());
+        }
+        Ok(self.staging.join(r))
+    }
+
+    /// Replaces the results folder with the staged set, carrying over [`KEPT`] entries.
+    pub fn commit(mut self) -> anyhow::Result<()> {
+        if self.home.is_dir() {
+            for kept in KEPT {
+                let from = self.home.join(kept);
+                if from.exists() {
+                    let to = self.staging.join(kept);
+                    if to.exists() {
+                        std::fs::remove_dir_all(&to)?;
+                    }
+                    std::fs::rename(&from, &to).with_context(|| format!("moving {}", from.display()))?;
+                }
+            }
+            exchange(&self.staging, &self.home)?;
+            // The staging path now holds the earlier set.
+            std::fs::remove_dir_all(&self.staging)
+                .with_context(|| format!("removing the earlier results, now at {}", self.staging.display()))?;
+        } else {
+            std::fs::rename(&self.staging, &self.home)
+                .with_context(|| format!("moving {} to {}", self.staging.display(), self.home.display()))?;
+        }
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
+}
+
+/// Swaps two folders atomically where the system can (Linux), else by two renames.
+fn exchange(a: &Path, b: &Path) -> anyhow::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::ffi::CString;
+        use std::os::unix::ffi::OsStrExt;
+        let (ca, cb) = (
+            CString::new(a.as_os_str().as_bytes())?,
+            CString::new(b.as_os_str().as_bytes())?,
+        );
+        // SAFETY: two valid NUL-terminated paths relative to the current folder.
+        let rc = unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                ca.as_ptr(),
+                libc::AT_FDCWD,
+                cb.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            )
+        };
+        if rc == 0 {
+            return Ok(());
+        }
+    }
+    let aside = a.with_extension("old");
+    std::fs::rename(b, &aside).with_context(|| format!("moving {} aside", b.display()))?;
+    std::fs::rename(a, b).with_context(|| format!("moving {} to {}", a.display(), b.display()))?;
+    std::fs::rename(&aside, a).with_context(|| format!("moving {} back", aside.display()))?;
+    Ok(())
+}
+
+/// Whether `home` may be replaced by a run of experiment `name` of `kind`: yes when it does not
+/// exist, holds only [`KEPT`] state, or holds a manifest of the same experiment; with `fresh`,
+/// also when it holds another experiment's results. A folder with files but no manifest is never
+/// a results folder: it is refused.
+pub fn check_home(home: &Path, kind: &str, name: &str, experiment: &Path, fresh: bool) -> Result<(), String> {
+    let Ok(entries) = std::fs::read_dir(home) else {
+        return if home.exists() {
+            Err(format!("{}: exists and is not a readable folder", home.display()))
+        } else {
+            Ok(())
+        };
+    };
+    let names: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    if names.iter().all(|n| KEPT.contains(&n.as_str())) {
+        return Ok(());
+    }
+    let manifest = home.join("manifest.toml");
+    let Some(table) = std::fs::read_to_string(&manifest)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+    else {
+        return Err(format!(
+            "{} holds files but no readable manifest.toml: not a results folder; choose another --out",
+            home.display()
+        ));
+    };
+    let text = |k: &str| table.get(k).and_then(|v| v.as_str()).map(str::to_string);
+    let same = match (text("kind"), text("name")) {
+        (Some(k), Some(n)) => k == kind && n == name,
+        // A manifest from before kinds were recorded: the same experiment file.
+        _ => table
+            .get("experiment")
+            .and_then(|v| v.as_str().or_else(|| v.get("path").and_then(|p| p.as_str())))
+            .is_some_and(|p| Path::new(p) == experiment),
+    };
+    if same || fresh {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} holds the results of another experiment ({}); pass --fresh to replace them, or choose another --out",
+            home.display(),
+            match (text("kind"), text("name")) {
+                (Some(k), Some(n)) => format!("kind `{k}`, name `{n}`"),
+                _ => "an earlier manifest".into(),
+            }
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_committed_set_replaces_the_old_and_keeps_state() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(home.join("cache")).unwrap();
+        std::fs::write(home.join("cache/gt"), b"cached").unwrap();
+        std::fs::write(home.join("old.csv"), b"old").unwrap();
+        let out = Outputs::begin(&home).unwrap();
+        std::fs::write(out.path("new.csv").unwrap(), b"new").unwrap();
+        assert!(home.join("old.csv").exists(), "nothing replaced before the commit");
+        out.commit().unwrap();
+        assert!(!home.join("old.csv").exists());
+        assert_eq!(std::fs::read(home.join("new.csv")).unwrap(), b"new");
+        assert_eq!(std::fs::read(home.join("cache/gt")).unwrap(), b"cached");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(left.len(), 1, "no staging folder left: {left:?}");
+    }
+
+    #[test]
+    fn an_abandoned_set_leaves_the_old_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(&home).unwrap();
+        std::fs::write(home.join("old.csv"), b"old").unwrap();
+        {
+            let out = Outputs::begin(&home).unwrap();
+            std::fs::write(out.path("new.csv").unwrap(), b"new").unwrap();
+        }
+        assert_eq!(std::fs::read(home.join("old.csv")).unwrap(), b"old");
+        assert!(!home.join("new.csv").exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn paths_stay_under_the_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = Outputs::begin(&dir.path().join("r")).unwrap();
+        for bad in ["../x", "/abs", "a/../../b", "", "."] {
+            assert!(out.path(bad).is_err(), "{bad}");
+        }
+        assert!(out.path("images/a.png").unwrap().starts_with(out.dir()));
+    }
+
+    #[test]
+    fn homes_holding_something_else_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        let e = Path::new("e.toml");
+        assert!(check_home(&home, "ao", "r", e, false).is_ok(), "new folder");
+        std::fs::create_dir_all(home.join(".journal")).unwrap();
+        assert!(check_home(&home, "ao", "r", e, false).is_ok(), "state only");
+        std::fs::write(home.join("notes.txt"), b"mine").unwrap();
+        assert!(check_home(&home, "ao", "r", e, true).is_err(), "no manifest: never");
+        std::fs::write(home.join("manifest.toml"), "kind = \"sweep\"\nname = \"r\"\n").unwrap();
+        assert!(check_home(&home, "ao", "r", e, false).is_err(), "another kind");
+        assert!(check_home(&home, "ao", "r", e, true).is_ok(), "--fresh replaces it");
+        assert!(check_home(&home, "sweep", "r", e, false).is_ok(), "the same experiment");
+        std::fs::write(home.join("manifest.toml"), "experiment = \"e.toml\"\n").unwrap();
+        assert!(
+            check_home(&home, "ao", "r", e, false).is_ok(),
+            "an older manifest of the same file"
+        );
+        assert!(check_home(&home, "ao", "r", Path::new("f.toml"), false).is_err());
+    }
+}

@@ -1,0 +1,170 @@
+//! The sweep as an experiment kind: a whole sweep, a shard's share of it (`--shard`), or the
+//! merge of finished shards (`--merge`), then the figures and the outputs.
+
+use super::filter;
+use super::merge::{merge_shards, MergePlan};
+use super::pictures::render_pictures;
+use super::report::{write_all, Results};
+use super::run::expand;
+use super::runner::{dry_run, run_sweep, verdict_radius};
+use super::shard::{self, run_shard, Shard};
+use super::Spec;
+use crate::experiment::cli::{BadInput, Cli};
+use crate::experiment::header::Header;
+use crate::experiment::{Accepts, Experiment, Finished, Run};
+use anyhow::Context;
+use clap::ValueEnum;
+use std::path::{Path, PathBuf};
+use tracing::info;
+
+impl Spec {
+    /// This sweep restricted by the command line's filters.
+    fn for_cli(&self, cli: &Cli) -> anyhow::Result<Spec> {
+        Ok(self.clone().filtered(&cli.filter).map_err(BadInput)?)
+    }
+}
+
+impl Experiment for Spec {
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    fn accepts(&self) -> Accepts {
+        Accepts {
+            subsets: true,
+            gpu: true,
+        }
+    }
+
+    fn inputs(&self) -> Vec<PathBuf> {
+        let mut v = vec![self.path.clone(), self.scene_path.clone()];
+        v.extend(self.scene.meshes().map(|m| PathBuf::from(&m.source)));
+        v
+    }
+
+    fn dry_run(&self, cli: &Cli) -> anyhow::Result<String> {
+        let spec = self.for_cli(cli)?;
+        Ok(match cli.shard {
+            Some(s) => shard::dry_run(&spec, s),
+            None => dry_run(&spec)?,
+        })
+    }
+
+    fn folder(&self, cli: &Cli) -> anyhow::Result<String> {
+        self.for_cli(cli)?;
+        Ok(match cli.filter.as_slice() {
+            [] => self.name.clone(),
+            f => format!("{}--{}", self.name, filter::label(f)),
+        })
+    }
+
+    fn run(&self, run: &mut Run) -> anyhow::Result<Finished> {
+        let spec = self.for_cli(run.cli)?;
+        let cli = run.cli;
+        info!("{} runs", expand(&spec).iter().map(|g| g.runs.len()).sum::<usize>());
+        if let Some(s) = cli.shard {
+            let done = run_shard(&spec, run.backend, s, run.home, cli.fresh, run.progress)?;
+            let m = &done.manifest;
+            info!(
+                "shard {s}: {} runs ({} failed, {} groups resumed) in {:.1} s; wrote {}",
+                m.runs,
+                m.failed,
+                m.resumed,
+                m.seconds,
+                done.dir.display()
+            );
+            let table = done.dir.join(shard::RECORDS).display().to_string();
+            return Ok(Finished::Shard {
+                failed: Some((m.failed, table)),
+            });
+        }
+        let outcome = if cli.merge.is_empty() {
+            run_sweep(
+                &spec,
+                run.backend,
+                &run.home.join(".journal"),
+                &run.home.join("cache"),
+                cli.fresh,
+                run.progress,
+            )?
+        } else {
+            let (dirs, split) = shard_dirs(&cli.merge, run.home)?;
+            let plan = MergePlan {
+                dirs: &dirs,
+                split,
+                rerun: &rerun_command(cli),
+                fresh: cli.fresh,
+            };
+            merge_shards(&spec, run.backend, &plan, run.home, run.progress)?
+        };
+        info!("render plan of a run:\n{}", outcome.plan);
+        let pictures =
+            render_pictures(&spec, run.backend, verdict_radius(&spec)).context("rendering the figures' pictures")?;
+        let adapter = run.backend.adapter().clone();
+        let results = Results {
+            spec: &spec,
+            outcome: &outcome,
+            pictures: pictures.as_ref(),
+            adapter: &adapter,
+            seconds: run.started.elapsed().as_secs_f64(),
+        };
+        write_all(&results, run.out)?;
+        info!(
+            "{} runs ({} failed, {} groups resumed)",
+            outcome.records.len(),
+            outcome.failures,
+            outcome.resumed
+        );
+        Ok(Finished::Results {
+            details: super::report::manifest::details(&results),
+            failed: Some((outcome.failures, run.home.join("runs.csv").display().to_string())),
+        })
+    }
+}
+
+/// The shard folders `--merge` names, and N where it was given: a number alone stands for
+/// every shard of an N-way split under the results folder `out`.
+fn shard_dirs(merge: &[PathBuf], out: &Path) -> anyhow::Result<(Vec<PathBuf>, Option<u32>)> {
+    let count = match merge {
+        [one] => one.to_str().and_then(|s| s.parse::<u32>().ok()),
+        _ => None,
+    };
+    match count {
+        Some(0) => Err(BadInput("--merge N needs N >= 1".into()).into()),
+        Some(n) if n > shard::MAX_SHARDS => {
+            Err(BadInput(format!("--merge N: at most {} shards", shard::MAX_SHARDS)).into())
+        }
+        Some(n) => Ok((
+            (1..=n).map(|index| Shard { index, count: n }.dir(out)).collect(),
+            Some(n),
+        )),
+        None => Ok((merge.to_vec(), None)),
+    }
+}
+
+/// `text` as one shell word.
+fn shell_word(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-=,:+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
+    }
+}
+
+/// How to rerun one shard of this sweep, for the merge's refusal.
+fn rerun_command(cli: &Cli) -> String {
+    let mut words = vec!["sweep".to_string(), cli.experiment.display().to_string()];
+    if let Some(out) = &cli.out {
+        words.extend(["--out".into(), out.display().to_string()]);
+    }
+    if let Some(b) = cli.backend {
+        let name = b.to_possible_value().expect("a named value").get_name().to_string();
+        words.extend(["--backend".into(), name]);
+    }
+    for f in &cli.filter {
+        words.extend(["--filter".into(), format!("{}={}", f.axis.name(), f.value)]);
+    }
+    words.push("--shard".into());
+    words.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" ")
+}

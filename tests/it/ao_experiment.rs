@@ -1,0 +1,94 @@
+//! The ambient-occlusion experiment kind (`kind = "ao"`): experiments/ao-ci.toml through the
+//! binary (two meshes, every structure including brute force, the kd-tree and the field tuned
+//! per mesh) writes its tables, images, plot and report, and every structure's AO image is
+//! brute force's bit for bit; bad input is a
+//! located error with exit status 2 and writes nothing; the verdict says when images differ.
+
+use crate::common;
+
+use penumbra::experiment::ao::report::verdict;
+use penumbra::experiment::ao::{run_ao, AoSpec};
+use penumbra::experiment::progress::Progress;
+use penumbra::render::cpu::CpuBackend;
+use std::ffi::OsStr;
+
+#[test]
+fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ao-ci");
+    let exp = common::repo("experiments/ao-ci.toml");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(out.join("ao.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(csv.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 2 * 4, "{csv}");
+    for r in &rows {
+        assert_eq!(&r[col("same_image_as_first")], "true", "{csv}");
+        assert!(r[col("receivers")].parse::<usize>().unwrap() > 50, "{csv}");
+        assert!(r[col("ao_rays")].parse::<u64>().unwrap() == 33 * r[col("receivers")].parse::<u64>().unwrap());
+    }
+    for file in [
+        "report.md",
+        "manifest.toml",
+        "images/cow.png",
+        "images/mech-holes-shark.png",
+        "plots/frame_time.png",
+    ] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
+    assert!(
+        report.contains("the paper: 1.80-2.51x") && report.contains("Cow (5.8K)"),
+        "{report}"
+    );
+}
+
+#[test]
+fn bad_input_is_located_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::repo("experiments/ao-ci.toml"))
+        .unwrap()
+        .replace("../assets/", &format!("{}/", common::repo("assets").display()));
+    for (edit, key) in [
+        (text.replace("\"vlf\", \"bvh\"", "\"vlf\", \"octree\""), "structures[2]"),
+        (text.replace("rays = 33", "rays = 34"), "rays"),
+        (text.replace("repeats = 5", "repeats = 2"), "timing.repeats"),
+        (text.replace("cow.off", "no-such.off"), "meshes[0].path"),
+        (text.replace("depth = [2, 4]", "depth = [2, 9]"), "accel.vlf.depth"),
+    ] {
+        common::rejected_at(dir.path(), &edit, key);
+    }
+}
+
+#[test]
+fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
+    let spec = AoSpec::load(&common::repo("experiments/ao-ci.toml")).unwrap();
+    let mut small = spec.clone();
+    small.meshes.truncate(1);
+    small.structures.retain(|(s, _)| ["kdtree", "vlf"].contains(s));
+    small.width = 8;
+    small.height = 8;
+    let (mut rows, _) = run_ao(&small, &mut CpuBackend::default(), &Progress::default()).unwrap();
+    assert!(verdict(&small, &rows).contains("equals"));
+    rows[1].same_image = false;
+    assert!(verdict(&small, &rows).contains("does NOT equal"));
+    // Speed-ups from hand-set frame times, paired by round: apart, and within noise.
+    rows[0].frame_seconds = vec![2.0, 2.1, 1.9, 2.0, 2.0];
+    rows[1].frame_seconds = vec![1.0, 1.1, 0.9, 1.0, 1.0];
+    let v = verdict(&small, &rows);
+    assert!(
+        v.contains("faster on 1 of 1 meshes, slower on 0, equal within noise on 0") && v.contains("cow 2.00 ["),
+        "{v}"
+    );
+    rows[1].frame_seconds = vec![1.9, 2.2, 1.8, 2.1, 2.0];
+    let v = verdict(&small, &rows);
+    assert!(
+        v.contains("faster on 0 of 1 meshes, slower on 0, equal within noise on 1")
+            && v.contains("(equal within noise)"),
+        "{v}"
+    );
+}

@@ -1,0 +1,205 @@
+//! Shared test fixtures: the GPU backend (opened once per test binary), scene paths, and the
+//! seeded ray generators of the visibility-field tests ([`rays`]).
+#![allow(dead_code)]
+
+use penumbra::render::gpu::GpuBackend;
+use std::path::PathBuf;
+use std::sync::{Mutex, OnceLock};
+
+pub mod rays;
+pub mod updates;
+
+/// The GPU backend, or `None` with a note when no adapter exists. Where the environment sets
+/// `PENUMBRA_REQUIRE_GPU=1` (CI installs lavapipe and does), a missing adapter fails the test.
+pub fn gpu() -> Option<std::sync::MutexGuard<'static, GpuBackend>> {
+    static GPU: OnceLock<Option<Mutex<GpuBackend>>> = OnceLock::new();
+    let slot = GPU.get_or_init(|| match GpuBackend::new() {
+        Ok(g) => Some(Mutex::new(g)),
+        Err(e) => {
+            if std::env::var("PENUMBRA_REQUIRE_GPU").as_deref() == Ok("1") {
+                panic!("PENUMBRA_REQUIRE_GPU=1 but: {e}");
+            }
+            eprintln!("skipping GPU checks: {e}");
+            None
+        }
+    });
+    slot.as_ref().map(|m| m.lock().unwrap_or_else(|p| p.into_inner()))
+}
+
+/// A shipped OFF mesh's triangles as loaded (file units, assets/meshes), degenerate ones
+/// dropped; every triangle of object 0.
+pub fn off_mesh(name: &str) -> penumbra::mesh::Triangles {
+    let file = penumbra::mesh::load(&repo(&format!("assets/meshes/{name}.off"))).unwrap();
+    let (positions, _) = penumbra::mesh::clean(file.triangles, &glam::DMat4::IDENTITY);
+    assert!(!positions.is_empty(), "{name}: no triangles");
+    penumbra::mesh::Triangles {
+        object_of: vec![0; positions.len()],
+        positions,
+    }
+}
+
+/// Earlier results of the sweep named `name` in `out`: a runs.csv reading "earlier results" and
+/// a manifest naming the experiment, so later runs recognise the folder as theirs.
+pub fn earlier_results(out: &std::path::Path, name: &str) {
+    std::fs::create_dir_all(out).unwrap();
+    std::fs::write(out.join("runs.csv"), "earlier results\n").unwrap();
+    std::fs::write(
+        out.join("manifest.toml"),
+        format!("schema = 2\nkind = \"sweep\"\nname = \"{name}\"\n"),
+    )
+    .unwrap();
+}
+
+/// Path of a file in the repository.
+pub fn repo(path: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// A tiny experiment over the sphere scene, written into `dir` with the scene beside it;
+/// `edit` may change the experiment text first. Returns the experiment path.
+pub fn tiny_experiment(dir: &std::path::Path, edit: impl Fn(String) -> String) -> PathBuf {
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::copy(repo("experiments/scenes/sphere.toml"), dir.join("scenes/sphere.toml")).unwrap();
+    let text = r#"name = "tiny"
+scene = "scenes/sphere.toml"
+
+[measure]
+camera = "measure"
+width = 24
+height = 24
+
+[sweep]
+schemes = ["uniform", "paper"]
+patterns = ["per-pixel", "shared"]
+samples = [4, 16]
+light_radii = [0.02]
+seeds = [1, 2]
+
+[ground_truth]
+samples = 256
+
+[timing]
+warmup = 0
+repeats = 0
+"#;
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, edit(text.to_string())).unwrap();
+    path
+}
+
+/// Runs experiment `text` (written to DIR/bad.toml) and checks it is refused as bad input at
+/// `key`: exit status 2, the file and key named, nothing written.
+pub fn rejected_at(dir: &std::path::Path, text: &str, key: &str) {
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let (code, err) = sweep(&[path.as_os_str(), std::ffi::OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 2, "{key}: {err}");
+    assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
+    assert!(!out.exists(), "{key}: wrote {}", out.display());
+}
+
+/// Runs the `sweep` binary; returns (exit code, stderr).
+pub fn sweep(args: &[&std::ffi::OsStr]) -> (i32, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Scene TOML for the receiver every test scene shares: the ground plane z = 0 and a one-sided
+/// disk light of `radius` metres 2 m above the origin, facing down.
+pub fn plane_and_light(radius: f64) -> String {
+    format!(
+        r#"
+[[planes]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+albedo = 0.8
+
+[[lights]]
+type = "disk"
+center = [0.0, 0.0, 2.0]
+normal = [0.0, 0.0, -1.0]
+radius = {radius}
+power = 60.0
+samples = 16
+"#
+    )
+}
+
+/// Scene TOML of one OBJ mesh (`obj`, relative to the scene file) under the shared receiver and
+/// light, seen by an orthographic measuring camera 0.6 m wide looking straight down.
+pub fn mesh_over_plane(obj: &str, light_radius: f64) -> String {
+    format!(
+        r#"
+[cameras.measure]
+projection = "orthographic"
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+width = 0.6
+
+[[meshes]]
+path = "{obj}"
+albedo = 0.7
+"#
+    ) + &plane_and_light(light_radius)
+}
+
+/// A scene of `triangles` alone (one mesh, every triangle its own), indexed by structure
+/// `name`: what the structure tests probe.
+pub fn triangles_scene(triangles: &penumbra::mesh::Triangles, name: &'static str) -> penumbra::scene::Scene {
+    let mesh = penumbra::scene::Mesh {
+        source: "test".into(),
+        file_fnv1a: 0,
+        albedo: 0.5,
+        mirror: 0.0,
+        triangles: triangles.positions.len(),
+        skipped: Default::default(),
+    };
+    penumbra::scene::Scene::analytic(vec![], vec![], vec![]).with_meshes(
+        vec![mesh],
+        penumbra::mesh::Triangles {
+            positions: triangles.positions.clone(),
+            object_of: vec![0; triangles.positions.len()],
+        },
+        penumbra::accel::AccelSettings::named(name).expect("a registered structure"),
+    )
+}
+
+/// A CPU backend that fails every render with seed 2: the runner's failure path, in sweeps and
+/// through shards.
+pub struct Flaky(pub penumbra::render::cpu::CpuBackend);
+
+impl penumbra::render::Backend for Flaky {
+    fn adapter(&self) -> &penumbra::render::AdapterInfo {
+        self.0.adapter()
+    }
+    fn dispatches(&self) -> u64 {
+        self.0.dispatches()
+    }
+    fn render(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+    ) -> anyhow::Result<penumbra::render::Frame> {
+        anyhow::ensure!(s.seed != 2, "simulated device loss");
+        self.0.render(scene, view, s)
+    }
+    fn time(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<penumbra::render::Timing> {
+        self.0.time(scene, view, s, warmup, repeats)
+    }
+}

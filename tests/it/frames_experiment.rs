@@ -1,0 +1,307 @@
+//! The frame-time experiment kind (`kind = "frames"`) through the binary: the CI walkthrough
+//! (experiments/frames-ci.toml) and small scaling and dynamic variants of it write their tables,
+//! plots, strips and reports, and every structure, including brute force, renders every frame
+//! identically: the committed threshold is zero differing pixels, static or moving. Bad input is
+//! a located error with exit status 2 that writes nothing.
+
+use crate::common;
+
+use std::ffi::OsStr;
+use std::path::Path;
+
+/// Runs `text` as an experiment; returns frames.csv as (header, rows) and the report.
+fn run(dir: &Path, text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>, String) {
+    let exp = dir.join("exp.toml");
+    std::fs::write(&exp, text).unwrap();
+    let out = dir.join("out");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    let mut reader = csv::Reader::from_path(out.join("frames.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let rows = reader.records().map(Result::unwrap).collect();
+    (header, rows, std::fs::read_to_string(out.join("report.md")).unwrap())
+}
+
+fn ci() -> String {
+    std::fs::read_to_string(common::repo("experiments/frames-ci.toml")).unwrap()
+}
+
+#[test]
+fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let (header, rows, report) = run(dir.path(), &ci());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
+    for r in &rows {
+        let same_frame: Vec<&csv::StringRecord> = rows
+            .iter()
+            .filter(|o| o[col("shading")] == r[col("shading")] && o[col("frame")] == r[col("frame")])
+            .collect();
+        assert!(
+            same_frame.iter().all(|o| o[col("rays")] == r[col("rays")]),
+            "every structure traces the same rays"
+        );
+        // Whitted's bound: camera rays, a shadow ray per light at the hit, and per bounce (3) a
+        // reflected ray and a shadow ray per light (4).
+        assert!(
+            r[col("rays")].parse::<u64>().unwrap() <= 32 * 32 * (1 + 4 + 3 * 5),
+            "{r:?}"
+        );
+    }
+    for r in &rows {
+        assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
+        let rays: u64 = r[col("rays")].parse().unwrap();
+        match &r[col("shading")] {
+            "opengl" => assert_eq!(rays, 32 * 32, "OpenGL-like shading traces camera rays only"),
+            _ => assert!(
+                rays > 4 * 32 * 32,
+                "Whitted: shadow rays to 4 lights and reflections; {rays}"
+            ),
+        }
+        assert!(r[col("frame_s")].parse::<f64>().unwrap() > 0.0);
+    }
+    let out = dir.path().join("out");
+    for file in [
+        "builds.csv",
+        "manifest.toml",
+        "plots/frame_time_opengl.png",
+        "plots/frame_time_whitted.png",
+        "images/strip_opengl.png",
+        "images/strip_whitted.png",
+    ] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    assert!(
+        report.contains("equals the first structure's pixel for pixel"),
+        "{report}"
+    );
+    assert!(
+        report.contains("Is `vlf` faster than `kdtree` (the paper's baseline), whitted shading?"),
+        "{report}"
+    );
+    assert!(
+        !out.join("plots/scaling_opengl.png").exists(),
+        "one scene size: no scaling plot"
+    );
+}
+
+#[test]
+fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = ci()
+        .replace(
+            "generator = \"classroom\"",
+            "generator = \"random-triangles\"\ntriangles = [300, 2400]\nseed = 5",
+        )
+        .replace("frames = 3", "frames = 2\nviewpoints = [\"outside\", \"inside\"]")
+        .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]");
+    let (header, rows, report) = run(dir.path(), &text);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 2 * 2 * 4, "sizes x viewpoints x frames x structures");
+    assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
+    for file in ["plots/scaling_opengl.png", "plots/memory.png", "plots/build_time.png"] {
+        assert!(dir.path().join("out").join(file).exists(), "{file} missing");
+    }
+    assert!(report.contains("median frame time grows as kdtree N^"), "{report}");
+    assert!(report.contains("Memory grows as"), "{report}");
+    assert!(!report.contains("NaN"), "{report}");
+}
+
+#[test]
+fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    // Every camera of the walk looks at the teacher's desk while the chrome ball rolls on it.
+    let text = ci().replace(
+        "[path]\nframes = 3",
+        "[path]\nframes = 3\nlook_at = [-3.5, 0.0, 0.9]\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, -0.05, 0.0]",
+    );
+    let (header, rows, report) = run(dir.path(), &text);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let methods: Vec<String> = rows
+        .iter()
+        .map(|r| format!("{} {}", &r[col("structure")], &r[col("update")]))
+        .collect();
+    for m in [
+        "kdtree rebuild",
+        "vlf update",
+        "bvh rebuild",
+        "bvh rebuild-fastest",
+        "bvh refit",
+        "brute rebuild",
+    ] {
+        assert!(methods.iter().any(|x| x == m), "{m} missing: {methods:?}");
+    }
+    assert_eq!(rows.len(), 2 * 3 * 6);
+    for r in &rows {
+        assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
+        assert!(r[col("update_s")].parse::<f64>().unwrap() > 0.0, "{r:?}");
+    }
+    assert!(
+        report.contains("Is `vlf (update)` cheaper than `bvh (refit)`?"),
+        "{report}"
+    );
+    assert!(dir.path().join("out/plots/update_time_whitted.png").exists());
+}
+
+#[test]
+fn bad_input_is_located_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = ci();
+    let random = text.replace(
+        "generator = \"classroom\"",
+        "generator = \"random-triangles\"\ntriangles = [300, 2400]",
+    );
+    for (edit, key) in [
+        (
+            text.replace("generator = \"classroom\"", "generator = \"office\""),
+            "scene.generator",
+        ),
+        (
+            text.replace("\"bvh\", \"brute\"", "\"bvh\", \"octree\""),
+            "structures[3]",
+        ),
+        (
+            text.replace("\"opengl\", \"whitted\"", "\"opengl\", \"opengl\""),
+            "shadings[1]",
+        ),
+        (text.replace("mirror_depth = 3", "mirror_depth = 0"), "mirror_depth"),
+        (text.replace("frames = 3", "frames = 0"), "path.frames"),
+        (text.replace("depth = 3", "depth = 9"), "accel.vlf.depth"),
+        (
+            text.replace(
+                "frames = 3",
+                "frames = 3\n\n[motion]\npart = \"piano\"\nstep = [0.0, 0.0, 0.1]",
+            ),
+            "motion.part",
+        ),
+        (
+            text.replace(
+                "generator = \"classroom\"",
+                "generator = \"classroom\"\ntriangles = [10]",
+            ),
+            "scene.triangles",
+        ),
+        (random.replace("[300, 2400]", "[2400, 300]"), "scene.triangles[1]"),
+        (random.clone(), "path.viewpoints"),
+        (
+            text.replace("frames = 3", "frames = 3\nlook_at = [-4.2, 0.0, 1.6]"),
+            "path.look_at",
+        ),
+        (
+            text.replace(
+                "frames = 3",
+                "frames = 3\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, 0.0, 1.0]",
+            ),
+            "motion.step",
+        ),
+        (text.replace("strip = 3", "strip = 0"), "strip"),
+        (
+            random.replace("frames = 3", "frames = 3\nviewpoints = [\"above\"]"),
+            "path.viewpoints[0]",
+        ),
+    ] {
+        common::rejected_at(dir.path(), &edit, key);
+    }
+    let exp = common::repo("experiments/frames-ci.toml");
+    let out = dir.path().join("gpu");
+    let (code, err) = common::sweep(&[
+        exp.as_os_str(),
+        OsStr::new("--backend"),
+        OsStr::new("gpu"),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("CPU backend"), "{err}");
+    assert!(!out.exists());
+}
+
+/// The verdict is computed from the rows: a structure whose frames differ fails exactness by
+/// name, and "is `vlf` faster" reads yes, no or not clearly from the interval of the median of
+/// per-frame ratios.
+#[test]
+fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
+    use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
+    use penumbra::experiment::frames::spec::ShadingName;
+    use penumbra::experiment::frames::verdict::verdict;
+    let mut spec = penumbra::experiment::frames::FramesSpec::load(&common::repo("experiments/frames-ci.toml")).unwrap();
+    spec.shadings.truncate(1);
+    let row = |structure: &'static str, frame: u32, seconds: f64, differing_pixels: usize| FrameRow {
+        triangles: 100,
+        structure,
+        update: "none",
+        shading: ShadingName::Opengl,
+        viewpoint: "walk".into(),
+        frame,
+        seconds,
+        renders: 3,
+        update_seconds: None,
+        rays: 10,
+        work: Default::default(),
+        differing_pixels,
+    };
+    // kd-tree about 2x slower than the field on every frame; the BVH faster on half the
+    // frames, slower on the other half.
+    let mut frames = Vec::new();
+    for f in 0..8 {
+        frames.push(row("kdtree", f, 2.0 + 0.01 * f as f64, 0));
+        frames.push(row("vlf", f, 1.0, if f == 2 { 7 } else { 0 }));
+        frames.push(row("bvh", f, if f % 2 == 0 { 1.5 } else { 0.5 }, 0));
+    }
+    let outcome = FramesOutcome {
+        frames,
+        ..Default::default()
+    };
+    let v = verdict(&spec, &outcome);
+    assert!(
+        v.contains("Exactness FAILED") && v.contains("vlf: 7 pixels on 1 frames (at most 7)"),
+        "{v}"
+    );
+    assert!(
+        v.contains("Is `vlf` faster than `kdtree` (the paper's baseline), opengl shading?** **yes**"),
+        "{v}"
+    );
+    assert!(v.contains("faster on 8 of 8 frames"), "{v}");
+    assert!(
+        v.contains("Is `vlf` faster than `bvh`, opengl shading?** **not clearly**"),
+        "{v}"
+    );
+    assert!(v.contains("faster on 4 of 8 frames"), "{v}");
+    frames_all_slower(&spec);
+}
+
+/// Every frame slower reads "no".
+fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
+    use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
+    use penumbra::experiment::frames::spec::ShadingName;
+    use penumbra::experiment::frames::verdict::verdict;
+    let frames = (0..8)
+        .flat_map(|f| {
+            [("kdtree", 0.5), ("vlf", 1.0 + 0.01 * f as f64)].map(|(structure, seconds)| FrameRow {
+                triangles: 100,
+                structure,
+                update: "none",
+                shading: ShadingName::Opengl,
+                viewpoint: "walk".into(),
+                frame: f,
+                seconds,
+                renders: 3,
+                update_seconds: None,
+                rays: 10,
+                work: Default::default(),
+                differing_pixels: 0,
+            })
+        })
+        .collect();
+    let v = verdict(
+        spec,
+        &FramesOutcome {
+            frames,
+            ..Default::default()
+        },
+    );
+    assert!(
+        v.contains("opengl shading?** **no**") && v.contains("- **Exactness**: every structure"),
+        "{v}"
+    );
+}

@@ -1,0 +1,172 @@
+//! The timing phase, against a backend whose clock drifts: every configuration is timed once
+//! (not once per seed) in interleaved rounds with warm-up frames, the A/A control is visited
+//! every round, drift does not rank configurations that do the same work, and a resumed sweep
+//! reuses the journaled timings.
+
+use crate::common;
+
+use penumbra::experiment::progress::Progress;
+use penumbra::experiment::sweep::timing::{compare, NOISE_VISITS};
+use penumbra::experiment::sweep::{run_sweep, Spec};
+use penumbra::experiment::timing::Comparison;
+use penumbra::render::cpu::CpuBackend;
+use penumbra::render::{AdapterInfo, Backend, Clock, Frame, Sampling, Timing, View};
+use penumbra::sampling::DiskScheme;
+use penumbra::scene::Scene;
+
+/// Renders on the CPU; `time` returns 10 ms plus a drift of 0.1 ms per call, and logs its calls.
+struct Drifting {
+    cpu: CpuBackend,
+    calls: Vec<(Sampling, u32, u32, u32)>,
+}
+
+impl Backend for Drifting {
+    fn adapter(&self) -> &AdapterInfo {
+        self.cpu.adapter()
+    }
+    fn dispatches(&self) -> u64 {
+        self.cpu.dispatches()
+    }
+    fn render(&mut self, scene: &Scene, view: View, s: Sampling) -> anyhow::Result<Frame> {
+        self.cpu.render(scene, view, s)
+    }
+    fn time(&mut self, scene: &Scene, _: View, s: Sampling, warmup: u32, repeats: u32) -> anyhow::Result<Timing> {
+        let samples = match &scene.lights[0] {
+            penumbra::scene::Light::Disk(d) => d.samples,
+            _ => 1,
+        };
+        self.calls.push((s, samples, warmup, repeats));
+        let t = 10e-3 + 1e-4 * self.calls.len() as f64;
+        Ok(Timing {
+            seconds: vec![t; repeats as usize],
+            primary_seconds: vec![],
+            clock: Clock::WallClock,
+        })
+    }
+}
+
+#[test]
+fn configurations_are_timed_once_in_interleaved_rounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| {
+        t.replace("warmup = 0\nrepeats = 0", "warmup = 2\nrepeats = 5")
+    });
+    let spec = Spec::load(&exp).unwrap();
+    let mut backend = Drifting {
+        cpu: CpuBackend::default(),
+        calls: vec![],
+    };
+    let (journal, cache) = (dir.path().join("j"), dir.path().join("c"));
+    let out = run_sweep(&spec, &mut backend, &journal, &cache, true, &Progress::default()).unwrap();
+    // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 5 rounds,
+    // plus the A/A control's visits.
+    let configs = 8;
+    let per_round = configs + NOISE_VISITS as usize;
+    assert_eq!(backend.calls.len(), 5 * per_round);
+    assert!(
+        backend.calls.iter().all(|c| c.2 == 2 && c.3 == 1),
+        "warm-up frames, one timed frame"
+    );
+    assert!(
+        backend.calls.iter().all(|c| c.0.seed == 1),
+        "timed with the first seed only"
+    );
+    let rounds: Vec<Vec<(DiskScheme, u32)>> = backend
+        .calls
+        .chunks(per_round)
+        .map(|r| r.iter().map(|c| (c.0.scheme, c.1)).collect())
+        .collect();
+    assert!(rounds.windows(2).all(|w| w[0] != w[1]), "every round has its own order");
+    assert_eq!(out.timings.configs.len(), configs);
+    let (probe, noise) = out.timings.noise.as_ref().expect("an A/A control");
+    assert_eq!(noise.frame_seconds.len(), 5 * NOISE_VISITS as usize);
+    assert_eq!((probe.scheme, probe.samples), (DiskScheme::Uniform, 16));
+    for r in &out.records {
+        assert_eq!(r.time.timed_frames, Some(5));
+        let (lo, med, hi) = (r.time.frame_s_lo, r.time.frame_s, r.time.frame_s_hi);
+        assert!(lo <= med && med <= hi && lo > 10e-3, "{lo} {med} {hi}");
+    }
+    // Every configuration does the same (fake) work; the drift must rank no two of them, and
+    // the A/A control reads equal.
+    let all: Vec<_> = out.timings.configs.values().chain([noise]).collect();
+    for a in &all {
+        for b in &all {
+            let (ratio, word) = compare(a, b, out.timings.seed);
+            assert_eq!(word, Comparison::Equal, "{ratio:?}");
+        }
+    }
+    // A resumed sweep takes the timings from the journal and times nothing.
+    backend.calls.clear();
+    let again = run_sweep(&spec, &mut backend, &journal, &cache, false, &Progress::default()).unwrap();
+    assert!(backend.calls.is_empty(), "{} frames re-timed", backend.calls.len());
+    assert_eq!(again.timings.configs, out.timings.configs);
+    assert_eq!(again.timings.noise.as_ref().map(|n| &n.1), Some(noise));
+    let frame_s =
+        |o: &penumbra::experiment::sweep::Outcome| -> Vec<f64> { o.records.iter().map(|r| r.time.frame_s).collect() };
+    assert_eq!(frame_s(&again), frame_s(&out));
+    // One configuration more: every configuration is timed again in one interleaved phase, so
+    // the new one is never ranked against frames timed in another process.
+    let text = std::fs::read_to_string(&exp).unwrap();
+    std::fs::write(
+        &exp,
+        text.replace(r#"["uniform", "paper"]"#, r#"["uniform", "paper", "jittered"]"#),
+    )
+    .unwrap();
+    let wider = Spec::load(&exp).unwrap();
+    backend.calls.clear();
+    let third = run_sweep(&wider, &mut backend, &journal, &cache, false, &Progress::default()).unwrap();
+    assert_eq!(third.timings.configs.len(), configs + 4);
+    assert_eq!(backend.calls.len(), 5 * (configs + 4 + NOISE_VISITS as usize));
+}
+
+#[test]
+fn timing_asks_for_at_least_five_repeats() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 3"));
+    let e = Spec::load(&exp).unwrap_err().to_string();
+    assert!(
+        e.contains("tiny.toml:") && e.contains("timing.repeats") && e.contains("at least 5"),
+        "{e}"
+    );
+}
+
+/// The frame-rate experiment times every configuration once per interleaved round, like every
+/// kind, each median with its interval.
+#[test]
+fn frame_rates_are_timed_in_interleaved_rounds() {
+    use penumbra::experiment::fps::{run_fps, FpsSpec};
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = common::repo("experiments/scenes");
+    let text = std::fs::read_to_string(common::repo("experiments/fps.toml"))
+        .unwrap()
+        .replace("repeats = 5", "repeats = 6")
+        .replace("resolutions = [[800, 600], [1920, 1080]]", "resolutions = [[16, 12]]")
+        .replace("scene = \"scenes/", &format!("scene = \"{}/", scenes.display()));
+    let path = dir.path().join("fps.toml");
+    std::fs::write(&path, text).unwrap();
+    let spec = FpsSpec::load(&path).unwrap();
+    let mut backend = Drifting {
+        cpu: CpuBackend::default(),
+        calls: vec![],
+    };
+    let rows = run_fps(&spec, &mut backend, &Progress::default()).unwrap();
+    assert_eq!(rows.len(), 4, "two scenes, one and two lights, one resolution");
+    assert_eq!(
+        backend.calls.len(),
+        4 * 6,
+        "one timed frame per configuration per round"
+    );
+    assert!(
+        backend.calls.iter().all(|c| (c.2, c.3) == (1, 1)),
+        "one warm-up, one timed frame"
+    );
+    for r in &rows {
+        assert_eq!(r.frame_seconds.len(), 6);
+        assert!(
+            r.frame.lo <= r.frame.median && r.frame.median <= r.frame.hi,
+            "{:?}",
+            r.frame
+        );
+        assert!(r.work.is_some_and(|w| w.queries > 0), "the CPU counts the work");
+    }
+}

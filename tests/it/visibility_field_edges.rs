@@ -1,0 +1,127 @@
+//! Edge cases of the visibility field against brute force: build parameters at their limits
+//! (the leaf keys packed above the triangle index), ray origins far from the scene, and the
+//! memory the field reports for its GPU form.
+
+use crate::common::rays::*;
+use glam::DVec3;
+use penumbra::accel::brute::Brute;
+use penumbra::accel::vlf::{Split, VisibilityField, VlfSettings};
+use penumbra::accel::Accelerator;
+
+fn mismatches(field: &VisibilityField, t: &penumbra::mesh::Triangles, rays: &[Ray]) -> usize {
+    let brute = Brute::build(t);
+    let mut bad = 0;
+    for &(o, d, tmax, skip) in rays {
+        let want = brute.closest(o, d, tmax, skip);
+        let got = field.closest(o, d, tmax, skip);
+        let any = field.any_hit(o, d, tmax, skip);
+        if got != want || any != want.is_some() {
+            if bad < 3 {
+                eprintln!("o={o:?} d={d:?} tmax={tmax}: got {got:?} (any {any}), want {want:?}");
+            }
+            bad += 1;
+        }
+    }
+    bad
+}
+
+/// Small triangles in a slab, each split tile deep: at depth 10 an entry has 12 bits for the
+/// triangle index, so a scene of more than 4095 triangles either builds exactly or is refused.
+#[test]
+fn deep_tile_bsp_with_many_triangles_is_exact_or_refused() {
+    let mut r = Rng(5);
+    let mut out = Vec::new();
+    for _ in 0..5000 {
+        let c = v(r.range(-1., 1.), r.range(-1., 1.), r.range(-1., 1.));
+        out.push([c, c + r.unit() * 0.05, c + r.unit() * 0.05]);
+    }
+    let t = tris(out);
+    for split in [Split::Uniform, Split::Median] {
+        let settings = VlfSettings {
+            level: 1,
+            tiles: 4,
+            depth: 10,
+            split,
+            leaf_size: 1,
+        };
+        let field = match VisibilityField::build(&t, settings) {
+            Ok(f) => f,
+            Err(e) => {
+                eprintln!("refused: {e}");
+                assert!(e.to_string().contains("depth"), "{e}");
+                continue;
+            }
+        };
+        let rays = random_segments(&t, 2000, &mut r);
+        let bad = mismatches(&field, &t, &rays);
+        assert_eq!(
+            bad,
+            0,
+            "{split:?}: {bad} of {} rays differ from brute force",
+            rays.len()
+        );
+    }
+}
+
+/// Geometry touching the ball (an octahedron's corners lie on it), seen from far away: the ray's
+/// segment inside the ball must not lose its ends to rounding.
+#[test]
+fn far_origins_match_brute_force() {
+    let c = [DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y];
+    let mut positions = Vec::new();
+    for i in 0..4 {
+        positions.push([c[i], c[(i + 1) % 4], DVec3::Z]);
+        positions.push([c[(i + 1) % 4], c[i], -DVec3::Z]);
+    }
+    let t = tris(positions);
+    let field = VisibilityField::build(&t, VlfSettings::default()).unwrap();
+    let mut r = Rng(9);
+    for dist in [1e3, 1e5, 1e6, 1e7] {
+        let mut rays = Vec::new();
+        for _ in 0..2000 {
+            let d = r.unit();
+            // Aim at points near the corners (on the ball) and edges.
+            let k = r.index(6);
+            let corner = [DVec3::X, DVec3::Y, DVec3::Z, -DVec3::X, -DVec3::Y, -DVec3::Z][k];
+            let target = corner * r.range(0.999, 1.0) + r.unit() * 1e-3;
+            rays.push((target - d * dist, d, f64::INFINITY, u32::MAX));
+        }
+        let bad = mismatches(&field, &t, &rays);
+        assert_eq!(bad, 0, "origins {dist} away: {bad} of {} rays differ", rays.len());
+    }
+}
+
+/// What the field reports as its GPU size is what its GPU form uploads.
+#[test]
+fn gpu_bytes_are_the_uploaded_buffers() {
+    let mut r = Rng(3);
+    let mut out = Vec::new();
+    for _ in 0..500 {
+        let c = v(r.range(-1., 1.), r.range(-1., 1.), r.range(-1., 1.));
+        out.push([c, c + r.unit() * 0.1, c + r.unit() * 0.1]);
+    }
+    let t = tris(out);
+    let field = VisibilityField::build(
+        &t,
+        VlfSettings {
+            level: 4,
+            tiles: 16,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let frame = penumbra::geometry::LocalFrame {
+        origin: DVec3::ZERO,
+        scale: 1.0,
+    };
+    let uploaded: usize = field.gpu(&frame).unwrap().buffers.iter().map(|(_, b)| b.len()).sum();
+    let reported = field.stats().gpu_bytes as usize;
+    eprintln!(
+        "reported {reported}, uploaded {uploaded}, boxes {}",
+        2 * field.base.boxes.len()
+    );
+    assert!(
+        (reported as f64 - uploaded as f64).abs() < 0.01 * uploaded as f64,
+        "reported {reported} bytes, uploads {uploaded}"
+    );
+}
