@@ -1,7 +1,8 @@
 //! Build-time provenance for every manifest: the commit the binary was built from, whether the
 //! checkout was clean (nothing changed or untracked outside `results/`, which reruns rewrite),
 //! and the compiler. Taken here rather than from the folder the binary later runs in, which
-//! may be another checkout.
+//! may be another checkout. Rerun when a checked-in folder or file changes or a commit moves a
+//! ref (not on `.git/index`, which a mere `git status` rewrites).
 
 use std::process::Command;
 
@@ -25,7 +26,6 @@ fn main() {
         "Cargo.lock",
         "README.md",
         ".git/HEAD",
-        ".git/index",
         ".git/refs",
         ".git/packed-refs",
     ] {

@@ -169,6 +169,11 @@ impl Source {
             if key.is_empty() {
                 key = span.as_ref().map(|s| self.key_on_line(s.start)).unwrap_or_default();
             }
+            let message = if message.starts_with("duplicate key") && !key.is_empty() {
+                format!("`{key}` is defined twice")
+            } else {
+                message
+            };
             self.error_at_span(span, key, message)
         })
     }
@@ -200,13 +205,18 @@ impl Source {
         }
     }
 
-    /// The bare key that starts the line holding `offset` (for syntax errors, where no
-    /// document tree exists to walk).
+    /// The bare key that starts the line holding `offset`, or the table a `[header]` line
+    /// names (for syntax errors, where no document tree exists to walk).
     fn key_on_line(&self, offset: usize) -> String {
         let start = self.text[..offset.min(self.text.len())]
             .rfind('\n')
             .map_or(0, |i| i + 1);
-        let line = self.text[start..].lines().next().unwrap_or("");
+        let line = self.text[start..].lines().next().unwrap_or("").trim();
+        let plain = |k: &str| !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c));
+        if let Some(header) = line.strip_prefix('[') {
+            let name = header.trim_start_matches('[').split(']').next().unwrap_or("").trim();
+            return if plain(name) { name.to_string() } else { String::new() };
+        }
         match line.split_once('=') {
             Some((k, _))
                 if !k.trim().is_empty() && k.trim().chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) =>
@@ -421,6 +431,15 @@ mod tests {
             .parse::<Doc>()
             .unwrap_err();
         assert_eq!(e.key, "lights[1].radius", "{e}");
+    }
+
+    #[test]
+    fn a_table_defined_twice_is_named() {
+        let e = src("name = \"a\"\n[measure]\nwidth = 1\nheight = 2\n[measure]\nwidth = 3\n")
+            .parse::<Nested>()
+            .unwrap_err();
+        assert_eq!((e.key.as_str(), e.position.map(|p| p.0)), ("measure", Some(5)), "{e}");
+        assert!(e.message.contains("`measure` is defined twice"), "{e}");
     }
 
     #[test]

@@ -21,6 +21,7 @@
 pub mod brute;
 pub mod bvh;
 pub mod kdtree;
+pub mod memory;
 pub mod settings;
 pub mod vlf;
 pub mod work;
@@ -145,8 +146,30 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
 
     /// Brings it up to date after the triangles of `object` moved by `step` (the scene's
     /// triangles are now `moved`, same count and order), by `method`, one of
-    /// [`Accelerator::updates`].
-    fn update(&mut self, method: &str, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<()>;
+    /// [`Accelerator::updates`]; says what it did.
+    fn update(&mut self, method: &str, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<Updated>;
+}
+
+/// What an update of moved triangles did to a structure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Updated {
+    /// Kept its topology and refitted its bounds (a BVH refit).
+    Refit,
+    /// Changed in place where the object was and is (the field's Section 8 update).
+    InPlace,
+    /// Was built again from the moved triangles.
+    Rebuilt,
+}
+
+impl Updated {
+    /// `refit`, `in-place`, `rebuild`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Updated::Refit => "refit",
+            Updated::InPlace => "in-place",
+            Updated::Rebuilt => "rebuild",
+        }
+    }
 }
 
 /// Refuses an update method a structure does not offer.
@@ -200,6 +223,9 @@ pub struct Registered {
     pub tuning: fn() -> toml::Table,
     /// Builds it over `triangles`, or says which limit the scene exceeds.
     pub build: fn(&Triangles, &AccelSettings) -> anyhow::Result<Arc<dyn Accelerator>>,
+    /// A lower bound on the bytes it takes over this many triangles with these settings
+    /// ([`memory::check`] refuses a build that cannot fit).
+    pub memory: fn(usize, &AccelSettings) -> u64,
     /// The ball (centre, radius) a structure built over these triangles can follow moved
     /// triangles within, where it has one (the field's directions are fixed to its ball).
     pub follows_within: Option<Region>,
@@ -217,6 +243,8 @@ pub const REGISTRY: &[Registered] = &[
         params: settings::validate::<bvh::BvhSettings>,
         tuning: <bvh::BvhSettings as settings::Params>::tuning,
         build: |t, s| Ok(Arc::new(Bvh::build(t, s.typed::<bvh::BvhSettings>().preset))),
+        // Two 32-byte nodes and an index per triangle, f32 and f64 copies of the triangles.
+        memory: |n, _| n as u64 * (64 + 4 + 48 + 72),
         follows_within: None,
     },
     Registered {
@@ -226,6 +254,7 @@ pub const REGISTRY: &[Registered] = &[
         params: settings::validate::<brute::BruteSettings>,
         tuning: <brute::BruteSettings as settings::Params>::tuning,
         build: |t, _| Ok(Arc::new(brute::Brute::build(t))),
+        memory: |n, _| n as u64 * 72,
         follows_within: None,
     },
     Registered {
@@ -235,6 +264,7 @@ pub const REGISTRY: &[Registered] = &[
         params: settings::validate::<vlf::VlfSettings>,
         tuning: <vlf::VlfSettings as settings::Params>::tuning,
         build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.typed())?)),
+        memory: |n, s| vlf::min_bytes(n, &s.typed()),
         follows_within: Some(vlf::ball),
     },
     Registered {
@@ -244,6 +274,8 @@ pub const REGISTRY: &[Registered] = &[
         params: settings::validate::<kdtree::KdSettings>,
         tuning: <kdtree::KdSettings as settings::Params>::tuning,
         build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()))),
+        // A leaf entry per triangle at least, and the f64 copy.
+        memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
     },
 ];
@@ -258,12 +290,14 @@ pub fn names() -> Vec<&'static str> {
     REGISTRY.iter().map(|r| r.name).collect()
 }
 
-/// Builds the structure `settings` names over `triangles`; `None` for no triangles.
+/// Builds the structure `settings` names over `triangles`; `None` for no triangles. A
+/// structure that cannot fit in the memory available is refused before it is built.
 pub fn build(triangles: &Triangles, settings: &AccelSettings) -> anyhow::Result<Option<Arc<dyn Accelerator>>> {
     let r = registered(settings.name).expect("settings hold a registered name");
     if triangles.positions.is_empty() {
         return Ok(None);
     }
+    memory::check(settings, triangles.positions.len(), memory::available_bytes()).map_err(anyhow::Error::msg)?;
     (r.build)(triangles, settings).map(Some)
 }
 

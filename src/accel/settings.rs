@@ -110,7 +110,7 @@ pub fn validate<P: Params>(table: &toml::Table) -> Result<toml::Table, (String, 
 /// The `[accel.*]` tables of a file at `at` (e.g. `["accel"]`): each name a registered
 /// structure, each table its parameters. With `lists`, a key may list values to tune over (the
 /// combinations, each validated); otherwise one value each. Returns every combination per named
-/// structure, in file order of keys.
+/// structure, by structure name. An empty table is the structure's defaults, one candidate.
 pub fn read_tables(
     source: &Source,
     at: &[Seg],

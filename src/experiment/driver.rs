@@ -83,7 +83,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
                 name: header.name.clone(),
                 build: Build::current(),
                 run: RunInfo {
-                    command_line: std::env::args().collect(),
+                    command_line: std::env::args_os().map(|a| a.to_string_lossy().into_owned()).collect(),
                     started_utc,
                     seconds: started.elapsed().as_secs_f64(),
                     peak_rss_bytes: peak_rss(),

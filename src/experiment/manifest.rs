@@ -1,6 +1,6 @@
 //! manifest.toml: where a results folder came from, one serde struct for every kind. The build
 //! (commit, clean tree, compiler) is taken when the binary was built, not from the folder it runs
-//! in; every input file is named with its hash, so a reader (and the stale-results test) can
+//! in; every input file is named with its hash, so a reader can
 //! tell whether the numbers belong to the code and files in front of them.
 
 use super::kind::Kind;

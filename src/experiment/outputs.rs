@@ -4,8 +4,10 @@
 //! folders in one step (`renameat2(RENAME_EXCHANGE)` on Linux). A failed or killed run leaves
 //! the earlier set whole; a folder never mixes two runs.
 //!
-//! Every output path is checked to stay under the staging folder ([`Outputs::path`]): names
-//! that become paths are plain names ([`super::header::plain_name`]), and this is the backstop.
+//! Names from an experiment file that become paths (the experiment's, its meshes') are plain
+//! names ([`super::header::plain_name`]); files named after them are written through
+//! [`Outputs::path`], which refuses anything that would leave the staging folder. The other
+//! outputs have fixed names.
 
 use anyhow::{bail, Context};
 use std::path::{Component, Path, PathBuf};
@@ -30,7 +32,8 @@ fn host() -> String {
 
 impl Outputs {
     /// A fresh staging folder for `home` (`.NAME.staging.HOST.PID` beside it); staging folders
-    /// that killed runs of this host left behind are removed.
+    /// that killed runs of this host left behind are removed, after the state they were
+    /// carrying over ([`KEPT`]) is moved back into `home` where `home` lacks it.
     pub fn begin(home: &Path) -> anyhow::Result<Outputs> {
         let name = home
             .file_name()
@@ -50,6 +53,13 @@ impl Outputs {
                     .and_then(|pid| pid.parse::<u32>().ok())
                     .is_some_and(|pid| pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists());
                 if dead {
+                    for kept in KEPT {
+                        let (from, to) = (e.path().join(kept), home.join(kept));
+                        if from.exists() && !to.exists() {
+                            let _ = std::fs::create_dir_all(home);
+                            let _ = std::fs::rename(&from, &to);
+                        }
+                    }
                     let _ = std::fs::remove_dir_all(e.path());
                 }
             }
@@ -86,20 +96,31 @@ impl Outputs {
         Ok(self.staging.join(r))
     }
 
-    /// Replaces the results folder with the staged set, carrying over [`KEPT`] entries.
+    /// Replaces the results folder with the staged set, carrying over [`KEPT`] entries; if the
+    /// swap fails, the carried entries go back where they were and the earlier set stays.
     pub fn commit(mut self) -> anyhow::Result<()> {
         if self.home.is_dir() {
-            for kept in KEPT {
-                let from = self.home.join(kept);
-                if from.exists() {
-                    let to = self.staging.join(kept);
-                    if to.exists() {
-                        std::fs::remove_dir_all(&to)?;
+            let mut moved = Vec::new();
+            let carried = (|| -> anyhow::Result<()> {
+                for kept in KEPT {
+                    let from = self.home.join(kept);
+                    if from.exists() {
+                        let to = self.staging.join(kept);
+                        if to.exists() {
+                            std::fs::remove_dir_all(&to)?;
+                        }
+                        std::fs::rename(&from, &to).with_context(|| format!("moving {}", from.display()))?;
+                        moved.push(kept);
                     }
-                    std::fs::rename(&from, &to).with_context(|| format!("moving {}", from.display()))?;
                 }
+                exchange(&self.staging, &self.home)
+            })();
+            if let Err(e) = carried {
+                for kept in moved {
+                    let _ = std::fs::rename(self.staging.join(kept), self.home.join(kept));
+                }
+                return Err(e);
             }
-            exchange(&self.staging, &self.home)?;
             // The staging path now holds the earlier set.
             std::fs::remove_dir_all(&self.staging)
                 .with_context(|| format!("removing the earlier results, now at {}", self.staging.display()))?;
@@ -187,7 +208,7 @@ pub fn check_home(home: &Path, kind: &str, name: &str, experiment: &Path, fresh:
         _ => table
             .get("experiment")
             .and_then(|v| v.as_str().or_else(|| v.get("path").and_then(|p| p.as_str())))
-            .is_some_and(|p| Path::new(p) == experiment),
+            .is_some_and(|p| super::manifest::tidy(Path::new(p)) == super::manifest::tidy(experiment)),
     };
     if same || fresh {
         Ok(())
@@ -223,6 +244,21 @@ mod tests {
         assert_eq!(std::fs::read(home.join("cache/gt")).unwrap(), b"cached");
         let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 1, "no staging folder left: {left:?}");
+    }
+
+    #[test]
+    fn a_killed_runs_carried_state_comes_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(&home).unwrap();
+        // A staging folder of this host whose process is gone, holding the journal it carried.
+        let dead = dir.path().join(format!(".r.staging.{}.{}", host(), u32::MAX - 1));
+        std::fs::create_dir_all(dead.join(".journal")).unwrap();
+        std::fs::write(dead.join(".journal/groups.csv"), b"journaled").unwrap();
+        let out = Outputs::begin(&home).unwrap();
+        assert!(!dead.exists());
+        assert_eq!(std::fs::read(home.join(".journal/groups.csv")).unwrap(), b"journaled");
+        drop(out);
     }
 
     #[test]

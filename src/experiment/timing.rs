@@ -5,33 +5,42 @@
 //! interleaved rounds; each even round visits them in a fresh order drawn from a recorded seed
 //! and the odd round after it in the reverse order (counterbalanced, ABBA), so a slow drift of
 //! the machine (clocks, other load), across rounds or within one, falls on every unit alike
-//! instead of on whichever ran first. Each visit renders `warmup` untimed frames, then times one.
+//! instead of on whichever ran first. Each visit renders `warmup` untimed frames, then times one
+//! (a frame-time experiment, whose units are the frames of a path, renders each path's first
+//! frame `warmup` times instead: consecutive frames warm each other).
 //!
-//! **Estimates.** Every reported time is a median with a 95 % percentile-bootstrap interval over
-//! its repeats ([`Estimate`], [`median_interval`]). Two units visited in the same rounds are
-//! compared by the median of their per-round time ratios, bootstrapped over rounds
-//! ([`paired_ratio`]): pairing by round cancels drift that a round shares. A ratio over a
-//! series of correlated units (consecutive frames of a camera path) is bootstrapped in moving
-//! blocks whose length the series' own autocorrelation sets ([`series_median`]).
+//! **Estimates.** Every reported time is a median with a distribution-free 95 % interval over
+//! its repeats: the order statistics `[x(k), x(n+1-k)]` with `k` from the binomial
+//! distribution, exact for a median whatever the timings' distribution (a percentile bootstrap
+//! of a median over a few repeats only picks order statistics too, with a coverage that swings
+//! with `n`: 87.5 % at 7 repeats). [`Estimate`], [`median_interval`]. Two units visited in the
+//! same rounds are compared by the median of their per-round time ratios ([`paired_ratio`]):
+//! pairing by round cancels drift that a round shares. A ratio over a series of correlated
+//! units (consecutive frames of a camera path) takes its interval from the medians of blocks of
+//! frames longer than the series' correlation ([`series_median`]).
 //!
 //! **Words.** [`Comparison::of`] reads the 95 % interval of a time ratio A / B: *faster* when the
-//! whole interval lies below 1, *slower* when it lies above 1, *equal within noise* otherwise;
-//! a claim "A is faster than B" is answered *yes*, *no* or *not clearly* by the same interval.
-//! [`RULE`] says so in every report.
+//! whole interval lies below 1 - [`MARGIN`], *slower* when it lies above 1 + [`MARGIN`], *equal
+//! within noise* otherwise; a claim "A is faster than B" is answered *yes*, *no* or *not
+//! clearly* by the same interval. The margin keeps a word from turning on a few percent: a
+//! device whose frames fall in two modes (lavapipe's take 15 or 29 ms at random) puts all the
+//! ratios of a few rounds on one side of 1 now and then, but rarely all beyond 5 %. [`RULE`]
+//! says so in every report.
 
 use crate::metrics::stats::median;
 use crate::sampling::rng::pcg;
 use serde::{Deserialize, Serialize};
 
 /// The rule, as every report states it.
-pub const RULE: &str = "Every time is a median with its 95 % bootstrap interval over repeats visited in seeded \
-interleaved rounds. A is called faster than B only when the whole 95 % interval of the time ratio A / B \
-(the median of per-round ratios, bootstrapped over rounds; over frames in moving blocks) lies below 1, \
-slower when it lies above 1, and equal within noise otherwise; a paper's claim that A is faster is \
-answered yes, no or not clearly by the same interval.";
+pub const RULE: &str = "Every time is a median with its distribution-free 95 % interval (order statistics of its \
+repeats, visited in seeded, counterbalanced interleaved rounds). A is called faster than B only when the whole \
+95 % interval of the time ratio A / B (the median of per-round ratios; along a camera path, of per-frame \
+ratios, its interval from the medians of blocks of frames longer than their correlation) lies below 0.95, \
+slower when it lies above 1.05, and equal within noise otherwise (a difference under 5 % is never called); a \
+paper's claim that A is faster is answered yes, no or not clearly by the same interval.";
 
-/// Bootstrap resamples behind every interval.
-pub const RESAMPLES: u32 = 2000;
+/// Smallest relative difference a word is given: a time ratio's interval must clear 1 by it.
+pub const MARGIN: f64 = 0.05;
 
 /// Default seed of the visiting order, where an experiment file gives none (recorded in the
 /// manifest either way).
@@ -132,67 +141,45 @@ impl Estimate {
     }
 }
 
-/// The 2.5 % and 97.5 % percentiles of `stats` (sorted in place).
-fn percentiles(stats: &mut [f64]) -> (f64, f64) {
-    stats.sort_by(f64::total_cmp);
-    let at = |p: f64| stats[((p * stats.len() as f64) as usize).min(stats.len() - 1)];
-    (at(0.025), at(0.975))
-}
-
-/// Index `k` of a bootstrap draw from `n` values in resample `b`.
-fn draw(seed: u32, b: u32, k: usize, n: usize) -> usize {
-    pcg(pcg(seed ^ pcg(b)) ^ pcg(k as u32 ^ 0x2545_f491)) as usize % n
-}
-
-/// Median of `values` with its 95 % percentile-bootstrap interval (resampled with replacement,
-/// [`RESAMPLES`] times, seeded).
-pub fn median_interval(values: &[f64], seed: u32) -> Estimate {
-    bootstrap(values, seed, 1)
-}
-
-/// Median of the per-round ratios `a[i] / b[i]` (units visited in the same rounds) with its 95 %
-/// interval, rounds resampled together.
-pub fn paired_ratio(a: &[f64], b: &[f64], seed: u32) -> Estimate {
-    assert_eq!(a.len(), b.len(), "paired units share their rounds");
-    let ratios: Vec<f64> = a.iter().zip(b).map(|(x, y)| x / y).collect();
-    bootstrap(&ratios, seed, 1)
-}
-
-/// Median of a series of correlated values (e.g. per-frame ratios along a camera path) with its
-/// 95 % moving-block bootstrap interval, and the block length used: the first lag at which the
-/// series' autocorrelation is no longer significant (|r| < 2 / sqrt(n)), at least n^(1/3), at most
-/// n / 4.
-pub fn series_median(values: &[f64], seed: u32) -> (Estimate, usize) {
-    let block = block_length(values);
-    (bootstrap(values, seed, block), block)
-}
-
-fn block_length(values: &[f64]) -> usize {
-    let n = values.len();
-    if n < 8 {
-        return 1;
+/// The rank `k` (1-based) of the distribution-free 95 % interval `[x(k), x(n+1-k)]` of the
+/// median of `n` values (order statistics): the largest `k` with `P(Binomial(n, 1/2) < k) <=
+/// 0.025`, at least 1. Exact whatever the values' distribution, for independent values.
+pub fn interval_rank(n: usize) -> usize {
+    if n > 1000 {
+        // Normal approximation of the binomial, off by well under one rank here.
+        let k = (n as f64 / 2.0 - 1.96 * (n as f64).sqrt() / 2.0).floor() as usize;
+        return k.max(1);
     }
-    let mean = values.iter().sum::<f64>() / n as f64;
-    let var: f64 = values.iter().map(|v| (v - mean).powi(2)).sum();
-    let floor = (n as f64).cbrt().ceil() as usize;
-    if var == 0.0 {
-        return floor;
+    // P(B <= i), i = 0, 1, ..., accumulated in f64 (0.5^1000 ~ 1e-301 still fits).
+    let (mut term, mut below) = (0.5f64.powi(n as i32), 0.0);
+    let mut k = 0;
+    for i in 0..n {
+        below += term;
+        if below > 0.025 {
+            break;
+        }
+        k = i + 1;
+        term *= (n - i) as f64 / (i + 1) as f64;
     }
-    let limit = (2.0 / (n as f64).sqrt(), n / 4);
-    let acf = |lag: usize| {
-        (0..n - lag)
-            .map(|i| (values[i] - mean) * (values[i + lag] - mean))
-            .sum::<f64>()
-            / var
-    };
-    let first_insignificant = (1..=limit.1).find(|&lag| acf(lag).abs() < limit.0).unwrap_or(limit.1);
-    first_insignificant.max(floor).min(limit.1.max(1))
+    k.max(1)
 }
 
-/// Percentile bootstrap of the median, resampling blocks of `block` consecutive values.
-fn bootstrap(values: &[f64], seed: u32, block: usize) -> Estimate {
-    let n = values.len();
+/// Coverage of the interval [`interval_rank`] gives for `n` values: `1 - 2 P(B < k)`.
+pub fn coverage(n: usize) -> f64 {
+    let k = interval_rank(n);
+    let (mut term, mut below) = (0.5f64.powi(n.min(1000) as i32), 0.0);
+    for i in 0..k.min(n) {
+        below += term;
+        term *= (n - i) as f64 / (i + 1) as f64;
+    }
+    1.0 - 2.0 * below
+}
+
+/// Median of `values` with its distribution-free 95 % interval (order statistics,
+/// [`interval_rank`]); the interval is NaN with fewer than two values or any non-finite value.
+pub fn median_interval(values: &[f64]) -> Estimate {
     let m = median(values);
+    let n = values.len();
     if n < 2 || values.iter().any(|v| !v.is_finite()) {
         return Estimate {
             median: m,
@@ -200,23 +187,84 @@ fn bootstrap(values: &[f64], seed: u32, block: usize) -> Estimate {
             hi: f64::NAN,
         };
     }
-    let block = block.clamp(1, n);
-    let starts = n - block + 1;
-    let mut resample = Vec::with_capacity(n);
-    let mut stats: Vec<f64> = (0..RESAMPLES)
-        .map(|b| {
-            resample.clear();
-            let mut k = 0;
-            while resample.len() < n {
-                let s = draw(seed, b, k, starts);
-                k += 1;
-                resample.extend(values[s..s + block].iter().take(n - resample.len()));
-            }
-            median(&resample)
-        })
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let k = interval_rank(n);
+    Estimate {
+        median: m,
+        lo: v[k - 1],
+        hi: v[n - k],
+    }
+}
+
+/// Median of the per-round ratios `a[i] / b[i]` (units visited in the same rounds) with its 95 %
+/// interval.
+pub fn paired_ratio(a: &[f64], b: &[f64]) -> Estimate {
+    assert_eq!(a.len(), b.len(), "paired units share their rounds");
+    let ratios: Vec<f64> = a.iter().zip(b).map(|(x, y)| x / y).collect();
+    median_interval(&ratios)
+}
+
+/// Fewest blocks a series' interval is read from: the order-statistic interval of six values
+/// covers 96.9 %; of five, only 93.75 %.
+pub const MIN_BLOCKS: usize = 6;
+
+/// Median of a series of correlated values (e.g. per-frame ratios along a camera path) with a
+/// 95 % interval from batch medians: the series is cut into consecutive blocks, each block's
+/// median taken, and the interval is the order-statistic interval of the block medians, which
+/// are close to independent when blocks outlast the correlation. The block length is the first
+/// lag at which the series' autocorrelation is no longer significant (|r| < 2 / sqrt(n)), or
+/// twice n over the effective sample size of an AR(1) series of the same lag-1 correlation if
+/// longer, and at least n^(1/3); it is returned with the estimate. A series too short or too correlated for
+/// [`MIN_BLOCKS`] blocks gets no interval (NaN): it cannot say more than its median.
+pub fn series_median(values: &[f64]) -> (Estimate, usize) {
+    let n = values.len();
+    let block = block_length(values);
+    let medians: Vec<f64> = values
+        .chunks(block)
+        .filter(|c| 2 * c.len() >= block)
+        .map(median)
         .collect();
-    let (lo, hi) = percentiles(&mut stats);
-    Estimate { median: m, lo, hi }
+    let mut e = if medians.len() >= MIN_BLOCKS {
+        median_interval(&medians)
+    } else {
+        Estimate::NAN
+    };
+    e.median = median(values);
+    if e.lo.is_finite() {
+        (e.lo, e.hi) = (e.lo.min(e.median), e.hi.max(e.median));
+    }
+    (e, block.min(n.max(1)))
+}
+
+fn block_length(values: &[f64]) -> usize {
+    let n = values.len();
+    let floor = (n as f64).cbrt().ceil() as usize;
+    if n < 4 {
+        return floor.max(1);
+    }
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let var: f64 = values.iter().map(|v| (v - mean).powi(2)).sum();
+    if var == 0.0 || !var.is_finite() {
+        return floor;
+    }
+    let acf = |lag: usize| {
+        (0..n - lag)
+            .map(|i| (values[i] - mean) * (values[i + lag] - mean))
+            .sum::<f64>()
+            / var
+    };
+    let limit = 2.0 / (n as f64).sqrt();
+    let first_insignificant = (1..n / 2).find(|&lag| acf(lag).abs() < limit).unwrap_or(n / 2);
+    // Blocks no more than the AR(1) effective sample size n (1 - r1) / (1 + r1), r1 corrected
+    // for the estimator's bias (its expectation falls short of the lag-1 correlation by about
+    // (1 + 3 r1) / n, Kendall): a short series underestimates how long its correlation lasts.
+    let r1 = acf(1);
+    let r1 = (r1 + (1.0 + 3.0 * r1.max(0.0)) / n as f64).clamp(0.0, 0.99);
+    let effective = (n as f64 * (1.0 - r1) / (1.0 + r1)).max(1.0);
+    // Twice that per block, so neighbouring blocks' medians are nearly independent too.
+    let per_effective = (2.0 * n as f64 / effective).ceil() as usize;
+    first_insignificant.max(per_effective).max(floor)
 }
 
 /// What the interval of a time ratio A / B says of A against B.
@@ -234,9 +282,9 @@ pub enum Comparison {
 impl Comparison {
     /// The word for a time ratio A / B with its interval ([`RULE`]).
     pub fn of(time_ratio: &Estimate) -> Comparison {
-        if time_ratio.hi < 1.0 {
+        if time_ratio.hi < 1.0 - MARGIN {
             Comparison::Faster
-        } else if time_ratio.lo > 1.0 {
+        } else if time_ratio.lo > 1.0 + MARGIN {
             Comparison::Slower
         } else {
             Comparison::Equal
@@ -317,19 +365,42 @@ mod tests {
         assert_eq!(times, vec![vec![0.0; 5], vec![1.0; 5], vec![2.0; 5]]);
     }
 
+    /// The ranks and coverages of the order-statistic interval: known values of the binomial
+    /// (n = 5: [min, max], 1 - 2/32; n = 9: the second smallest and largest, 1 - 2 x 10/512),
+    /// at least 95 % from 6 values on, and the normal approximation agreeing at the hand-over.
+    #[test]
+    fn order_statistic_intervals_have_their_coverage() {
+        assert_eq!((interval_rank(5), coverage(5)), (1, 1.0 - 2.0 / 32.0));
+        assert_eq!(interval_rank(9), 2);
+        assert!((coverage(9) - (1.0 - 20.0 / 512.0)).abs() < 1e-12);
+        for n in 6..=1000 {
+            assert!(coverage(n) >= 0.95, "n = {n}: {}", coverage(n));
+        }
+        assert!(interval_rank(1000).abs_diff(interval_rank(1001)) <= 1);
+        assert_eq!(
+            median_interval(&[5.0, 1.0, 3.0, 2.0, 4.0]),
+            Estimate {
+                median: 3.0,
+                lo: 1.0,
+                hi: 5.0
+            }
+        );
+    }
+
     #[test]
     fn intervals_hold_the_median_and_shrink_with_more_repeats() {
-        let few = median_interval(&draws(1, 5, 10.0, 0.1), 3);
-        let many = median_interval(&draws(2, 200, 10.0, 0.1), 3);
+        let few = median_interval(&draws(1, 6, 10.0, 0.1));
+        let many = median_interval(&draws(2, 200, 10.0, 0.1));
         for e in [few, many] {
             assert!(e.lo <= e.median && e.median <= e.hi, "{e:?}");
         }
         assert!(many.hi - many.lo < (few.hi - few.lo) / 2.0, "{few:?} {many:?}");
         assert!(many.lo < 10.0 && 10.0 < many.hi, "{many:?}");
-        assert!(median_interval(&[4.0], 1).lo.is_nan());
-        assert!(median_interval(&[], 1).median.is_nan());
+        assert!(median_interval(&[4.0]).lo.is_nan());
+        assert!(median_interval(&[]).median.is_nan());
+        assert!(median_interval(&[1.0, f64::NAN, 2.0]).lo.is_nan());
         assert_eq!(
-            median_interval(&[2.0; 6], 1),
+            median_interval(&[2.0; 6]),
             Estimate {
                 median: 2.0,
                 lo: 2.0,
@@ -338,25 +409,53 @@ mod tests {
         );
     }
 
-    /// The rule on synthetic timings: identical distributions read "equal" in at least 90 % of
-    /// seeded trials at 5 rounds (the percentile interval of a median of 5 is about [min, max]:
-    /// wrong only when all five ratios fall on one side, 2 x 1/32); times 20 % apart with 5 %
-    /// noise read "faster" in every trial.
+    /// Two modes at random, as lavapipe's frames: 15 or 29 ms, each half the time, with 2 %
+    /// jitter.
+    fn bimodal(stream: u32, n: usize) -> Vec<f64> {
+        let s = Stream::new(stream, 1, None);
+        (0..n as u32)
+            .map(|i| if s.unit(2 * i) < 0.5 { 15.0 } else { 29.0 } * (1.0 + 0.02 * (s.unit(2 * i + 1) - 0.5)))
+            .collect()
+    }
+
+    /// The rule on synthetic timings, at every number of rounds from 5 to 15: identical
+    /// distributions (normal-ish with 10 % spread, or two modes) are called different in at
+    /// most 1 - coverage(n) of seeded trials before the margin and in at most 1 % with it;
+    /// times 20 % apart with 5 % noise read "faster" in every trial; 3 % apart, "equal" (below
+    /// the margin).
     #[test]
     fn identical_read_equal_and_separated_read_faster() {
-        let trials = 1000;
-        let (mut equal, mut faster) = (0, 0);
-        for t in 0..trials {
-            let a = draws(10 + 3 * t, 5, 50.0, 0.05);
-            let b = draws(11 + 3 * t, 5, 50.0, 0.05);
-            equal += (Comparison::of(&paired_ratio(&a, &b, t)) == Comparison::Equal) as u32;
-            let c = draws(12 + 3 * t, 5, 40.0, 0.05);
-            faster += (Comparison::of(&paired_ratio(&c, &b, t)) == Comparison::Faster) as u32;
+        let trials = 1500u32;
+        for n in 5..=15usize {
+            let (mut differ, mut words, mut words_bimodal, mut faster, mut close) = (0, 0, 0, 0, 0);
+            for t in 0..trials {
+                let k = 17 * n as u32 + 7919 * t;
+                let (a, b) = (draws(k, n, 50.0, 0.1), draws(k + 1, n, 50.0, 0.1));
+                let r = paired_ratio(&a, &b);
+                differ += (r.hi < 1.0 || r.lo > 1.0) as u32;
+                words += (Comparison::of(&r) != Comparison::Equal) as u32;
+                let (x, y) = (bimodal(k + 2, n), bimodal(k + 3, n));
+                words_bimodal += (Comparison::of(&paired_ratio(&x, &y)) != Comparison::Equal) as u32;
+                let c = draws(k + 4, n, 40.0, 0.05);
+                let b5 = draws(k + 5, n, 50.0, 0.05);
+                faster += (Comparison::of(&paired_ratio(&c, &b5)) == Comparison::Faster) as u32;
+                let (d, e) = (draws(k + 6, n, 48.5, 0.005), draws(k + 7, n, 50.0, 0.005));
+                close += (Comparison::of(&paired_ratio(&d, &e)) == Comparison::Equal) as u32;
+            }
+            let share = |k: u32| k as f64 / trials as f64;
+            eprintln!(
+                "n = {n}: identical differ in {:.4} (coverage {:.4}), get a word in {:.4} (two modes: {:.4})",
+                share(differ),
+                coverage(n),
+                share(words),
+                share(words_bimodal)
+            );
+            assert!(share(differ) <= 1.0 - coverage(n) + 0.02, "n = {n}: {}", share(differ));
+            assert!(share(words) <= 0.01, "n = {n}: {}", share(words));
+            assert!(share(words_bimodal) <= 0.01, "n = {n}: {}", share(words_bimodal));
+            assert_eq!(faster, trials, "n = {n}");
+            assert_eq!(close, trials, "n = {n}");
         }
-        let equal = equal as f64 / trials as f64;
-        eprintln!("identical read equal in {equal}; separated read faster in {faster}/{trials}");
-        assert!(equal >= 0.9, "{equal}");
-        assert_eq!(faster, trials);
     }
 
     /// A drift within rounds (each visit slower than the last) ranks no two identical units:
@@ -366,7 +465,7 @@ mod tests {
         let s = Schedule {
             seed: 3,
             warmup: 0,
-            repeats: 5,
+            repeats: 6,
         };
         let mut clock = 0.0;
         let times = s
@@ -377,43 +476,84 @@ mod tests {
             .unwrap();
         for a in &times {
             for b in &times {
-                let r = paired_ratio(a, b, 1);
-                assert_eq!(Comparison::of(&r), Comparison::Equal, "{r:?}");
+                let r = paired_ratio(a, b);
+                assert!(r.lo <= 1.0 && r.hi >= 1.0, "{r:?}");
             }
         }
     }
 
-    /// Paired by round, a drift shared by both units cancels; unpaired it would swamp a 5 %
+    /// Paired by round, a drift shared by both units cancels; unpaired it would swamp a 10 %
     /// difference.
     #[test]
     fn pairing_by_round_cancels_shared_drift() {
         let drift: Vec<f64> = (0..9).map(|r| 1.0 + 0.5 * r as f64).collect();
-        let a: Vec<f64> = drift.iter().map(|d| 0.95 * d).collect();
-        let ratio = paired_ratio(&a, &drift, 5);
+        let a: Vec<f64> = drift.iter().map(|d| 0.9 * d).collect();
+        let ratio = paired_ratio(&a, &drift);
         assert_eq!(Comparison::of(&ratio), Comparison::Faster, "{ratio:?}");
-        assert!((ratio.median - 0.95).abs() < 1e-12);
-        let spread = median_interval(&a, 5);
+        assert!((ratio.median - 0.9).abs() < 1e-12);
+        let spread = median_interval(&a);
         assert!(spread.hi / spread.lo > 1.5, "unpaired, the drift dominates: {spread:?}");
     }
 
-    /// A slowly varying series is resampled in blocks: its interval is wider than the iid
-    /// bootstrap's, which would claim a precision the correlated frames do not have.
+    /// An AR(1) series: x_i = rho x_(i-1) + noise, around `mean`.
+    fn ar1(stream: u32, n: usize, mean: f64, rho: f64, rel: f64) -> Vec<f64> {
+        let e = draws(stream, n, 1.0, rel);
+        let mut x = 0.0;
+        (0..n)
+            .map(|i| {
+                x = rho * x + (e[i] - 1.0) * (1.0 - rho * rho).sqrt();
+                mean * (1.0 + x)
+            })
+            .collect()
+    }
+
+    /// Along a path, frames are correlated: identical structures whose per-frame ratios wander
+    /// as an AR(1) series (rho 0.9, 10 % spread) get an interval excluding 1 in at most 5 % of
+    /// seeded trials at 30 and at 420 frames (measured: 1.3 % and 4.0 %; the iid interval would
+    /// in 60 %), and a word (with the margin) in at most 1 %; a 20 % difference still reads
+    /// faster at 420 (a series of 30 frames this correlated rarely gets an interval at all).
     #[test]
-    fn correlated_series_get_blocks_and_wider_intervals() {
-        let n = 400;
-        let noise = draws(40, n, 1.0, 0.02);
-        let series: Vec<f64> = (0..n)
-            .map(|i| 1.0 + 0.1 * (i as f64 / 40.0).sin() + noise[i] - 1.0)
-            .collect();
-        let (blocked, block) = series_median(&series, 9);
-        let iid = median_interval(&series, 9);
-        assert!(block >= 10, "block {block}");
+    fn correlated_series_keep_their_false_alarms_rare() {
+        let trials = 600u32;
+        for n in [30usize, 420] {
+            let (mut differ, mut differ_iid, mut words, mut faster) = (0, 0, 0, 0);
+            for t in 0..trials {
+                let k = 31 * n as u32 + 104_729 * t;
+                let ratios = ar1(k, n, 1.0, 0.9, 0.1);
+                let (e, _) = series_median(&ratios);
+                differ += (e.hi < 1.0 || e.lo > 1.0) as u32;
+                let iid = median_interval(&ratios);
+                differ_iid += (iid.hi < 1.0 || iid.lo > 1.0) as u32;
+                words += (Comparison::of(&e) != Comparison::Equal) as u32;
+                let (f, _) = series_median(&ar1(k + 1, n, 0.8, 0.9, 0.05));
+                faster += (Comparison::of(&f) == Comparison::Faster) as u32;
+            }
+            let share = |k: u32| k as f64 / trials as f64;
+            eprintln!(
+                "{n} frames: differ {:.3} (iid interval {:.3}), words {:.3}, 20 % apart faster {:.3}",
+                share(differ),
+                share(differ_iid),
+                share(words),
+                share(faster)
+            );
+            assert!(share(differ) <= 0.05, "{n}: {}", share(differ));
+            assert!(
+                share(differ_iid) > 0.2,
+                "{n}: the iid interval would not do: {}",
+                share(differ_iid)
+            );
+            assert!(share(words) <= 0.01, "{n}: {}", share(words));
+            if n == 420 {
+                assert!(share(faster) >= 0.99, "{}", share(faster));
+            }
+        }
+        let (white, block) = series_median(&draws(41, 400, 1.0, 0.02));
         assert!(
-            blocked.hi - blocked.lo > 1.5 * (iid.hi - iid.lo),
-            "{blocked:?} vs {iid:?}"
+            block <= 10 && white.lo.is_finite(),
+            "white noise gets short blocks: {block}"
         );
-        let (_, white) = series_median(&draws(41, n, 1.0, 0.02), 9);
-        assert!(white <= 10, "white noise block {white}");
+        let (e, _) = series_median(&[1.0, 2.0, 3.0]);
+        assert!(e.median == 2.0 && e.lo.is_nan(), "three frames tell no interval: {e:?}");
     }
 
     #[test]
@@ -423,9 +563,11 @@ mod tests {
             lo,
             hi,
         };
-        assert_eq!(Comparison::of(&e(0.8, 0.95)), Comparison::Faster);
-        assert_eq!(Comparison::of(&e(1.05, 1.2)), Comparison::Slower);
+        assert_eq!(Comparison::of(&e(0.8, 0.94)), Comparison::Faster);
+        assert_eq!(Comparison::of(&e(1.06, 1.2)), Comparison::Slower);
         assert_eq!(Comparison::of(&e(0.9, 1.1)), Comparison::Equal);
+        assert_eq!(Comparison::of(&e(0.96, 0.99)), Comparison::Equal, "under the margin");
+        assert_eq!(Comparison::of(&e(1.01, 1.04)), Comparison::Equal, "under the margin");
         assert_eq!(Comparison::of(&Estimate::NAN), Comparison::Equal);
         assert_eq!(Comparison::of_speedup(&e(1.1, 1.3)), Comparison::Faster);
         assert_eq!(Comparison::Faster.answer(), "yes");

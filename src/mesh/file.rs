@@ -84,10 +84,24 @@ pub fn load(path: &Path) -> Result<MeshFile, MeshFileError> {
             })
         }
     };
-    let text = std::fs::read_to_string(path).map_err(|e| MeshFileError {
+    let fail = |message: String| MeshFileError {
         file: path.to_path_buf(),
         line: None,
-        message: format!("cannot read: {e}"),
-    })?;
+        message,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(fail("not a regular file".into()));
+    }
+    if meta.len() > MAX_MESH_BYTES {
+        return Err(fail(format!(
+            "{} bytes: larger than the {MAX_MESH_BYTES} bytes a mesh file may have",
+            meta.len()
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read: {e}")))?;
     parse(&text, path)
 }
+
+/// Largest mesh file read (a 1 GiB text file already describes tens of millions of triangles).
+pub const MAX_MESH_BYTES: u64 = 1 << 30;

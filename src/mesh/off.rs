@@ -47,7 +47,8 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
             .map_err(|_| err(counts_line, format!("bad {what} count `{w}`")))
     };
     let (n_vertices, n_faces) = (count(0, "vertex")?, count(1, "face")?);
-    let mut positions = Vec::with_capacity(n_vertices.min(1 << 24));
+    // No more vertices than lines: a header's count sizes nothing by itself.
+    let mut positions = Vec::with_capacity(n_vertices.min(last_line));
     for k in 0..n_vertices {
         let (n, l) = lines
             .next()
@@ -74,11 +75,13 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
         if corners < 3 {
             return Err(err(n, format!("a face needs at least 3 vertices, got {corners}")));
         }
+        // The count is checked against the words on the line before anything is sized by it.
+        let listed: Vec<&str> = ws.collect();
+        if listed.len() < corners {
+            return Err(err(n, format!("face lists fewer than its {corners} vertices")));
+        }
         let mut face = Vec::with_capacity(corners);
-        for _ in 0..corners {
-            let w = ws
-                .next()
-                .ok_or_else(|| err(n, format!("face lists fewer than its {corners} vertices")))?;
+        for &w in &listed[..corners] {
             let i: usize = w.parse().map_err(|_| err(n, format!("bad face index `{w}`")))?;
             let p = positions
                 .get(i)
@@ -122,6 +125,14 @@ mod tests {
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", 6, "at least 3"),
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "fewer than"),
             ("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 6, "after 1 of 2 faces"),
+            // Corner counts no line could hold: refused, never allocated.
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n18446744073709551615 0 1 2\n",
+                6,
+                "fewer than",
+            ),
+            ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n100000000000 0 1 2\n", 6, "fewer than"),
+            ("OFF\n18446744073709551615 1 0\n0 0 0\n", 3, "after 1 of"),
         ] {
             let e = parse(text, Path::new("m.off")).unwrap_err();
             assert_eq!(e.line, Some(line), "{text:?}: {e}");

@@ -6,7 +6,7 @@
 //! - bias = mean_p (x_p - ref_p), signed
 //!
 //! where p runs over a [`PenumbraMask`]: the measured receiver's pixels whose reference visibility
-//! is strictly between [`EPS`] and 1 - [`EPS`]. Pixels that see another surface (the occluder
+//! is strictly between [`EPS`] and 1 - [`EPS`] (with several lights, that of any one light). Pixels that see another surface (the occluder
 //! itself, a mesh, the sky) are never in it: the exact answer does not exist there, and the shadow
 //! being judged is the one cast on the receiver.
 
@@ -38,6 +38,22 @@ impl PenumbraMask {
             .iter()
             .map(|&(i, _)| i)
             .filter(|&i| in_penumbra(reference[i]))
+            .collect();
+        pixels.sort_unstable();
+        PenumbraMask { pixels }
+    }
+}
+
+impl PenumbraMask {
+    /// Receiver pixels in the penumbra of any of `lights` (per-light reference visibilities):
+    /// with several lights, a pixel one light wholly lights and another wholly misses has a
+    /// partial mean but no penumbra, and no sampling error to judge.
+    pub fn union(lights: &[Vec<f32>], receivers: &Receivers) -> Self {
+        let mut pixels: Vec<usize> = receivers
+            .pixels
+            .iter()
+            .map(|&(i, _)| i)
+            .filter(|&i| lights.iter().any(|l| in_penumbra(l[i])))
             .collect();
         pixels.sort_unstable();
         PenumbraMask { pixels }
@@ -123,6 +139,21 @@ mod tests {
         assert!(e.bias.abs() < 1e-7);
         assert!((e.relmse - 0.01 / 0.26).abs() < 1e-6);
         assert!((e.max_abs - 0.1).abs() < 1e-7);
+    }
+
+    /// With two lights, the penumbra is either light's: a pixel one light wholly lights and the
+    /// other wholly misses (mean 0.5) is not in it; a pixel in one light's penumbra is, whatever
+    /// the other does.
+    #[test]
+    fn the_mask_of_several_lights_is_their_penumbrae() {
+        let l0 = vec![0.0, 0.0, 0.5, 1.0, 1.0];
+        let l1 = vec![1.0, 0.3, 1.0, 1.0, 0.0];
+        let mask = PenumbraMask::union(&[l0.clone(), l1.clone()], &receivers(&[0, 1, 2, 3, 4]));
+        assert_eq!(mask.pixels, vec![1, 2]);
+        let mean: Vec<f32> = l0.iter().zip(&l1).map(|(a, b)| (a + b) / 2.0).collect();
+        let of_mean = PenumbraMask::new(&mean, &receivers(&[0, 1, 2, 3, 4]));
+        assert_eq!(of_mean.pixels, vec![0, 1, 2, 4], "the mean alone would take in 0 and 4");
+        assert_eq!(PenumbraMask::union(&[l0], &receivers(&[0, 1, 2, 3, 4])).pixels, vec![2]);
     }
 
     #[test]

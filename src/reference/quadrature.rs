@@ -47,6 +47,11 @@ fn panel(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
 /// Bisection depth at which a panel is accepted whatever its error estimate.
 pub const MAX_DEPTH: u32 = 40;
 
+/// Panels one integral may evaluate (15 integrand calls each): past it every panel is accepted
+/// as it stands and counted as unresolved, so no integrand (a light as large as the world, a
+/// tolerance below f64's reach everywhere) makes the rule run for hours.
+pub const MAX_PANELS: u32 = 1 << 14;
+
 /// An integral with what the adaptive rule knows of its accuracy.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Estimate {
@@ -55,9 +60,9 @@ pub struct Estimate {
     /// Sum of |Kronrod - Gauss| over the accepted panels: the rule's (usually pessimistic) bound
     /// on |value - integral|.
     pub error: f64,
-    /// Panels accepted at [`MAX_DEPTH`] with their error still above their share of the
-    /// tolerance: where the integrand could not be resolved (a jump, or a tolerance below what
-    /// f64 can deliver). Never silent: callers report it.
+    /// Panels accepted at [`MAX_DEPTH`], or once [`MAX_PANELS`] were spent, with their error
+    /// still above their share of the tolerance: where the integrand could not be resolved (a
+    /// jump, or a tolerance below what f64 can deliver). Never silent: callers report it.
     pub depth_limited: u32,
 }
 
@@ -87,21 +92,36 @@ pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels
 }
 
 /// Integral of `f` over [a, b] to absolute tolerance `tol` (bisecting panels whose error
-/// estimate exceeds their share), stopping at [`MAX_DEPTH`].
+/// estimate exceeds their share), stopping at [`MAX_DEPTH`] or when [`MAX_PANELS`] are spent.
 pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Estimate {
-    fn rec(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> Estimate {
-        if whole.1 <= tol || depth >= MAX_DEPTH {
-            return Estimate {
-                value: whole.0,
-                error: whole.1,
-                depth_limited: (whole.1 > tol) as u32,
-            };
-        }
-        let m = 0.5 * (a + b);
-        let (l, r) = (panel(f, a, m), panel(f, m, b));
-        rec(f, a, m, 0.5 * tol, l, depth + 1) + rec(f, m, b, 0.5 * tol, r, depth + 1)
+    struct Rule<'a, F> {
+        f: &'a F,
+        spent: std::cell::Cell<u32>,
     }
-    rec(&f, a, b, tol, panel(&f, a, b), 0)
+    impl<F: Fn(f64) -> f64> Rule<'_, F> {
+        fn panel(&self, a: f64, b: f64) -> (f64, f64) {
+            self.spent.set(self.spent.get() + 1);
+            panel(self.f, a, b)
+        }
+        fn rec(&self, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> Estimate {
+            if whole.1 <= tol || depth >= MAX_DEPTH || self.spent.get() + 2 > MAX_PANELS {
+                return Estimate {
+                    value: whole.0,
+                    error: whole.1,
+                    depth_limited: (whole.1 > tol) as u32,
+                };
+            }
+            let m = 0.5 * (a + b);
+            let (l, r) = (self.panel(a, m), self.panel(m, b));
+            self.rec(a, m, 0.5 * tol, l, depth + 1) + self.rec(m, b, 0.5 * tol, r, depth + 1)
+        }
+    }
+    let rule = Rule {
+        f: &f,
+        spent: std::cell::Cell::new(0),
+    };
+    let whole = rule.panel(a, b);
+    rule.rec(a, b, tol, whole, 0)
 }
 
 #[cfg(test)]
@@ -145,5 +165,22 @@ mod tests {
         // A tolerance below f64 resolution cannot be met.
         let e = integrate(|x| x.sqrt(), 0.0, 1.0, 1e-30);
         assert!(e.depth_limited > 0 && e.error > 1e-30, "{e:?}");
+    }
+
+    /// An integrand no tolerance can resolve anywhere (a jump at every scale) spends the panel
+    /// budget and stops, reporting what it could not resolve, instead of bisecting 2^40 panels.
+    #[test]
+    fn the_panel_budget_ends_an_unresolvable_integral() {
+        let calls = std::cell::Cell::new(0u64);
+        let wild = |x: f64| {
+            calls.set(calls.get() + 1);
+            ((x * 1e12).sin() * 1e6).signum()
+        };
+        let start = std::time::Instant::now();
+        let e = integrate(wild, 0.0, 1.0, 1e-15);
+        assert!(calls.get() <= 15 * MAX_PANELS as u64, "{} calls", calls.get());
+        assert!(e.depth_limited > 0, "{e:?}");
+        assert!(e.value.is_finite() && e.error.is_finite(), "{e:?}");
+        eprintln!("{} integrand calls in {:?}", calls.get(), start.elapsed());
     }
 }

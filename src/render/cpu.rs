@@ -48,7 +48,7 @@ pub fn closest_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<Receiver>
 /// [`closest_hit`] ignoring triangle `skip` (a secondary ray's own triangle).
 pub fn closest_hit_skipping(scene: &Scene, origin: DVec3, dir: DVec3, skip: u32) -> Option<Receiver> {
     work::query();
-    work::add(0, scene.shapes.len() as u64);
+    work::add(0, scene.analytic_shapes() as u64);
     let mut best: Option<(f64, usize)> = None;
     for (id, shape) in scene.shapes.iter().enumerate() {
         if let Some(t) = shape.first_t(origin, dir) {

@@ -4,7 +4,7 @@
 use crate::accel::work;
 use crate::geometry::offset_origin;
 use crate::sampling::{DiskScheme, Stream};
-use crate::scene::{DiskLight, Light, Scene};
+use crate::scene::{DiskLight, Light, Scene, Shape};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
@@ -62,8 +62,9 @@ pub fn blocked(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver)
     work::query();
     let mut tests = 0;
     let analytic = scene.shapes.iter().enumerate().any(|(id, s)| {
-        tests += (id as u32 != r.object) as u64;
-        id as u32 != r.object && s.blocks(origin, dir, len)
+        let tested = id as u32 != r.object && !matches!(s, Shape::Mesh(_));
+        tests += tested as u64;
+        tested && s.blocks(origin, dir, len)
     });
     work::add(0, tests);
     analytic

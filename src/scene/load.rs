@@ -144,6 +144,12 @@ impl Scene {
             let rotation = DQuat::from_rotation_z(rz) * DQuat::from_rotation_y(ry) * DQuat::from_rotation_x(rx);
             let transform = DMat4::from_scale_rotation_translation(DVec3::splat(m.scale), rotation, translate);
             let (kept, skipped) = clean(raw, &transform);
+            if kept.is_empty() {
+                return Err(source.error(
+                    &at("path"),
+                    format!("{} holds no triangle a ray can hit", path.display()),
+                ));
+            }
             if skipped.degenerate + skipped.non_finite > 0 {
                 tracing::warn!(
                     "{}: skipped {} degenerate and {} non-finite triangles (they can never be hit)",
@@ -188,16 +194,24 @@ impl Scene {
     }
 }
 
+/// Largest coordinate, size or scale a scene file may give (metres): a scene 20,000 km across
+/// is already beyond what f32 on the GPU resolves at a pixel; past it sizes are nonsense that
+/// would only exhaust memory or the exact answer's quadrature.
+pub const MAX_EXTENT: f64 = 1e7;
+
 struct Validator<'a> {
     source: &'a Source,
 }
 
 impl Validator<'_> {
     fn point(&self, p: &[f64; 3], at: &[Seg]) -> Result<DVec3, ConfigError> {
-        if p.iter().all(|x| x.is_finite()) {
+        if p.iter().all(|x| x.is_finite() && x.abs() <= MAX_EXTENT) {
             Ok(DVec3::from_array(*p))
         } else {
-            Err(self.source.error(at, "coordinates must be finite"))
+            Err(self.source.error(
+                at,
+                format!("coordinates must be finite and within +-{MAX_EXTENT:e} m, got {p:?}"),
+            ))
         }
     }
 
@@ -208,10 +222,12 @@ impl Validator<'_> {
     }
 
     fn positive(&self, x: f64, at: &[Seg]) -> Result<f64, ConfigError> {
-        if x.is_finite() && x > 0.0 {
+        if x.is_finite() && x > 0.0 && x <= MAX_EXTENT {
             Ok(x)
         } else {
-            Err(self.source.error(at, format!("must be positive and finite, got {x}")))
+            Err(self
+                .source
+                .error(at, format!("must be positive and at most {MAX_EXTENT:e}, got {x}")))
         }
     }
 

@@ -252,6 +252,12 @@ impl Scene {
         })
     }
 
+    /// Shapes a query tests one by one (spheres and planes; a mesh's triangles are the
+    /// structure's to test).
+    pub fn analytic_shapes(&self) -> usize {
+        self.shapes.iter().filter(|s| !matches!(s, Shape::Mesh(_))).count()
+    }
+
     /// The planes, in id order.
     pub fn planes(&self) -> impl Iterator<Item = &Plane> {
         self.shapes.iter().filter_map(|s| match s {

@@ -379,3 +379,36 @@ fn kd_tree_parameters_are_checked() {
     let stats = s.accel.as_ref().unwrap().stats();
     assert_eq!(stats.parameters, "depth 7 leaf 1");
 }
+
+/// The work counters are exact and deterministic: with brute force and no light, each pixel asks
+/// one query that tests the two analytic shapes and all four triangles; every structure's counts
+/// are the same on one thread as on two; and every structure asks the same queries (the same
+/// rays) as brute force.
+#[test]
+fn work_counts_are_exact_and_do_not_depend_on_threads() {
+    let cam = camera();
+    let mut dark = scene("brute");
+    dark.lights.clear();
+    let f = render(&mut CpuBackend::default(), &dark, &cam);
+    let pixels = 48 * 40;
+    let w = f.work().expect("the CPU counts");
+    assert_eq!((w.queries, w.nodes, w.primitives), (pixels, 0, pixels * (2 + 4)));
+    let on = |threads: usize, s: &Scene| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| render(&mut CpuBackend::default(), s, &cam))
+            .work()
+            .unwrap()
+    };
+    let brute = on(2, &scene("brute"));
+    for r in REGISTRY {
+        let s = scene(r.name);
+        let (one, two) = (on(1, &s), on(2, &s));
+        assert_eq!(one, two, "{}: counts depend on the thread count", r.name);
+        assert_eq!(two.queries, brute.queries, "{} asks other queries", r.name);
+        assert!(
+            two.primitives <= brute.primitives,
+            "{} tests more than brute force",
+            r.name
+        );
+    }
+}

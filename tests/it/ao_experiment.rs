@@ -56,7 +56,7 @@ fn bad_input_is_located_and_writes_nothing() {
     for (edit, key) in [
         (text.replace("\"vlf\", \"bvh\"", "\"vlf\", \"octree\""), "structures[2]"),
         (text.replace("rays = 33", "rays = 34"), "rays"),
-        (text.replace("repeats = 5", "repeats = 2"), "timing.repeats"),
+        (text.replacen("repeats = 6", "repeats = 2", 1), "timing.repeats"),
         (text.replace("cow.off", "no-such.off"), "meshes[0].path"),
         (text.replace("depth = [2, 4]", "depth = [2, 9]"), "accel.vlf.depth"),
     ] {

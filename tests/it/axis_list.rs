@@ -24,7 +24,7 @@ fn identity_columns_and_row_order_come_from_the_axis_list() {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::tiny_experiment(dir.path(), |t| {
         t.replace("light_radii = [0.02]", "light_radii = [0.02, 0.03]")
-            .replace("repeats = 0", "repeats = 5")
+            .replace("repeats = 0", "repeats = 6")
     });
     let out = dir.path().join("out");
     let (code, e) = common::sweep(&[

@@ -12,7 +12,7 @@ fn rejects(edit: impl Fn(String) -> String) -> String {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::tiny_experiment(dir.path(), edit);
     let out = dir.path().join("results");
-    common::earlier_results(&out, "tiny");
+    common::earlier_results(&out, "sweep", "tiny");
     let (code, stderr) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
     assert_eq!(code, 2, "bad input must exit with status 2; stderr:\n{stderr}");
     assert_eq!(
@@ -169,7 +169,7 @@ fn another_kinds_file_is_read_by_its_kind() {
     // A frame rate cannot go untimed: the fps kind's own rule.
     let e = rejects(|t| format!("kind = \"fps\"\n{t}"));
     assert!(e.contains("tiny.toml:") && e.contains("key `timing.repeats`"), "{e}");
-    let e = rejects(|t| format!("kind = \"fps\"\n{}", t.replace("repeats = 0", "repeats = 5")));
+    let e = rejects(|t| format!("kind = \"fps\"\n{}", t.replace("repeats = 0", "repeats = 6")));
     assert!(
         e.contains("tiny.toml:") && e.contains("unknown field") && e.contains("`samples`"),
         "{e}"

@@ -58,11 +58,18 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
                 "Whitted: shadow rays to 4 lights and reflections; {rays}"
             ),
         }
-        assert!(r[col("frame_s")].parse::<f64>().unwrap() > 0.0);
+        let (lo, med, hi) = (
+            r[col("frame_s_lo")].parse::<f64>().unwrap(),
+            r[col("frame_s")].parse::<f64>().unwrap(),
+            r[col("frame_s_hi")].parse::<f64>().unwrap(),
+        );
+        assert!(0.0 < lo && lo <= med && med <= hi, "{r:?}");
+        assert_eq!(&r[col("timed_renders")], "3");
     }
     let out = dir.path().join("out");
     for file in [
         "builds.csv",
+        "summary.csv",
         "manifest.toml",
         "plots/frame_time_opengl.png",
         "plots/frame_time_whitted.png",
@@ -135,6 +142,12 @@ fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
     for r in &rows {
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
         assert!(r[col("update_s")].parse::<f64>().unwrap() > 0.0, "{r:?}");
+        let said = match &r[col("update")] {
+            "update" => "in-place",
+            "refit" => "refit",
+            _ => "rebuild",
+        };
+        assert_eq!(&r[col("update_kind")], said, "what the structure says it did: {r:?}");
     }
     assert!(
         report.contains("Is `vlf (update)` cheaper than `bvh (refit)`?"),
@@ -234,17 +247,19 @@ fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
         viewpoint: "walk".into(),
         frame,
         seconds,
-        renders: 3,
+        renders: vec![seconds; 3],
         update_seconds: None,
-        rays: 10,
+        updated: None,
+        rays: Default::default(),
         work: Default::default(),
         differing_pixels,
     };
-    // kd-tree about 2x slower than the field on every frame; the BVH faster on half the
-    // frames, slower on the other half.
+    // kd-tree about 2x slower than the field on every one of 36 frames (jittered, no trend);
+    // the BVH faster on half the frames, slower on the other half.
+    let jitter = |f: u32| 0.01 * ((f * 7) % 5) as f64;
     let mut frames = Vec::new();
-    for f in 0..8 {
-        frames.push(row("kdtree", f, 2.0 + 0.01 * f as f64, 0));
+    for f in 0..36 {
+        frames.push(row("kdtree", f, 2.0 + jitter(f), 0));
         frames.push(row("vlf", f, 1.0, if f == 2 { 7 } else { 0 }));
         frames.push(row("bvh", f, if f % 2 == 0 { 1.5 } else { 0.5 }, 0));
     }
@@ -261,12 +276,24 @@ fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
         v.contains("Is `vlf` faster than `kdtree` (the paper's baseline), opengl shading?** **yes**"),
         "{v}"
     );
-    assert!(v.contains("faster on 8 of 8 frames"), "{v}");
+    assert!(v.contains("faster on 36 of 36 frames"), "{v}");
     assert!(
         v.contains("Is `vlf` faster than `bvh`, opengl shading?** **not clearly**"),
         "{v}"
     );
-    assert!(v.contains("faster on 4 of 8 frames"), "{v}");
+    assert!(v.contains("faster on 18 of 36 frames"), "{v}");
+    // Three frames, all 2x faster, give no interval: not clearly.
+    let few = FramesOutcome {
+        frames: (0..3)
+            .flat_map(|f| [row("kdtree", f, 2.0, 0), row("vlf", f, 1.0, 0)])
+            .collect(),
+        ..Default::default()
+    };
+    let v = verdict(&spec, &few);
+    assert!(
+        v.contains("(the paper's baseline), opengl shading?** **not clearly**"),
+        "{v}"
+    );
     frames_all_slower(&spec);
 }
 
@@ -275,9 +302,9 @@ fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
     use penumbra::experiment::frames::runner::{FrameRow, FramesOutcome};
     use penumbra::experiment::frames::spec::ShadingName;
     use penumbra::experiment::frames::verdict::verdict;
-    let frames = (0..8)
+    let frames = (0..36)
         .flat_map(|f| {
-            [("kdtree", 0.5), ("vlf", 1.0 + 0.01 * f as f64)].map(|(structure, seconds)| FrameRow {
+            [("kdtree", 0.5), ("vlf", 1.0 + 0.01 * ((f * 7) % 5) as f64)].map(|(structure, seconds)| FrameRow {
                 triangles: 100,
                 structure,
                 update: "none",
@@ -285,9 +312,10 @@ fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
                 viewpoint: "walk".into(),
                 frame: f,
                 seconds,
-                renders: 3,
+                renders: vec![seconds; 3],
                 update_seconds: None,
-                rays: 10,
+                updated: None,
+                rays: Default::default(),
                 work: Default::default(),
                 differing_pixels: 0,
             })

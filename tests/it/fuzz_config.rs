@@ -1,5 +1,6 @@
-//! Bad input, fuzzed: random edits of valid experiment and scene files never panic the loader,
-//! and every rejection names the file (and, when the text parses as TOML, a line).
+//! Bad input, fuzzed: random edits of valid experiment and scene files, of every kind, never
+//! panic the loader, and every rejection names the file (and, when the text parses as TOML, a
+//! line).
 
 use penumbra::experiment::sweep::Spec;
 use proptest::prelude::*;
@@ -66,6 +67,49 @@ proptest! {
     fn arbitrary_bytes_are_rejected_cleanly(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
         let scene = std::fs::read(repo("experiments/scenes/sphere.toml")).unwrap();
         prop_assert!(load_edited(&bytes, &scene).is_err());
+    }
+}
+
+/// The shipped CI-sized experiment of each other kind, its relative paths made absolute.
+fn kind_file(file: &str) -> String {
+    std::fs::read_to_string(repo(&format!("experiments/{file}")))
+        .unwrap()
+        .replace("\"../assets/", &format!("\"{}/", repo("assets").display()))
+        .replace("\"scenes/", &format!("\"{}/", repo("experiments/scenes").display()))
+}
+
+/// Loads `text` as an experiment of any kind through the driver's loader; an error must name
+/// the file.
+fn load_kind(text: &[u8]) {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(&exp, text).unwrap();
+    if let Err(e) = penumbra::experiment::load(&exp) {
+        let text = e.to_string();
+        assert!(
+            text.contains("exp.toml") || text.contains(".toml") || text.contains(".off"),
+            "error names no file: {text}"
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    #[test]
+    fn edited_frame_time_experiments_never_panic(edits in proptest::collection::vec((any::<usize>(), any::<u8>(), any::<u8>()), 1..6)) {
+        load_kind(&mutate(&kind_file("frames-ci.toml"), &edits));
+    }
+
+    #[test]
+    fn edited_ambient_occlusion_experiments_never_panic(edits in proptest::collection::vec((any::<usize>(), any::<u8>(), any::<u8>()), 1..6)) {
+        load_kind(&mutate(&kind_file("ao-ci.toml"), &edits));
+    }
+
+    #[test]
+    fn edited_frame_rate_experiments_never_panic(edits in proptest::collection::vec((any::<usize>(), any::<u8>(), any::<u8>()), 1..6)) {
+        let text = kind_file("fps.toml").replace("scenes/body.toml", "scenes/sphere-two-lights.toml");
+        load_kind(&mutate(&text, &edits));
     }
 }
 

@@ -17,6 +17,7 @@ mod fuzz_mesh_files;
 mod gpu_backend;
 mod gpu_resources;
 mod hard_cases;
+mod hostile_input;
 mod kdtree;
 mod mesh_scene;
 mod receiver_masks;

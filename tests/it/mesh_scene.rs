@@ -325,3 +325,64 @@ fn the_visibility_field_renders_the_body_as_the_bvh_does() {
         }
     }
 }
+
+/// body.toml measures both lights: each light's penumbra covers hundreds of the measuring
+/// view's receiver pixels, and each light carries a real share of a run's error over the sweep's
+/// mask (the union of the lights' penumbrae): sampling a light exactly instead removes at least
+/// 15 % of the squared error. Where a light casts no penumbra in view (the earlier view: the
+/// second light's shadow fell elsewhere), it carries none, and the two-light error is the
+/// one-light error rescaled.
+#[test]
+fn both_lights_carry_a_share_of_the_measured_error() {
+    use penumbra::metrics::error::PenumbraMask;
+    use penumbra::metrics::profile::Receivers;
+    let scene = body();
+    let camera = &scene.cameras["measure"];
+    let view = View {
+        camera,
+        width: 96,
+        height: 96,
+    };
+    let with_samples = |n: u32| {
+        let mut s = scene.clone();
+        for l in &mut s.lights {
+            if let penumbra::scene::Light::Disk(d) = l {
+                d.samples = n;
+            }
+        }
+        s
+    };
+    let render = |s: &Scene, scheme: DiskScheme, seed: u32| {
+        let sampling = Sampling {
+            scheme,
+            pattern: Pattern::PerPixel,
+            seed,
+        };
+        CpuBackend::default().render(s, view, sampling).unwrap()
+    };
+    let gt = render(&with_samples(128), DiskScheme::Jittered, 1);
+    let run = render(&with_samples(16), DiskScheme::Uniform, 2);
+    let receivers = Receivers::new(&scene, view, 0, &gt.hit, camera.look_at, 0.7 / 96.0);
+    assert!(receivers.pixels.len() > 90 * 90, "the view sees the floor");
+    let (g, v) = (&gt.visibility, &run.visibility);
+    for light in 0..2 {
+        let own = PenumbraMask::union(&g[light..light + 1], &receivers);
+        assert!(
+            own.pixels.len() >= 300,
+            "light {light}: {} penumbra pixels",
+            own.pixels.len()
+        );
+    }
+    let mask = PenumbraMask::union(g, &receivers);
+    let squared = |a0: &[f32], a1: &[f32]| -> f64 {
+        mask.pixels
+            .iter()
+            .map(|&i| (((a0[i] + a1[i]) - (g[0][i] + g[1][i])) as f64 / 2.0).powi(2))
+            .sum::<f64>()
+    };
+    let both = squared(&v[0], &v[1]);
+    for (light, without) in [(0, squared(&g[0], &v[1])), (1, squared(&v[0], &g[1]))] {
+        let share = 1.0 - without / both;
+        assert!(share >= 0.15, "light {light} carries {share:.3} of the squared error");
+    }
+}

@@ -347,7 +347,13 @@ impl penumbra::accel::Accelerator for Renamed {
     fn gpu(&self, frame: &penumbra::geometry::LocalFrame) -> anyhow::Result<penumbra::accel::GpuStructure> {
         self.0.gpu(frame)
     }
-    fn update(&mut self, _: &str, _: &penumbra::mesh::Triangles, _: u32, _: DVec3) -> anyhow::Result<()> {
+    fn update(
+        &mut self,
+        _: &str,
+        _: &penumbra::mesh::Triangles,
+        _: u32,
+        _: DVec3,
+    ) -> anyhow::Result<penumbra::accel::Updated> {
         anyhow::bail!("a test double does not move")
     }
 }

@@ -318,7 +318,7 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         ]);
     }
     // Earlier results in the folder must survive every refused merge.
-    common::earlier_results(&out, "ci");
+    common::earlier_results(&out, "sweep", "ci");
     let refused = |extra: &[&OsStr], expect: &[&str]| {
         let mut args = vec![
             ci().into_os_string(),

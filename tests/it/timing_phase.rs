@@ -49,7 +49,7 @@ impl Backend for Drifting {
 fn configurations_are_timed_once_in_interleaved_rounds() {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::tiny_experiment(dir.path(), |t| {
-        t.replace("warmup = 0\nrepeats = 0", "warmup = 2\nrepeats = 5")
+        t.replace("warmup = 0\nrepeats = 0", "warmup = 2\nrepeats = 6")
     });
     let spec = Spec::load(&exp).unwrap();
     let mut backend = Drifting {
@@ -58,11 +58,11 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     };
     let (journal, cache) = (dir.path().join("j"), dir.path().join("c"));
     let out = run_sweep(&spec, &mut backend, &journal, &cache, true, &Progress::default()).unwrap();
-    // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 5 rounds,
+    // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 6 rounds,
     // plus the A/A control's visits.
     let configs = 8;
     let per_round = configs + NOISE_VISITS as usize;
-    assert_eq!(backend.calls.len(), 5 * per_round);
+    assert_eq!(backend.calls.len(), 6 * per_round);
     assert!(
         backend.calls.iter().all(|c| c.2 == 2 && c.3 == 1),
         "warm-up frames, one timed frame"
@@ -79,10 +79,10 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     assert!(rounds.windows(2).all(|w| w[0] != w[1]), "every round has its own order");
     assert_eq!(out.timings.configs.len(), configs);
     let (probe, noise) = out.timings.noise.as_ref().expect("an A/A control");
-    assert_eq!(noise.frame_seconds.len(), 5 * NOISE_VISITS as usize);
+    assert_eq!(noise.frame_seconds.len(), 6 * NOISE_VISITS as usize);
     assert_eq!((probe.scheme, probe.samples), (DiskScheme::Uniform, 16));
     for r in &out.records {
-        assert_eq!(r.time.timed_frames, Some(5));
+        assert_eq!(r.time.timed_frames, Some(6));
         let (lo, med, hi) = (r.time.frame_s_lo, r.time.frame_s, r.time.frame_s_hi);
         assert!(lo <= med && med <= hi && lo > 10e-3, "{lo} {med} {hi}");
     }
@@ -91,7 +91,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     let all: Vec<_> = out.timings.configs.values().chain([noise]).collect();
     for a in &all {
         for b in &all {
-            let (ratio, word) = compare(a, b, out.timings.seed);
+            let (ratio, word) = compare(a, b);
             assert_eq!(word, Comparison::Equal, "{ratio:?}");
         }
     }
@@ -116,16 +116,16 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     backend.calls.clear();
     let third = run_sweep(&wider, &mut backend, &journal, &cache, false, &Progress::default()).unwrap();
     assert_eq!(third.timings.configs.len(), configs + 4);
-    assert_eq!(backend.calls.len(), 5 * (configs + 4 + NOISE_VISITS as usize));
+    assert_eq!(backend.calls.len(), 6 * (configs + 4 + NOISE_VISITS as usize));
 }
 
 #[test]
-fn timing_asks_for_at_least_five_repeats() {
+fn timing_asks_for_at_least_six_repeats() {
     let dir = tempfile::tempdir().unwrap();
-    let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 3"));
+    let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 5"));
     let e = Spec::load(&exp).unwrap_err().to_string();
     assert!(
-        e.contains("tiny.toml:") && e.contains("timing.repeats") && e.contains("at least 5"),
+        e.contains("tiny.toml:") && e.contains("timing.repeats") && e.contains("at least 6"),
         "{e}"
     );
 }

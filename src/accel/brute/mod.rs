@@ -95,11 +95,17 @@ impl Accelerator for Brute {
         })
     }
 
-    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
+    fn update(
+        &mut self,
+        method: &str,
+        moved: &Triangles,
+        _object: u32,
+        _step: DVec3,
+    ) -> anyhow::Result<super::Updated> {
         match method {
             "rebuild" => *self = Brute::build(moved),
             m => return Err(super::unknown_update(self, m)),
         }
-        Ok(())
+        Ok(super::Updated::Rebuilt)
     }
 }

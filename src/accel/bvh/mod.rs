@@ -251,12 +251,13 @@ impl Bvh {
 
     /// Walks the CPU tree along `ray`, near child first, calling `test(slot)` for each
     /// primitive slot of every leaf the ray's current segment meets: `Some(t)` shortens the
-    /// segment to `t`, `Some(NEG_INFINITY)` ends the walk. Counts box tests and primitive tests
-    /// ([`crate::accel::work`]).
+    /// segment to `t`, `Some(NEG_INFINITY)` ends the walk. Counts the nodes it examines (an
+    /// inner node whose children's boxes it tests, a leaf whose triangles it tests; none when
+    /// the root's box is missed) and the primitive tests ([`crate::accel::work`]).
     #[inline]
     fn walk(&self, mut ray: Ray, mut test: impl FnMut(usize) -> Option<f32>) {
         let nodes = &self.cpu_tree.nodes;
-        let (mut boxes, mut prims) = (1u64, 0u64);
+        let (mut visited, mut prims) = (0u64, 0u64);
         let mut leaf = |node: &obvhs::bvh2::node::Bvh2Node, ray: &mut Ray, prims: &mut u64| -> bool {
             for slot in node.first_index..node.first_index + node.prim_count {
                 *prims += 1;
@@ -271,12 +272,11 @@ impl Bvh {
         };
         let root = &nodes[0];
         if root.aabb().intersect_ray(&ray) >= ray.tmax {
-            work::add(boxes, prims);
             return;
         }
         if root.is_leaf() {
             leaf(root, &mut ray, &mut prims);
-            work::add(boxes, prims);
+            work::add(1, prims);
             return;
         }
         let mut small = [0u32; 128];
@@ -292,7 +292,7 @@ impl Bvh {
         loop {
             let (mut near, mut far) = (&nodes[current], &nodes[current + 1]);
             let (mut tn, mut tf) = (near.aabb().intersect_ray(&ray), far.aabb().intersect_ray(&ray));
-            boxes += 2;
+            visited += 1;
             if tn > tf {
                 std::mem::swap(&mut tn, &mut tf);
                 std::mem::swap(&mut near, &mut far);
@@ -303,8 +303,9 @@ impl Bvh {
                     continue;
                 }
                 if node.is_leaf() {
+                    visited += 1;
                     if !leaf(node, &mut ray, &mut prims) {
-                        work::add(boxes, prims);
+                        work::add(visited, prims);
                         return;
                     }
                 } else {
@@ -320,7 +321,7 @@ impl Bvh {
                 [Some(a), None] | [None, Some(a)] => a,
                 [None, None] => {
                     if top == 0 {
-                        work::add(boxes, prims);
+                        work::add(visited, prims);
                         return;
                     }
                     top -= 1;
@@ -429,16 +430,28 @@ impl Accelerator for Bvh {
         &["refit", "rebuild", "rebuild-fastest"]
     }
 
-    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
-        match method {
+    fn update(
+        &mut self,
+        method: &str,
+        moved: &Triangles,
+        _object: u32,
+        _step: DVec3,
+    ) -> anyhow::Result<super::Updated> {
+        Ok(match method {
             "refit" => {
                 self.refit(moved);
+                super::Updated::Refit
             }
-            "rebuild" => *self = Bvh::build(moved, self.preset),
-            "rebuild-fastest" => *self = Bvh::build(moved, Preset::Fastest),
+            "rebuild" => {
+                *self = Bvh::build(moved, self.preset);
+                super::Updated::Rebuilt
+            }
+            "rebuild-fastest" => {
+                *self = Bvh::build(moved, Preset::Fastest);
+                super::Updated::Rebuilt
+            }
             m => return Err(super::unknown_update(self, m)),
-        }
-        Ok(())
+        })
     }
 }
 

@@ -304,11 +304,17 @@ impl Accelerator for KdTree {
         gpu::structure(self, &self.triangles, frame)
     }
 
-    fn update(&mut self, method: &str, moved: &Triangles, _object: u32, _step: DVec3) -> anyhow::Result<()> {
+    fn update(
+        &mut self,
+        method: &str,
+        moved: &Triangles,
+        _object: u32,
+        _step: DVec3,
+    ) -> anyhow::Result<crate::accel::Updated> {
         match method {
             "rebuild" => *self = KdTree::build(moved, self.settings),
             m => return Err(crate::accel::unknown_update(self, m)),
         }
-        Ok(())
+        Ok(crate::accel::Updated::Rebuilt)
     }
 }

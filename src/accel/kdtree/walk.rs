@@ -80,11 +80,9 @@ pub fn walk(
         .max(origin.abs())
         .max_element();
     let delta = DELTA * scale.max(f64::MIN_POSITIVE);
-    let Some((t0, t1)) = clip(tree.bounds, origin, dir, tmax, delta) else {
-        work::add(1, 0);
-        return None;
-    };
-    let (mut nodes, mut prims) = (1u64, 0u64);
+    let (t0, t1) = clip(tree.bounds, origin, dir, tmax, delta)?;
+    // Nodes examined: inner nodes descended through and leaves whose triangles are tested.
+    let (mut nodes, mut prims) = (0u64, 0u64);
     let mut stack = [(0usize, 0.0f64, 0.0f64); STACK];
     let mut top = 0;
     let mut current = Some((0usize, t0, t1));
@@ -121,6 +119,7 @@ pub fn walk(
         if tree.nodes[node].inner().is_some() {
             continue;
         }
+        nodes += 1;
         let (first, count) = tree.nodes[node].items();
         for &i in &tree.items[first..first + count] {
             if i == skip {

@@ -194,6 +194,16 @@ pub fn ball(world: &[[DVec3; 3]]) -> (DVec3, f64) {
     (centre, radius)
 }
 
+/// A lower bound on the field's peak bytes while it is built over `triangles` triangles: its
+/// arrays hold a 4-byte offset per tile of every direction and at least one 6-byte entry (id
+/// and footprint box) per triangle per direction, and the build holds them twice (every
+/// direction's part, then the merged arrays); besides, the packed triangles.
+pub fn min_bytes(triangles: usize, s: &VlfSettings) -> u64 {
+    let directions = 2 * s.level as u64 * s.level as u64 + 1;
+    let arrays = directions * (s.tiles as u64).pow(2) * 4 + triangles as u64 * directions * 6;
+    2 * arrays + triangles as u64 * 72
+}
+
 impl VisibilityField {
     /// Builds the field over `triangles` (an empty list gives a field that never hits).
     pub fn build(triangles: &Triangles, settings: VlfSettings) -> anyhow::Result<VisibilityField> {
@@ -322,10 +332,29 @@ impl Accelerator for VisibilityField {
         &["update"]
     }
 
-    fn update(&mut self, method: &str, _moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<()> {
-        match method {
-            "update" => self.move_object(object, |p| p + step).map(|_| ()),
-            m => Err(crate::accel::unknown_update(self, m)),
+    /// The field moves its own copy of the object; the scene's moved triangles must be that
+    /// copy, bit for bit, or the field would answer for triangles the scene no longer has.
+    fn update(
+        &mut self,
+        method: &str,
+        moved: &Triangles,
+        object: u32,
+        step: DVec3,
+    ) -> anyhow::Result<crate::accel::Updated> {
+        if method != "update" {
+            return Err(crate::accel::unknown_update(self, method));
         }
+        self.move_object(object, |p| p + step)?;
+        anyhow::ensure!(
+            moved.positions.len() == self.world.len()
+                && moved
+                    .object_of
+                    .iter()
+                    .zip(&moved.positions)
+                    .zip(&self.world)
+                    .all(|((&o, m), w)| o != object || m == w),
+            "the visibility field's copy of object {object} moved by {step} differs from the scene's moved triangles"
+        );
+        Ok(crate::accel::Updated::InPlace)
     }
 }

@@ -59,7 +59,7 @@ impl Experiment for AoSpec {
         let (rows, tuning) = run_ao(self, run.backend, run.progress)?;
         let threads = rayon::current_num_threads();
         let seconds = run.started.elapsed().as_secs_f64();
-        report::write_ao(self, (&rows, &tuning), threads, seconds, run.out.dir())?;
+        report::write_ao(self, (&rows, &tuning), threads, seconds, run.out)?;
         tracing::info!("{} rows", rows.len());
         let mut details = toml::Table::new();
         details.insert("rows".into(), (rows.len() as i64).into());

@@ -4,6 +4,7 @@
 
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
+use crate::experiment::outputs::Outputs;
 use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
@@ -11,7 +12,6 @@ use crate::output::images::{grey, write_png};
 use crate::output::plots::{line_plot, Axes, Series};
 use crate::output::table::{float, write_rows};
 use serde::Serialize;
-use std::path::Path;
 
 /// A row of ao.csv.
 #[derive(Serialize)]
@@ -67,11 +67,11 @@ fn find<'a>(rows: &'a [AoRow], mesh: &str, structure: &str) -> Option<&'a AoRow>
 
 /// Speed-up of `subject` over `other` on one mesh: `other`'s time over `subject`'s (median of
 /// per-round ratios with its interval), and the rule's word for `subject`.
-fn speedup(subject: &AoRow, other: &AoRow, seed: u32) -> (Estimate, Comparison) {
+fn speedup(subject: &AoRow, other: &AoRow) -> (Estimate, Comparison) {
     if subject.frame_seconds.len() != other.frame_seconds.len() || subject.frame_seconds.is_empty() {
         return (Estimate::NAN, Comparison::Equal);
     }
-    let ratio = paired_ratio(&subject.frame_seconds, &other.frame_seconds, seed);
+    let ratio = paired_ratio(&subject.frame_seconds, &other.frame_seconds);
     (ratio.recip(), Comparison::of(&ratio))
 }
 
@@ -79,7 +79,6 @@ fn speedup(subject: &AoRow, other: &AoRow, seed: u32) -> (Estimate, Comparison) 
 /// other structure, per mesh by the rule, with the work and memory behind each time.
 pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     let mut out = String::new();
-    let seed = spec.header.schedule.seed;
     let identical = rows.iter().all(|r| r.same_image);
     out += &format!(
         "- **Exactness**: every structure's AO image {} the first structure's, bit for bit, on every mesh.\n",
@@ -92,7 +91,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
             .iter()
             .filter_map(|m| {
                 let (a, b) = (find(rows, &m.name, subject)?, find(rows, &m.name, other)?);
-                let (e, c) = speedup(a, b, seed);
+                let (e, c) = speedup(a, b);
                 Some((m.name.clone(), e, c))
             })
             .collect();
@@ -168,16 +167,18 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     out
 }
 
-/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png and report.md under `out`.
+/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png and report.md into `outputs`
+/// (each path checked to stay in it: mesh names become file names).
 pub fn write_ao(
     spec: &AoSpec,
     (rows, tuning): (&[AoRow], &[TuningRow]),
     threads: usize,
     seconds: f64,
-    out: &Path,
+    outputs: &Outputs,
 ) -> anyhow::Result<()> {
+    let out = |name: &str| outputs.path(name);
     write_rows(
-        &out.join("tuning.csv"),
+        &out("tuning.csv")?,
         tuning.iter().map(|t| TuningCsv {
             mesh: &t.mesh,
             structure: t.structure,
@@ -211,11 +212,11 @@ pub fn write_ao(
         mean_ao: r.mean_ao,
         same_image_as_first: r.same_image,
     });
-    write_rows(&out.join("ao.csv"), csv)?;
+    write_rows(&out("ao.csv")?, csv)?;
     for m in &spec.meshes {
         if let Some(r) = rows.iter().find(|r| r.mesh == m.name) {
             write_png(
-                &out.join("images").join(format!("{}.png", m.name)),
+                &out(&format!("images/{}.png", m.name))?,
                 &grey(&r.image, spec.width, spec.height),
             )?;
         }
@@ -241,7 +242,7 @@ pub fn write_ao(
         })
         .collect();
     line_plot(
-        &out.join("plots/frame_time.png"),
+        &out("plots/frame_time.png")?,
         &Axes::new(
             &format!(
                 "AO, {} rays per hit, {}x{}, CPU f64",
@@ -255,7 +256,7 @@ pub fn write_ao(
         &series,
         &[],
     )?;
-    write_atomic(&out.join("report.md"), report(spec, rows, threads, seconds).as_bytes())
+    write_atomic(&out("report.md")?, report(spec, rows, threads, seconds).as_bytes())
 }
 
 fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {
@@ -315,7 +316,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
     md += &format!("\n## The paper's Table 1 beside ours\n\nThe paper (2.8 GHz Pentium 4, 256x256, 513 rays per point): CRT and VLF-RT seconds at each one's best depth. Ours: `{baseline}`'s frame time over `{subject}`'s (median of per-round ratios, 95 % interval).\n\n| mesh | paper CRT s (depth) | paper VLF-RT s (depth) | paper speed-up | our speed-up |\n|---|---|---|---|---|\n");
     for m in &spec.meshes {
         let ours = match (find(rows, &m.name, subject), find(rows, &m.name, baseline)) {
-            (Some(a), Some(b)) => format!("{}x", speedup(a, b, schedule.seed).0.show(2)),
+            (Some(a), Some(b)) => format!("{}x", speedup(a, b).0.show(2)),
             _ => "n/a".into(),
         };
         match &m.paper {

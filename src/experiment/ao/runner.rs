@@ -172,7 +172,7 @@ fn tune(
             mesh: mesh.name.clone(),
             structure,
             settings: settings.clone(),
-            frame: median_interval(t, schedule.seed),
+            frame: median_interval(t),
             work,
             chosen: false,
         })
@@ -238,11 +238,13 @@ pub fn run_ao(
             bar.inc(1);
         }
         if schedule.repeats > 0 {
-            bar.message(format!("{}: timing", mesh.name));
-            let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {})?;
+            bar.message(format!("{}: timing {} rounds", mesh.name, schedule.repeats));
+            let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {
+                bar.message(format!("{}: timing", mesh.name))
+            })?;
             let base = rows.len() - scenes.len();
             for (row, t) in rows[base..].iter_mut().zip(times) {
-                row.frame = median_interval(&t, schedule.seed);
+                row.frame = median_interval(&t);
                 row.frame_seconds = t;
             }
         }

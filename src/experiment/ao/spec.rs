@@ -183,10 +183,14 @@ impl AoSpec {
             t.width,
             t.height,
         )?;
-        if !(1..=crate::experiment::header::MAX_REPEATS).contains(&t.repeats) {
+        let least = crate::experiment::kind::Kind::Ao.min_repeats();
+        if !(least..=crate::experiment::header::MAX_REPEATS).contains(&t.repeats) {
             return Err(err(
                 &key_path!["tuning", "repeats"],
-                format!("must be in 1..={}", crate::experiment::header::MAX_REPEATS),
+                format!(
+                    "must be in {least}..={} (the rounds behind each candidate's median and its interval)",
+                    crate::experiment::header::MAX_REPEATS
+                ),
             ));
         }
         let mut given = read_tables(source, &key_path!["accel"], &f.accel, true)?;
@@ -208,7 +212,7 @@ impl AoSpec {
                 "must differ from `subject`".into(),
             ));
         }
-        let structures = names
+        let structures: Vec<(&'static str, Vec<AccelSettings>)> = names
             .into_iter()
             .map(|name| {
                 let r = crate::accel::registered(name).expect("a registered name");
@@ -260,6 +264,21 @@ impl AoSpec {
         }
         if meshes.is_empty() {
             return Err(err(&key_path!["meshes"], "list at least one mesh".into()));
+        }
+        let available = crate::accel::memory::available_bytes();
+        for (i, (name, candidates)) in structures.iter().enumerate() {
+            for m in &meshes {
+                for c in candidates {
+                    crate::accel::memory::check(c, m.triangles.positions.len(), available).map_err(|e| {
+                        let at = if f.accel.contains_key(*name) {
+                            key_path!["accel", *name]
+                        } else {
+                            key_path!["structures", i]
+                        };
+                        err(&at, format!("mesh `{}`: {e}", m.name))
+                    })?;
+                }
+            }
         }
         Ok(AoSpec {
             name: header.name.clone(),

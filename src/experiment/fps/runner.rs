@@ -111,7 +111,7 @@ pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend, progress: &Progress) -
     })?;
     bar.finish();
     for ((row, seconds), clock) in rows.iter_mut().zip(times).zip(clocks) {
-        row.frame = median_interval(&seconds, schedule.seed);
+        row.frame = median_interval(&seconds);
         row.frame_seconds = seconds;
         row.clock = clock;
     }

@@ -6,7 +6,7 @@
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{FramesSpec, Generator};
 use super::verdict::{label, labels, median_at, verdict};
-use crate::experiment::timing::{series_median, RULE};
+use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::tonemap;
@@ -26,10 +26,20 @@ struct FrameCsv<'a> {
     frame: u32,
     #[serde(with = "float")]
     frame_s: f64,
+    #[serde(with = "float")]
+    frame_s_lo: f64,
+    #[serde(with = "float")]
+    frame_s_hi: f64,
     timed_renders: usize,
     #[serde(with = "float")]
     update_s: f64,
+    /// `refit`, `in-place` or `rebuild`, as the structure says.
+    update_kind: &'static str,
     rays: u64,
+    primary_rays: u64,
+    shadow_rays: u64,
+    reflection_rays: u64,
+    ambient_rays: u64,
     queries: u64,
     nodes_visited: u64,
     primitive_tests: u64,
@@ -65,9 +75,16 @@ pub fn write_frames(
             viewpoint: &r.viewpoint,
             frame: r.frame,
             frame_s: r.seconds,
-            timed_renders: r.renders,
+            frame_s_lo: median_interval(&r.renders).lo,
+            frame_s_hi: median_interval(&r.renders).hi,
+            timed_renders: r.renders.len(),
             update_s: r.update_seconds.unwrap_or(f64::NAN),
-            rays: r.rays,
+            update_kind: r.updated.map_or("", |u| u.name()),
+            rays: r.rays.total(),
+            primary_rays: r.rays.primary,
+            shadow_rays: r.rays.shadow_total(),
+            reflection_rays: r.rays.reflection,
+            ambient_rays: r.rays.ambient,
             queries: r.work.queries,
             nodes_visited: r.work.nodes,
             primitive_tests: r.work.primitives,
@@ -84,6 +101,7 @@ pub fn write_frames(
             memory_bytes: b.memory_bytes,
         }),
     )?;
+    write_rows(&out.join("summary.csv"), summarise(spec, outcome))?;
     let all = labels(rows);
     let largest = outcome.builds.iter().map(|b| b.triangles).max().unwrap_or(0);
     for &(shading, _) in &spec.shadings {
@@ -232,11 +250,94 @@ pub fn write_frames(
     )
 }
 
+/// One structure (and way of following motion) at one scene size and shading, over its path:
+/// a row of summary.csv and of the report's medians.
+#[derive(Serialize)]
+struct Summary {
+    triangles: usize,
+    shading: &'static str,
+    structure: String,
+    #[serde(with = "float")]
+    frame_s: f64,
+    #[serde(with = "float")]
+    frame_s_lo: f64,
+    #[serde(with = "float")]
+    frame_s_hi: f64,
+    block_frames: usize,
+    #[serde(skip)]
+    update: Estimate,
+    #[serde(with = "float")]
+    update_s: f64,
+    #[serde(with = "float")]
+    rays: f64,
+    #[serde(with = "float")]
+    nodes: f64,
+    #[serde(with = "float")]
+    tests: f64,
+    frames: usize,
+}
+
+impl Summary {
+    fn frame(&self) -> Estimate {
+        Estimate {
+            median: self.frame_s,
+            lo: self.frame_s_lo,
+            hi: self.frame_s_hi,
+        }
+    }
+}
+
+/// Every size x shading x structure of the rows, in scene, shading and first-seen order.
+fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
+    let rows = &outcome.frames;
+    let mut sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
+    sizes.dedup();
+    let mut out = Vec::new();
+    for &t in &sizes {
+        for &(shading, _) in &spec.shadings {
+            for l in labels(rows) {
+                let sel: Vec<&FrameRow> = rows
+                    .iter()
+                    .filter(|r| r.triangles == t && r.shading == shading && label(r) == l)
+                    .collect();
+                if sel.is_empty() {
+                    continue;
+                }
+                let secs: Vec<f64> = sel.iter().map(|r| r.seconds).collect();
+                let (frame, block) = series_median(&secs);
+                let upd: Vec<f64> = sel.iter().filter_map(|r| r.update_seconds).collect();
+                let update = if upd.is_empty() {
+                    Estimate::NAN
+                } else {
+                    series_median(&upd).0
+                };
+                let of = |f: fn(&FrameRow) -> u64| median(&sel.iter().map(|r| f(r) as f64).collect::<Vec<_>>());
+                out.push(Summary {
+                    triangles: t,
+                    shading: shading.name(),
+                    structure: l,
+                    frame_s: frame.median,
+                    frame_s_lo: frame.lo,
+                    frame_s_hi: frame.hi,
+                    block_frames: block,
+                    update,
+                    update_s: update.median,
+                    rays: of(|r| r.rays.total()),
+                    nodes: of(|r| r.work.nodes),
+                    tests: of(|r| r.work.primitives),
+                    frames: sel.len(),
+                });
+            }
+        }
+    }
+    out
+}
+
 fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f64) -> String {
     let rows = &outcome.frames;
     let mut md = format!("# {}: frame times per acceleration structure\n\n", spec.name);
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (each a fresh seeded order of the structures; order seed {}), the median kept, and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (counterbalanced seeded orders of the structures; order seed {}), the median kept (`frames.csv`: every frame with the interval of its renders: their range for three, a 75 % interval), and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
         spec.path.display(),
         seconds,
         outcome.scenes.join("; "),
@@ -261,40 +362,32 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
     };
     md += "## Verdict\n\n";
     md += &verdict(spec, outcome);
-    md += "\n## Medians\n\nFrame seconds: the median over the path's frames with its 95 % moving-block interval; rays, nodes visited and primitive tests: per-frame medians (deterministic).\n\n| triangles | shading | structure | frame s | update s | rays per frame | nodes per frame | tests per frame | frames |\n|---|---|---|---|---|---|---|---|---|\n";
-    let mut sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
-    sizes.dedup();
-    for &t in &sizes {
-        for &(shading, _) in &spec.shadings {
-            for l in labels(rows) {
-                let sel: Vec<&FrameRow> = rows
-                    .iter()
-                    .filter(|r| r.triangles == t && r.shading == shading && label(r) == l)
-                    .collect();
-                if sel.is_empty() {
-                    continue;
-                }
-                let secs: Vec<f64> = sel.iter().map(|r| r.seconds).collect();
-                let (frame, _) = series_median(&secs, spec.header.schedule.seed);
-                let upd: Vec<f64> = sel.iter().filter_map(|r| r.update_seconds).collect();
-                let of = |f: fn(&FrameRow) -> u64| median(&sel.iter().map(|r| f(r) as f64).collect::<Vec<_>>());
-                md += &format!(
-                    "| {t} | {} | {l} | {} | {} | {:.0} | {:.3e} | {:.3e} | {} |\n",
-                    shading.name(),
-                    frame.show(4),
-                    if upd.is_empty() {
-                        "-".into()
-                    } else {
-                        series_median(&upd, spec.header.schedule.seed).0.show(4)
-                    },
-                    of(|r| r.rays),
-                    of(|r| r.work.nodes),
-                    of(|r| r.work.primitives),
-                    sel.len()
-                );
-            }
-        }
+    md += "\n## Medians\n\nFrame seconds: the median over the path's frames with its 95 % interval from the medians of blocks of frames (block length in `summary.csv`; n/a where the path is too short or too correlated for six blocks); rays, nodes visited and primitive tests: per-frame medians (deterministic).\n\n| triangles | shading | structure | frame s | update s | rays per frame | nodes per frame | tests per frame | frames |\n|---|---|---|---|---|---|---|---|---|\n";
+    let summaries = summarise(spec, outcome);
+    for r in &summaries {
+        md += &format!(
+            "| {} | {} | {} | {} | {} | {:.0} | {:.3e} | {:.3e} | {} |\n",
+            r.triangles,
+            r.shading,
+            r.structure,
+            r.frame().show(4),
+            if r.update.median.is_nan() {
+                "-".into()
+            } else {
+                r.update.show(4)
+            },
+            r.rays,
+            r.nodes,
+            r.tests,
+            r.frames
+        );
     }
+    let sizes: Vec<usize> = summaries.iter().map(|r| r.triangles).fold(Vec::new(), |mut v, t| {
+        if !v.contains(&t) {
+            v.push(t);
+        }
+        v
+    });
     md += "\n## Builds\n\n| triangles | structure | parameters | build s | MB |\n|---|---|---|---|---|\n";
     for b in &outcome.builds {
         md += &format!(
@@ -306,7 +399,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
             b.memory_bytes as f64 / 1e6
         );
     }
-    md += "\nOutputs: `frames.csv` (one row per frame and structure), `builds.csv`, `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
+    md += "\nOutputs: `frames.csv` (one row per frame and structure), `summary.csv` (the medians above), `builds.csv`, `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
     if spec.motion.is_some() {
         md += ", `plots/update_time_SHADING.png` (update time along the path)";
     }

@@ -1,8 +1,8 @@
 //! Runs a frame-time experiment on the f64 CPU backend, where every structure answers exactly
 //! and frames can be compared pixel for pixel: per scene, each structure is built once (its
 //! build time and memory recorded); then, for each shading and viewpoint, every frame of the
-//! path is rendered by every structure in the schedule's interleaved rounds (each round a fresh
-//! seeded order of the structures, so a change of machine load falls on all alike; the median
+//! path is rendered by every structure in the schedule's interleaved rounds (counterbalanced
+//! seeded orders of the structures, so a change of machine load falls on all alike; the median
 //! of the rounds is kept, with the frame's rays and work), and each structure's frame is compared
 //! with the first structure's. With a `[motion]`, one part moves by a step before each frame and
 //! each structure is first brought up to date in every way it offers
@@ -12,11 +12,11 @@
 
 use super::spec::{FramesSpec, ShadingName};
 use crate::accel::work::Work;
-use crate::accel::AccelSettings;
+use crate::accel::{AccelSettings, Updated};
 use crate::experiment::progress::Progress;
 use crate::mesh::Triangles;
 use crate::metrics::stats::median;
-use crate::render::{Backend, Frame, Sampling, View};
+use crate::render::{Backend, Frame, RayCounts, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::procedural::Generated;
 use crate::scene::Scene;
@@ -49,12 +49,14 @@ pub struct FrameRow {
     pub frame: u32,
     /// Median render seconds over the rounds.
     pub seconds: f64,
-    /// Timed renders behind the median.
-    pub renders: usize,
+    /// Seconds of each timed render, in round order.
+    pub renders: Vec<f64>,
     /// Seconds the update before this frame took (dynamic scenes).
     pub update_seconds: Option<f64>,
-    /// Rays the frame traced.
-    pub rays: u64,
+    /// What that update did to the structure.
+    pub updated: Option<Updated>,
+    /// Rays the frame traced, per pass.
+    pub rays: RayCounts,
     /// What the frame's queries cost.
     pub work: Work,
     /// Pixels whose object or radiance differs from the first structure's frame.
@@ -110,17 +112,18 @@ struct Variant {
 
 impl Variant {
     /// Moves part `object` by `step` in this variant's scene (the scene's triangles become
-    /// `moved`) and brings its structure up to date its own way; returns the update's time.
-    fn update(&mut self, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<Duration> {
+    /// `moved`) and brings its structure up to date its own way; returns the update's time and
+    /// what the structure says it did.
+    fn update(&mut self, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<(Duration, Updated)> {
         let mut accel = self.scene.accel.take().expect("generated scenes have triangles");
         let start = Instant::now();
-        Arc::get_mut(&mut accel)
+        let did = Arc::get_mut(&mut accel)
             .expect("a variant's structure is its own")
             .update(self.update, moved, object, step)?;
         let took = start.elapsed();
         self.scene.accel = Some(accel);
         self.scene.triangles.positions.clone_from(&moved.positions);
-        Ok(took)
+        Ok((took, did))
     }
 }
 
@@ -237,7 +240,8 @@ pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progr
                             }
                         }
                         for (v, u) in variants.iter_mut().zip(&mut updates) {
-                            *u = Some(v.update(&current, object, step)?.as_secs_f64());
+                            let (took, did) = v.update(&current, object, step)?;
+                            *u = Some((took.as_secs_f64(), did));
                         }
                     }
                     // Every round renders each variant once, in the round's own order; the
@@ -265,9 +269,10 @@ pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progr
                             viewpoint: viewpoint.clone(),
                             frame,
                             seconds: median(&times[i]),
-                            renders: times[i].len(),
-                            update_seconds: updates[i],
-                            rays: frames[i].rays.total(),
+                            renders: times[i].clone(),
+                            update_seconds: updates[i].map(|u| u.0),
+                            updated: updates[i].map(|u| u.1),
+                            rays: frames[i].rays,
                             work: frames[i].work,
                             differing_pixels: differing(first, &frames[i]),
                         });

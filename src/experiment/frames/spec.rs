@@ -361,6 +361,7 @@ impl FramesSpec {
             strip: f.strip,
         };
         spec.check_path(source)?;
+        spec.check_memory(source, &f.accel)?;
         Ok(spec)
     }
 
@@ -422,6 +423,29 @@ impl FramesSpec {
                         ),
                     ));
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// Every structure fits in the memory available over every scene size, by its own lower
+    /// bound, before anything is generated or built.
+    fn check_memory(&self, source: &Source, tables: &BTreeMap<String, toml::Table>) -> Result<(), ConfigError> {
+        let counts = match &self.generator {
+            Generator::Classroom => vec![classroom::TRIANGLES],
+            Generator::RandomTriangles { counts, .. } => counts.clone(),
+        };
+        let available = crate::accel::memory::available_bytes();
+        for (i, s) in self.structures.iter().enumerate() {
+            for &n in &counts {
+                crate::accel::memory::check(s, n, available).map_err(|e| {
+                    let at = if tables.contains_key(s.name) {
+                        key_path!["accel", s.name]
+                    } else {
+                        key_path!["structures", i]
+                    };
+                    source.error(&at, e)
+                })?;
             }
         }
         Ok(())

@@ -64,8 +64,8 @@ struct Speedup {
 }
 
 impl Speedup {
-    fn of(ratios: &[f64], seed: u32) -> Speedup {
-        let (estimate, block) = series_median(ratios, seed);
+    fn of(ratios: &[f64]) -> Speedup {
+        let (estimate, block) = series_median(ratios);
         Speedup {
             estimate,
             block,
@@ -87,15 +87,6 @@ impl Speedup {
             self.faster_frames,
             self.frames
         )
-    }
-}
-
-/// A time ratio (theirs / ours) in words: "2.00x faster" or "3.00x slower".
-fn faster(ratio: f64) -> String {
-    if ratio >= 1.0 {
-        format!("{ratio:.2}x faster")
-    } else {
-        format!("{:.2}x slower", 1.0 / ratio)
     }
 }
 
@@ -171,7 +162,6 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         }
         v
     });
-    let seed = spec.header.schedule.seed;
     let subject = spec.claim.subject.as_str();
     let work = |l: &str, shading: ShadingName| {
         let of = |f: fn(&FrameRow) -> u64| {
@@ -196,7 +186,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
                 if r.is_empty() {
                     continue;
                 }
-                let sp = Speedup::of(&r, seed);
+                let sp = Speedup::of(&r);
                 let role = if *other == spec.claim.baseline {
                     " (the paper's baseline)"
                 } else {
@@ -215,7 +205,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
                         .iter()
                         .map(|&t| {
                             let r = per_frame_ratios(rows, shading, Some(t), (subject, other), &|r| r.seconds);
-                            let sp = Speedup::of(&r, seed);
+                            let sp = Speedup::of(&r);
                             format!("{}K {}x", t as f64 / 1e3, sp.estimate.show(2))
                         })
                         .collect();
@@ -268,34 +258,26 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
             let Some(own) = &own else { continue };
             let field = update(own);
             for other in all.iter().filter(|l| *l != own) {
-                let updates = Speedup::of(
-                    &per_frame_ratios(rows, shading, None, (own, other), &|r| {
-                        r.update_seconds.unwrap_or(f64::NAN)
-                    }),
-                    seed,
-                );
-                let totals = Speedup::of(
-                    &per_frame_ratios(rows, shading, None, (own, other), &|r| {
-                        r.seconds + r.update_seconds.unwrap_or(0.0)
-                    }),
-                    seed,
-                );
+                let updates = Speedup::of(&per_frame_ratios(rows, shading, None, (own, other), &|r| {
+                    r.update_seconds.unwrap_or(f64::NAN)
+                }));
+                let totals = Speedup::of(&per_frame_ratios(rows, shading, None, (own, other), &|r| {
+                    r.seconds + r.update_seconds.unwrap_or(0.0)
+                }));
                 out += &format!(
-                    "- **Is `{own}` cheaper than `{other}`?** **{}**: to update, {} ({}); update + render: **{}**, {} ({}).\n",
+                    "- **Is `{own}` cheaper than `{other}`?** To update: **{}**, speed-up per frame (its time / `{own}`'s) {}. Update + render: **{}**, {}.\n",
                     updates.comparison().answer(),
-                    faster(updates.estimate.median),
                     updates.summary(),
                     totals.comparison().answer(),
-                    faster(totals.estimate.median),
                     totals.summary(),
                 );
             }
             if let Some(b) = outcome.builds.iter().find(|b| b.structure == subject) {
                 out += &format!(
-                    "- **`{own}` vs building `{subject}` again**: {:.4} s against {:.2} s ({}).\n",
+                    "- **`{own}` vs building `{subject}` again**: a median {:.4} s per update against one {:.2} s build (a ratio of {:.1}; the build is timed once).\n",
                     field,
                     b.build_seconds,
-                    faster(b.build_seconds / field)
+                    b.build_seconds / field
                 );
             }
         }

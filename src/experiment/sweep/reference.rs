@@ -32,7 +32,9 @@ pub struct Reference {
     pub exact_quality: Option<ExactQuality>,
     /// Receiver-plane pixels and their radii from the shadow's centre.
     pub receivers: Receivers,
-    /// Penumbra pixels of the ground truth on the receiver: every run is judged over these.
+    /// Penumbra pixels of the ground truth on the receiver, of any light in use (not those
+    /// where one light is wholly hidden and another wholly seen, whose mean alone is partial):
+    /// every run is judged over these.
     pub mask: PenumbraMask,
     /// Closed-form radii, when one light is on and the scene is on-axis.
     pub on_axis: Option<OnAxis>,
@@ -82,7 +84,7 @@ impl Reference {
         // The context holds the build id: a changed renderer never reuses a cached ground truth.
         let key = format!("{context};lights={lights};r={radius:e}");
         let file = cache.join(format!("ground-truth-{:016x}.bin", fnv1a(key.as_bytes())));
-        let (ground_truth, hit) = match load_cached(&file, view) {
+        let (per_light, hit) = match load_cached(&file, view, lights as usize) {
             Some(cached) => cached,
             None => {
                 let sampling = Sampling {
@@ -93,11 +95,12 @@ impl Reference {
                 let f = backend
                     .render(&scene, view, sampling)
                     .context("rendering the ground truth")?;
-                let rendered = (shadow_image(&f.visibility), f.hit);
+                let rendered = (f.visibility, f.hit);
                 save_cached(&file, &rendered)?;
                 rendered
             }
         };
+        let ground_truth = shadow_image(&per_light);
         let on_axis = if lights == 1 {
             OnAxis::detect(&scene, 0, m.plane)
         } else {
@@ -116,7 +119,7 @@ impl Reference {
             }
             false => (None, None),
         };
-        let mask = PenumbraMask::new(&ground_truth, &receivers);
+        let mask = PenumbraMask::union(&per_light, &receivers);
         let exact_profile = exact
             .as_deref()
             .filter(|_| on_axis.is_some())
@@ -248,23 +251,28 @@ pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Recei
     (image, quality)
 }
 
-const MAGIC: &[u8; 8] = b"PNBRGT01";
+const MAGIC: &[u8; 8] = b"PNBRGT02";
 
 /// Cached (visibility of the measured light, object ids) of a ground-truth render.
-fn load_cached(path: &Path, view: View) -> Option<(Vec<f32>, Vec<u32>)> {
+/// A cached ground truth: each light's visibility image, then the hit ids.
+fn load_cached(path: &Path, view: View, lights: usize) -> Option<(Vec<Vec<f32>>, Vec<u32>)> {
     let bytes = std::fs::read(path).ok()?;
     let n = view.pixels();
-    if bytes.len() != 8 + 8 * n || &bytes[..8] != MAGIC {
+    if bytes.len() != 8 + 4 * n * (lights + 1) || &bytes[..8] != MAGIC {
         return None;
     }
-    let vis: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes[8..8 + 4 * n]);
-    let hit: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n..]);
+    let vis = (0..lights)
+        .map(|l| bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n * l..8 + 4 * n * (l + 1)]))
+        .collect();
+    let hit: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n * lights..]);
     Some((vis, hit))
 }
 
-fn save_cached(path: &Path, (vis, hit): &(Vec<f32>, Vec<u32>)) -> anyhow::Result<()> {
+fn save_cached(path: &Path, (vis, hit): &(Vec<Vec<f32>>, Vec<u32>)) -> anyhow::Result<()> {
     let mut bytes = MAGIC.to_vec();
-    bytes.extend_from_slice(bytemuck::cast_slice(vis));
+    for v in vis {
+        bytes.extend_from_slice(bytemuck::cast_slice(v));
+    }
     bytes.extend_from_slice(bytemuck::cast_slice(hit));
     crate::files::write_atomic(path, &bytes)
 }

@@ -215,7 +215,7 @@ pub(super) fn time_phase(
 ) -> anyhow::Result<()> {
     if spec.timing.repeats > 0 {
         out.timings = time_sweep(spec, backend, groups, out, context, journal, progress)?;
-        fill_timing_columns(out, groups, context, spec.timing.seed);
+        fill_timing_columns(out, groups, context);
     }
     Ok(())
 }
@@ -290,7 +290,7 @@ fn time_sweep(
 /// Writes each configuration's timing into the records of all its seeds (a configuration is
 /// timed once, with its first seed): median frame time and its 95 % interval, frames timed, the
 /// clock, and rays per second from the median and the timed run's ray counts.
-fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str, seed: u32) {
+fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
     let group_of: HashMap<String, String> = groups
         .iter()
         .flat_map(|g| {
@@ -314,7 +314,7 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str, seed:
             continue;
         };
         let Some(t) = out.timings.configs.get(gk) else { continue };
-        let frame = t.frame(seed);
+        let frame = t.frame();
         let (primary, shadow) = rays[gk];
         let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] =
             rays_per_second(primary, shadow, frame.median, t.primary_median());

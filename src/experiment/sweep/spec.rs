@@ -65,6 +65,10 @@ pub struct Figures {
     pub ground_truth_samples: u32,
 }
 
+/// Largest swept light radius, in multiples of the lowest swept disk light's height over the
+/// measured plane.
+pub const MAX_RADIUS_PER_HEIGHT: f64 = 100.0;
+
 /// A validated experiment.
 #[derive(Clone, Debug)]
 pub struct Spec {
@@ -190,6 +194,13 @@ impl Spec {
                     format!("must be in 1..={}, the scene's lights", scene.lights.len()),
                 ));
             }
+            // Rows would name a scheme and a radius that nothing sampled.
+            if !scene.lights[..k as usize].iter().any(|l| matches!(l, Light::Disk(_))) {
+                return Err(err(
+                    &key_path!["sweep", "light_counts", i],
+                    format!("the scene's first {k} light(s) hold no disk light: nothing would sample the swept schemes and radii"),
+                ));
+            }
         }
         if scene.plane(m.plane).is_none() {
             return Err(err(
@@ -215,11 +226,31 @@ impl Spec {
                 ));
             }
         }
+        // A disk light far larger than its height over the measured plane is no light over
+        // this scene (and would only exhaust the exact answer's quadrature).
+        let (_, measured) = scene.plane(m.plane).expect("checked above");
+        let lowest = scene
+            .lights
+            .iter()
+            .take(*a.light_counts.iter().max().unwrap_or(&1) as usize)
+            .filter_map(|l| match l {
+                Light::Disk(d) => Some((d.center - measured.point).dot(measured.normal).abs()),
+                _ => None,
+            })
+            .fold(f64::INFINITY, f64::min);
         for (i, &r) in a.light_radii.iter().enumerate() {
             if !(r.is_finite() && r > 0.0) {
                 return Err(err(
                     &key_path!["sweep", "light_radii", i],
                     format!("light radius must be positive, got {r}"),
+                ));
+            }
+            if r > MAX_RADIUS_PER_HEIGHT * lowest {
+                return Err(err(
+                    &key_path!["sweep", "light_radii", i],
+                    format!(
+                        "a {r} m light is more than {MAX_RADIUS_PER_HEIGHT} times its {lowest:.3} m height over the measured plane"
+                    ),
                 ));
             }
         }

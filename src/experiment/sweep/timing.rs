@@ -38,8 +38,8 @@ impl ConfigTiming {
     }
 
     /// Median frame time with its 95 % interval, seconds.
-    pub fn frame(&self, seed: u32) -> Estimate {
-        median_interval(&self.frame_seconds, seed)
+    pub fn frame(&self) -> Estimate {
+        median_interval(&self.frame_seconds)
     }
 
     /// Wall-clock frames of the given milliseconds: hand-made timings for tests.
@@ -61,11 +61,11 @@ impl ConfigTiming {
 /// The time ratio `a / b` of two configurations timed in the same rounds (paired by round) with
 /// its interval, and the word the rule gives it; NaN and "equal" where either is untimed or
 /// they were not timed in the same rounds.
-pub fn compare(a: &ConfigTiming, b: &ConfigTiming, seed: u32) -> (Estimate, Comparison) {
+pub fn compare(a: &ConfigTiming, b: &ConfigTiming) -> (Estimate, Comparison) {
     if a.frame_seconds.is_empty() || a.frame_seconds.len() != b.frame_seconds.len() {
         return (Estimate::NAN, Comparison::Equal);
     }
-    let ratio = paired_ratio(&a.frame_seconds, &b.frame_seconds, seed);
+    let ratio = paired_ratio(&a.frame_seconds, &b.frame_seconds);
     (ratio, Comparison::of(&ratio))
 }
 
@@ -162,17 +162,17 @@ mod tests {
     fn comparisons_pair_by_round_and_follow_the_rule() {
         let a = timing(&[10.0, 11.0, 12.0, 13.0, 14.0]);
         let b = timing(&[15.0, 16.0, 17.0, 18.0, 19.0]);
-        assert_eq!(compare(&a, &b, 1).1, Comparison::Faster);
-        assert_eq!(compare(&b, &a, 1).1, Comparison::Slower);
+        assert_eq!(compare(&a, &b).1, Comparison::Faster);
+        assert_eq!(compare(&b, &a).1, Comparison::Slower);
         let drifting = timing(&[10.0, 20.0, 12.0, 13.0, 14.0]);
         let same = timing(&[10.5, 19.0, 12.5, 12.5, 14.5]);
-        assert_eq!(compare(&drifting, &same, 1).1, Comparison::Equal);
-        assert_eq!(compare(&a, &timing(&[]), 1).1, Comparison::Equal);
+        assert_eq!(compare(&drifting, &same).1, Comparison::Equal);
+        assert_eq!(compare(&a, &timing(&[])).1, Comparison::Equal);
         assert!(
-            compare(&a, &timing(&[1.0, 2.0]), 1).0.median.is_nan(),
+            compare(&a, &timing(&[1.0, 2.0])).0.median.is_nan(),
             "not timed in the same rounds"
         );
-        let f = a.frame(1);
+        let f = a.frame();
         assert!((f.median - 0.012).abs() < 1e-12 && f.lo <= f.median && f.hi >= f.median);
         assert!(a.primary_median().is_nan());
     }

@@ -199,6 +199,10 @@ fn furniture() -> Vec<Part> {
 /// Where the four ceiling lamps hang; a point light sits 5 cm below each shade.
 const LAMPS: [(f64, f64); 4] = [(-2.5, -2.0), (2.5, -2.0), (-2.5, 2.0), (2.5, 2.0)];
 
+/// Triangles of [`classroom`] (the paper's classroom has 51,208): what a structure's memory is
+/// estimated from before the scene is generated.
+pub const TRIANGLES: usize = 51_224;
+
 /// The classroom, always the same.
 pub fn classroom() -> Generated {
     let mut parts = shell();
@@ -245,6 +249,7 @@ mod tests {
         let n = a.triangle_count();
         assert_eq!(a.triangles().positions, classroom().triangles().positions);
         assert!((n as f64 / 51_208.0 - 1.0).abs() < 0.01, "{n} triangles");
+        assert_eq!(n, TRIANGLES);
         assert_eq!(a.lights.len(), 4);
         assert!(a.parts.iter().filter(|p| p.mirror > 0.0).count() >= 2);
         for t in a.triangles().positions {

@@ -38,14 +38,14 @@ pub fn off_mesh(name: &str) -> penumbra::mesh::Triangles {
     }
 }
 
-/// Earlier results of the sweep named `name` in `out`: a runs.csv reading "earlier results" and
-/// a manifest naming the experiment, so later runs recognise the folder as theirs.
-pub fn earlier_results(out: &std::path::Path, name: &str) {
+/// Earlier results of experiment `name` of `kind` in `out`: a runs.csv reading "earlier
+/// results" and a manifest naming the experiment, so later runs recognise the folder as theirs.
+pub fn earlier_results(out: &std::path::Path, kind: &str, name: &str) {
     std::fs::create_dir_all(out).unwrap();
     std::fs::write(out.join("runs.csv"), "earlier results\n").unwrap();
     std::fs::write(
         out.join("manifest.toml"),
-        format!("schema = 2\nkind = \"sweep\"\nname = \"{name}\"\n"),
+        format!("schema = 2\nkind = \"{kind}\"\nname = \"{name}\"\n"),
     )
     .unwrap();
 }

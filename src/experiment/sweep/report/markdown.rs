@@ -96,7 +96,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
         s += &timing_section(outcome);
     }
     for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
-        s += &cost_section(outcome, summaries, &slice, n, radius);
+        s += &cost_section(summaries, &slice, n, radius);
     }
     s += &super::structures::structure_section(spec, outcome, summaries);
     s += "\n## Outputs\n\n- `runs.csv`: one row per run; `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
@@ -137,7 +137,7 @@ Every configuration timed with its first seed, once per round, in {} interleaved
             .find(|g| g.config == *config)
             .and_then(|g| t.configs.get(&g.key))
         {
-            let (ratio, word) = compare(twin, first, t.seed);
+            let (ratio, word) = compare(twin, first);
             s += &format!(
                 "A/A control: one configuration ({} {}, {} rays, light radius {} m) visited twice per round as if it were two; the time ratio of its two series is {}: **{}**{}
 
@@ -161,10 +161,10 @@ Every configuration timed with its first seed, once per round, in {} interleaved
 
 /// How a configuration's frame time compares with uniform sampling's (time ratio with its
 /// interval and the rule's word).
-fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, seed: u32) -> String {
+fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>) -> String {
     match (x, uniform) {
         (Some(a), Some(b)) => {
-            let (ratio, word) = compare(a, b, seed);
+            let (ratio, word) = compare(a, b);
             format!("{}x uniform's time: {}", ratio.show(2), word.word())
         }
         _ => "untimed".into(),
@@ -206,7 +206,7 @@ const COST_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis:
 /// What accuracy costs: error, frame time and work per scheme at the verdict's count, and for
 /// each scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count,
 /// compared with uniform's time by the rule.
-fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
+fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
     let lights = slice.config.lights;
     let more = match slice.label(&[Axis::Lights]) {
         l if l.is_empty() => l,
@@ -238,13 +238,12 @@ fn cost_section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32,
             .filter(|x| x.config.agrees_except(&at.config, &[Axis::Samples]))
             .collect();
         rows.sort_by_key(|x| x.config.samples);
-        let seed = outcome.timings.seed;
         let matched = match uniform.filter(|u| u.metrics.rmse.mean.is_finite()) {
             None => "n/a".to_string(),
             Some(u) => rows.iter().find(|x| x.metrics.rmse.mean <= u.metrics.rmse.mean).map_or(
                 "not reached".to_string(),
                 |x| {
-                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref(), seed);
+                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref());
                     format!("{} rays, {}, {rank}", x.config.samples, ms_ci(&x.frame))
                 },
             ),
@@ -277,16 +276,16 @@ mod tests {
     #[test]
     fn times_are_compared_by_the_rule() {
         let a = timing(&[99.0, 99.5, 100.0, 100.5, 101.0]);
-        let b = timing(&[103.0, 103.5, 104.0, 104.5, 105.0]);
+        let b = timing(&[113.0, 113.5, 114.0, 114.5, 115.0]);
         let noisy = timing(&[80.0, 120.0, 100.0, 90.0, 110.0]);
         assert!(
-            time_rank(Some(&a), Some(&b), 1).ends_with(": faster"),
+            time_rank(Some(&a), Some(&b)).ends_with(": faster"),
             "{}",
-            time_rank(Some(&a), Some(&b), 1)
+            time_rank(Some(&a), Some(&b))
         );
-        assert!(time_rank(Some(&b), Some(&a), 1).ends_with(": slower"));
-        assert!(time_rank(Some(&a), Some(&noisy), 1).ends_with(": equal within noise"));
-        assert_eq!(time_rank(None, Some(&b), 1), "untimed");
+        assert!(time_rank(Some(&b), Some(&a)).ends_with(": slower"));
+        assert!(time_rank(Some(&a), Some(&noisy)).ends_with(": equal within noise"));
+        assert_eq!(time_rank(None, Some(&b)), "untimed");
         assert_eq!(ms_ci(&Estimate::NAN), "n/a");
     }
 }

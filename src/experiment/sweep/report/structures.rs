@@ -53,7 +53,7 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
         compared += both;
         let (ratio, word) = match (&other.timing, &first.timing) {
             (Some(a), Some(b)) => {
-                let (r, w) = compare(a, b, outcome.timings.seed);
+                let (r, w) = compare(a, b);
                 (r, w.word())
             }
             _ => (crate::experiment::timing::Estimate::NAN, "untimed"),

@@ -79,7 +79,7 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip) -> Vec<Summary> {
                     .timings
                     .configs
                     .get(&g.key)
-                    .map_or(Estimate::NAN, |t| t.frame(outcome.timings.seed)),
+                    .map_or(Estimate::NAN, ConfigTiming::frame),
                 rays: first.and_then(|r| Some(r.rays.primary_rays? + r.rays.shadow_rays?)),
                 work: first.and_then(|r| {
                     let c = &r.rays;

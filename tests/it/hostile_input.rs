@@ -1,0 +1,552 @@
+//! Hostile input over all four kinds, table-driven: every case exits with status 2 and a message
+//! naming the file and the key (or table), never panics, writes nothing anywhere (the whole
+//! scratch tree, results folder included, is byte-for-byte what it was) and leaves earlier
+//! results whole. Then what only a run can show: a killed run leaves the earlier set whole and
+//! the next run clears its staging folder; a folder holding another experiment's results is
+//! replaced only with `--fresh`, and then as a whole.
+
+use crate::common;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Every file under `root` with its bytes.
+fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap().flatten() {
+            let (p, kind) = (e.path(), e.file_type().unwrap());
+            if kind.is_dir() {
+                out.insert(p.clone(), b"<dir>".to_vec());
+                stack.push(p);
+            } else if kind.is_file() {
+                out.insert(p.clone(), std::fs::read(&p).unwrap_or_default());
+            } else {
+                out.insert(p.clone(), b"<not a file>".to_vec());
+            }
+        }
+    }
+    out
+}
+
+/// A scratch tree: `root/a/b/work` is the working folder (so `../../x` stays inside `root`),
+/// holding the experiment as `exp.toml` and earlier results of experiment `name` (of the kind
+/// the text declares) in `results/NAME`.
+struct Scratch {
+    _dir: tempfile::TempDir,
+    root: PathBuf,
+    work: PathBuf,
+}
+
+impl Scratch {
+    fn new(experiment: &str, name: &str) -> Scratch {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().to_path_buf();
+        let work = root.join("a/b/work");
+        std::fs::create_dir_all(&work).unwrap();
+        std::fs::write(work.join("exp.toml"), experiment).unwrap();
+        let kind = ["fps", "ao", "frames"]
+            .into_iter()
+            .find(|k| experiment.contains(&format!("kind = \"{k}\"")))
+            .unwrap_or("sweep");
+        common::earlier_results(&work.join("results").join(name), kind, name);
+        Scratch { _dir: dir, root, work }
+    }
+
+    /// Runs the binary in the working folder.
+    fn run(&self, args: &[&str]) -> (i32, String) {
+        self.run_with(args, &[])
+    }
+
+    /// Runs the binary in the working folder with `env` set.
+    fn run_with(&self, args: &[&str], env: &[(&str, &str)]) -> (i32, String) {
+        let out = Command::new(env!("CARGO_BIN_EXE_sweep"))
+            .current_dir(&self.work)
+            .args(args)
+            .envs(env.iter().copied())
+            .output()
+            .unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    }
+}
+
+/// The shipped experiment `file` with every relative path made absolute, so it runs from any
+/// folder.
+fn shipped(file: &str) -> String {
+    let text = std::fs::read_to_string(common::repo(&format!("experiments/{file}"))).unwrap();
+    text.replace("\"../assets/", &format!("\"{}/", common::repo("assets").display()))
+        .replace(
+            "\"scenes/",
+            &format!("\"{}/", common::repo("experiments/scenes").display()),
+        )
+}
+
+/// The tiny sweep (`common::tiny_experiment`) with its scene path made absolute.
+fn tiny() -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t);
+    std::fs::read_to_string(exp).unwrap().replace(
+        "\"scenes/",
+        &format!("\"{}/", common::repo("experiments/scenes").display()),
+    )
+}
+
+/// A scene file in the scratch tree's working folder, the sphere scene edited.
+fn scene_edit(edit: impl Fn(String) -> String) -> String {
+    edit(std::fs::read_to_string(common::repo("experiments/scenes/sphere.toml")).unwrap())
+}
+
+/// One hostile case: the experiment's text, extra files in the working folder, extra command
+/// line words, and what the message must name.
+struct Case {
+    what: &'static str,
+    name: &'static str,
+    text: String,
+    files: Vec<(&'static str, Vec<u8>)>,
+    args: Vec<&'static str>,
+    env: Vec<(&'static str, &'static str)>,
+    names: Vec<&'static str>,
+}
+
+fn case(what: &'static str, name: &'static str, text: String, names: &[&'static str]) -> Case {
+    Case {
+        what,
+        name,
+        text,
+        files: vec![],
+        args: vec![],
+        env: vec![],
+        names: names.to_vec(),
+    }
+}
+
+/// `text` without the table headed `header` (up to the next blank line).
+fn without_table(text: &str, header: &str) -> String {
+    let start = text.find(&format!("\n{header}\n")).expect("the table is there") + 1;
+    let end = text[start..].find("\n\n").map_or(text.len(), |e| start + e + 1);
+    assert!(text[start..end].starts_with(header));
+    format!("{}{}", &text[..start], &text[end..])
+}
+
+/// Contents that make a case's file a named pipe (reading one would block for ever).
+const FIFO: &[u8] = b"<fifo>";
+
+/// An OFF file whose one face claims `corners` corners.
+fn off_claiming(corners: &str) -> Vec<u8> {
+    format!("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n{corners} 0 1 2\n").into_bytes()
+}
+
+fn cases() -> Vec<Case> {
+    let (sweep, fps, ao, frames) = (
+        tiny(),
+        shipped("fps.toml"),
+        shipped("ao-ci.toml"),
+        shipped("frames-ci.toml"),
+    );
+    let named =
+        |text: &str, from: &str, to: &str| text.replacen(&format!("name = \"{from}\""), &format!("name = \"{to}\""), 1);
+    let mut v = Vec::new();
+    // Names that would become paths outside the results folder, in every kind.
+    for (text, name) in [(&sweep, "tiny"), (&fps, "fps"), (&ao, "ao-ci"), (&frames, "frames-ci")] {
+        for bad in ["../../x", "/abs/x", "..", "", "a/b", ".hidden"] {
+            v.push(case(
+                "a name that is a path",
+                name,
+                named(text, name, bad),
+                &["exp.toml", "key `name`"],
+            ));
+        }
+        v.push(case(
+            "a name that is no string",
+            name,
+            named(text, name, "x").replacen("name = \"x\"", "name = 7", 1),
+            &["exp.toml", "key `name`"],
+        ));
+        v.push(case(
+            "a repeat count that never ends",
+            name,
+            text.lines()
+                .map(|l| {
+                    if l.starts_with("repeats = ") {
+                        "repeats = 4294967295"
+                    } else {
+                        l
+                    }
+                })
+                .collect::<Vec<_>>()
+                .join("\n"),
+            &["exp.toml", "timing.repeats"],
+        ));
+        v.push(case(
+            "an unknown kind",
+            name,
+            format!("kind = \"sweeps\"\n{}", text.replacen("kind = ", "# kind = ", 1)),
+            &["exp.toml", "key `kind`"],
+        ));
+        v.push(case(
+            "a repeated table",
+            name,
+            format!("{text}\n[timing]\nwarmup = 1\n"),
+            &["exp.toml", "`timing`", "twice"],
+        ));
+    }
+    v.push(case(
+        "an ao mesh name that is a path",
+        "ao-ci",
+        ao.replacen("name = \"cow\"", "name = \"../../../x\"", 1),
+        &["exp.toml", "meshes[0].name"],
+    ));
+    v.push(case(
+        "two ao meshes of one name",
+        "ao-ci",
+        ao.replace("name = \"mech-holes-shark\"", "name = \"cow\""),
+        &["exp.toml", "meshes[1].name", "twice"],
+    ));
+    v.push(case(
+        "an fps scene name that is a path",
+        "fps",
+        fps.replacen("name = \"sphere\"", "name = \"../x\"", 1),
+        &["exp.toml", "scenes[0].name"],
+    ));
+    // Counts and sizes that would panic, abort or run out of memory.
+    for (corners, what) in [
+        ("18446744073709551615", "a face of 2^64 - 1 corners"),
+        ("100000000000", "a face of 1e11 corners"),
+    ] {
+        let mut c = case(
+            what,
+            "ao-ci",
+            ao.replacen(
+                &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+                "\"bad.off\"",
+                1,
+            ),
+            &["bad.off:6", "meshes[0].path", "fewer than"],
+        );
+        c.files.push(("bad.off", off_claiming(corners)));
+        v.push(c);
+    }
+    let mut c = case(
+        "a vertex count of 2^64 - 1",
+        "ao-ci",
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            "\"bad.off\"",
+            1,
+        ),
+        &["bad.off", "meshes[0].path"],
+    );
+    c.files
+        .push(("bad.off", b"OFF\n18446744073709551615 1 0\n0 0 0\n".to_vec()));
+    v.push(c);
+    let mut c = case(
+        "a mesh path that is a pipe",
+        "ao-ci",
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            "\"pipe.off\"",
+            1,
+        ),
+        &["exp.toml", "meshes[0].path", "not a regular file"],
+    );
+    c.files.push(("pipe.off", FIFO.to_vec()));
+    v.push(c);
+    let with_scene = |edit: &dyn Fn(String) -> String| -> (String, Vec<(&'static str, Vec<u8>)>) {
+        (
+            sweep.replace(
+                &format!("\"{}/sphere.toml\"", common::repo("experiments/scenes").display()),
+                "\"s.toml\"",
+            ),
+            vec![("s.toml", scene_edit(edit).into_bytes())],
+        )
+    };
+    for (what, edit, names) in [
+        (
+            "an orthographic camera 1e200 m wide",
+            Box::new(|t: String| t.replacen("width = 0.08", "width = 1e200", 1)) as Box<dyn Fn(String) -> String>,
+            vec!["s.toml", "cameras.measure.width"],
+        ),
+        (
+            "a camera at z = 1e300",
+            Box::new(|t: String| t.replacen("position = [0.3375, 0.0, 3.0]", "position = [0.3375, 0.0, 1e300]", 1)),
+            vec!["s.toml", "cameras.measure.position"],
+        ),
+    ] {
+        let (text, files) = with_scene(&*edit);
+        let mut c = case(what, "tiny", text, &names);
+        c.files = files;
+        v.push(c);
+    }
+    // Inside the allowed ranges, but 17 GB while building: refused on a 4 GB share.
+    let (text, mut files) = with_scene(&|t: String| {
+        format!("accelerator = \"vlf\"\n{t}\n[accel.vlf]\nlevel = 64\ntiles = 512\n\n[[meshes]]\npath = \"tri.obj\"\n")
+    });
+    files.push(("tri.obj", b"v 0 0 0.5\nv 0.1 0 0.5\nv 0 0.1 0.5\nf 1 2 3\n".to_vec()));
+    let mut c = case(
+        "a visibility field too large for the machine",
+        "tiny",
+        text,
+        &["s.toml", "key `accelerator`", "needs at least 17.2 GB"],
+    );
+    c.files = files;
+    c.env = vec![("PENUMBRA_MEMORY_BYTES", "4000000000")];
+    v.push(c);
+    v.push(case(
+        "a light as large as the world",
+        "tiny",
+        sweep.replace("light_radii = [0.02]", "light_radii = [1e200]"),
+        &["exp.toml", "sweep.light_radii[0]"],
+    ));
+    v.push(case(
+        "four billion random triangles",
+        "frames-ci",
+        frames
+            .replace(
+                "generator = \"classroom\"",
+                "generator = \"random-triangles\"\ntriangles = [4000000000]",
+            )
+            .replace("[path]\nframes = 3", "[path]\nframes = 3\nviewpoints = [\"outside\"]"),
+        &["exp.toml", "scene.triangles[0]"],
+    ));
+    v.push(case(
+        "a path of four billion frames",
+        "frames-ci",
+        frames.replace("frames = 3", "frames = 4294967295"),
+        &["exp.toml", "path.frames"],
+    ));
+    let mut c = case("a merge of 99999999 shards", "tiny", sweep.clone(), &["--merge"]);
+    c.args = vec!["--merge", "99999999"];
+    v.push(c);
+    // Missing parts, named with their tables.
+    v.push(case(
+        "no [measure]",
+        "tiny",
+        without_table(&sweep, "[measure]"),
+        &["exp.toml", "key `measure`", "missing"],
+    ));
+    v.push(case(
+        "no scene",
+        "tiny",
+        sweep.replacen("scene = ", "# scene = ", 1),
+        &["exp.toml", "key `scene`", "missing"],
+    ));
+    v.push(case(
+        "no [tuning]",
+        "ao-ci",
+        without_table(&ao, "[tuning]"),
+        &["exp.toml", "key `tuning`", "missing"],
+    ));
+    v.push(case(
+        "no meshes",
+        "ao-ci",
+        ao.split("[[meshes]]").next().unwrap().to_string(),
+        &["exp.toml", "key `meshes`", "missing"],
+    ));
+    v.push(case(
+        "no [path]",
+        "frames-ci",
+        without_table(&frames, "[path]"),
+        &["exp.toml", "key `path`", "missing"],
+    ));
+    v.push(case(
+        "no height in [measure]",
+        "tiny",
+        sweep.replace("height = 24\n", ""),
+        &["exp.toml", "key `measure.height`", "missing"],
+    ));
+    v.push(case(
+        "an fps scene file that does not exist",
+        "fps",
+        fps.replacen("sphere-two-lights.toml", "nowhere.toml", 1),
+        &["exp.toml", "scenes[0].scene", "nowhere.toml"],
+    ));
+    v.push(case(
+        "a scene path that is a folder",
+        "tiny",
+        sweep.replace(
+            &format!("\"{}/sphere.toml\"", common::repo("experiments/scenes").display()),
+            &format!("\"{}\"", common::repo("experiments/scenes").display()),
+        ),
+        &["exp.toml", "key `scene`", "not a regular file"],
+    ));
+    // Nonsense.
+    let (text, mut files) = with_scene(&|t: String| format!("{t}\n[[meshes]]\npath = \"empty.obj\"\n"));
+    files.push(("empty.obj", b"# nothing\n".to_vec()));
+    let mut c = case(
+        "an empty OBJ in a sweep scene",
+        "tiny",
+        text,
+        &["s.toml", "meshes[0].path", "no triangle"],
+    );
+    c.files = files;
+    v.push(c);
+    v.push(case(
+        "no resolutions",
+        "fps",
+        fps.replace("resolutions = [[800, 600], [1920, 1080]]", "resolutions = []"),
+        &["exp.toml", "resolutions"],
+    ));
+    v.push(case(
+        "no light counts",
+        "fps",
+        fps.replacen("lights = [1, 2]", "lights = []", 1),
+        &["exp.toml", "scenes[0].lights"],
+    ));
+    v.push(case(
+        "a NaN paper figure",
+        "fps",
+        fps.replacen("paper_fps = [15.95, 9.39]", "paper_fps = [nan, 9.39]", 1),
+        &["exp.toml", "scenes[0].paper_fps[0]"],
+    ));
+    v.push(case(
+        "a negative paper figure",
+        "ao-ci",
+        ao.replacen("crt_seconds = 38.01", "crt_seconds = -38.01", 1),
+        &["exp.toml", "meshes[0].paper.crt_seconds"],
+    ));
+    let (text, files) = with_scene(&|t: String| {
+        t.replacen(
+            "[[lights]]",
+            "[[lights]]\ntype = \"point\"\nposition = [0.0, 0.0, 2.0]\npower = 10.0\n\n[[lights]]",
+            1,
+        )
+    });
+    let mut c = case(
+        "a swept light count of point lights only",
+        "tiny",
+        text.replace("seeds = [1, 2]", "seeds = [1, 2]\nlight_counts = [1]"),
+        &["exp.toml", "sweep.light_counts[0]", "disk"],
+    );
+    c.files = files;
+    v.push(c);
+    v.push(case(
+        "an experiment file that is a device",
+        "tiny",
+        String::new(),
+        &["not a regular file"],
+    ));
+    v
+}
+
+#[test]
+fn every_hostile_input_is_refused_with_its_place_and_nothing_written() {
+    let all = cases();
+    eprintln!("{} hostile inputs", all.len());
+    let mut failures = Vec::new();
+    for c in &all {
+        let s = Scratch::new(&c.text, c.name);
+        for (file, bytes) in &c.files {
+            if bytes == FIFO {
+                let made = Command::new("mkfifo").arg(s.work.join(file)).status().unwrap();
+                assert!(made.success(), "mkfifo");
+            } else {
+                std::fs::write(s.work.join(file), bytes).unwrap();
+            }
+        }
+        let before = snapshot(&s.root);
+        let mut args = vec![if c.what == "an experiment file that is a device" {
+            "/dev/zero"
+        } else {
+            "exp.toml"
+        }];
+        args.extend(&c.args);
+        let (code, stderr) = s.run_with(&args, &c.env);
+        let mut wrong = Vec::new();
+        if code != 2 {
+            wrong.push(format!("exit {code}"));
+        }
+        if stderr.contains("panicked") {
+            wrong.push("panicked".into());
+        }
+        for n in &c.names {
+            if !stderr.contains(n) {
+                wrong.push(format!("does not name `{n}`"));
+            }
+        }
+        if snapshot(&s.root) != before {
+            wrong.push("wrote something".into());
+        }
+        if !wrong.is_empty() {
+            failures.push(format!("{}: {}\n{stderr}", c.what, wrong.join(", ")));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases broke a promise:\n{}",
+        failures.len(),
+        all.len(),
+        failures.join("\n")
+    );
+}
+
+/// A run killed half-way leaves the earlier results whole; the next run clears what the killed
+/// one left behind and replaces the set.
+#[test]
+fn a_killed_run_leaves_the_earlier_results_whole() {
+    let s = Scratch::new(
+        &shipped("frames-ci.toml").replace("frames = 3", "frames = 12"),
+        "frames-ci",
+    );
+    let home = s.work.join("results/frames-ci");
+    let before = snapshot(&home);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .current_dir(&s.work)
+        .arg("exp.toml")
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Killed once the staging folder exists (the run is under way), long before it ends.
+    let staging = |dir: &Path| {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .any(|e| e.file_name().to_string_lossy().starts_with(".frames-ci.staging."))
+    };
+    let start = std::time::Instant::now();
+    while !staging(&s.work.join("results")) && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(snapshot(&home), before, "the earlier set changed");
+    assert!(
+        staging(&s.work.join("results")),
+        "the killed run's staging folder is left"
+    );
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!staging(&s.work.join("results")), "the next run clears it");
+    assert!(
+        home.join("frames.csv").exists() && !home.join("runs.csv").exists(),
+        "one set, the new one"
+    );
+}
+
+/// Another experiment's results are refused without `--fresh` and replaced whole with it.
+#[test]
+fn another_experiments_results_are_replaced_only_with_fresh() {
+    let text = shipped("frames-ci.toml").replace("name = \"frames-ci\"", "name = \"tiny\"");
+    let s = Scratch::new(&text, "tiny");
+    let home = s.work.join("results/tiny");
+    common::earlier_results(&home, "sweep", "tiny");
+    let before = snapshot(&s.root);
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("another experiment") && stderr.contains("--fresh"),
+        "{stderr}"
+    );
+    assert_eq!(snapshot(&s.root), before);
+    let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        !home.join("runs.csv").exists(),
+        "nothing of the sweep's results is left"
+    );
+    assert!(home.join("frames.csv").exists() && home.join("manifest.toml").exists());
+}
