@@ -22,11 +22,16 @@ pub fn available_bytes() -> Option<u64> {
     }
 }
 
+/// The lower bound on the bytes of `settings`' structure over `triangles` triangles.
+pub fn estimate(settings: &AccelSettings, triangles: usize) -> u64 {
+    let r = registered(settings.name).expect("settings name a registered structure");
+    (r.memory)(triangles, settings)
+}
+
 /// Refuses to build `settings`' structure over `triangles` triangles when its lower-bound
 /// estimate exceeds `available` bytes; the message gives both.
 pub fn check(settings: &AccelSettings, triangles: usize, available: Option<u64>) -> Result<(), String> {
-    let r = registered(settings.name).expect("settings name a registered structure");
-    let need = (r.memory)(triangles, settings);
+    let need = estimate(settings, triangles);
     match available {
         Some(free) if need > free => Err(format!(
             "`{}` ({}) over {triangles} triangles needs at least {:.1} GB, more than the {:.1} GB this machine has available",

@@ -5,7 +5,7 @@
 
 use super::cli::{BadInput, Cli, RunsFailed};
 use super::manifest::{peak_rss, utc, Build, Input, Machine, Manifest, RunInfo, SCHEMA};
-use super::outputs::{check_home, Outputs};
+use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
 use super::sweep::merge::MergeRefused;
 use super::{load, Finished, Run};
@@ -44,11 +44,42 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         print!("{}", experiment.dry_run(cli)?);
         return Ok(());
     }
-    let home = match &cli.out {
+    let out = match &cli.out {
         Some(out) => out.clone(),
         None => PathBuf::from("results").join(experiment.folder(cli)?),
     };
-    check_home(&home, kind, &header.name, &cli.experiment, cli.fresh).map_err(BadInput)?;
+    // The folders this run makes for its results, innermost first: a failed run removes those
+    // it left empty (a journal worth resuming keeps its folder).
+    let made: Vec<PathBuf> = out
+        .ancestors()
+        .take_while(|p| !p.as_os_str().is_empty() && !p.exists())
+        .map(|p| p.to_path_buf())
+        .collect();
+    let home = resolve_home(&out).map_err(BadInput)?;
+    let result = run_into(experiment.as_ref(), cli, &home, started, started_utc, inputs);
+    if result.is_err() {
+        for p in &made {
+            let _ = std::fs::remove_dir(p);
+        }
+    }
+    result
+}
+
+/// Runs `experiment` into the results folder `home` ([`resolve_home`]).
+fn run_into(
+    experiment: &dyn super::Experiment,
+    cli: &Cli,
+    home: &std::path::Path,
+    started: Instant,
+    started_utc: String,
+    inputs: Vec<Input>,
+) -> anyhow::Result<()> {
+    let header = experiment.header().clone();
+    let kind = header.kind.name();
+    let accepts = experiment.accepts();
+    let choice = cli.backend.or(header.backend).unwrap_or(BackendChoice::Auto);
+    check_home(home, kind, &header.name, &cli.experiment, cli.fresh).map_err(BadInput)?;
+    let out = Outputs::begin(home).map_err(|e| BadInput(format!("{e:#}")))?;
     let mut backend: Box<dyn Backend> = if accepts.gpu {
         open_backend(choice)?
     } else {
@@ -63,13 +94,11 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         adapter.api,
         home.display()
     );
-    std::fs::create_dir_all(&home).map_err(|e| anyhow::anyhow!("creating {}: {e}", home.display()))?;
-    let out = Outputs::begin(&home)?;
     let progress = Progress::new();
     let finished = experiment.run(&mut Run {
         backend: backend.as_mut(),
         cli,
-        home: &home,
+        home,
         out: &out,
         progress: &progress,
         started,

@@ -10,6 +10,8 @@
 //! outputs have fixed names.
 
 use anyhow::{bail, Context};
+use std::fs::File;
+use std::os::unix::fs::MetadataExt;
 use std::path::{Component, Path, PathBuf};
 
 /// Entries of a results folder that outlive a run and are carried into the new set.
@@ -21,6 +23,55 @@ pub struct Outputs {
     home: PathBuf,
     staging: PathBuf,
     committed: bool,
+    /// The results folder, open and locked for as long as this run may replace it.
+    _lock: File,
+}
+
+/// The results folder a run will replace, as the real path its swap acts on: created if
+/// missing (with its parents), followed through symbolic links, and refused when it is not a
+/// folder or lies on another file system than its parent (a mount point: the swap is a rename,
+/// which cannot cross file systems). `out` must end in a name (not `.` or `..`).
+pub fn resolve_home(out: &Path) -> Result<PathBuf, String> {
+    let last = out.as_os_str().as_encoded_bytes();
+    let dotted = last.ends_with(b"/.") || last.ends_with(b"/..") || last == b"." || last == b"..";
+    if dotted || out.file_name().is_none() {
+        return Err(format!(
+            "{}: the results folder must end in a folder name",
+            out.display()
+        ));
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("creating {}: {e}", out.display()))?;
+    let home = out
+        .canonicalize()
+        .map_err(|e| format!("{}: cannot resolve: {e}", out.display()))?;
+    if !home.is_dir() {
+        return Err(format!("{}: not a folder", out.display()));
+    }
+    let parent = home.parent().unwrap_or(Path::new("/"));
+    let dev = |p: &Path| std::fs::metadata(p).map(|m| m.dev()).ok();
+    if dev(&home) != dev(parent) {
+        return Err(format!(
+            "{} is on another file system than {} (a mount point): results are swapped in by a rename, which cannot cross file systems; choose a folder inside it",
+            home.display(),
+            parent.display()
+        ));
+    }
+    Ok(home)
+}
+
+/// Takes an exclusive lock on the results folder for this run, or says another run holds it.
+fn lock(home: &Path) -> anyhow::Result<File> {
+    use std::os::fd::AsRawFd;
+    let dir = File::open(home).with_context(|| format!("opening {}", home.display()))?;
+    // SAFETY: a valid open descriptor; the lock lasts as long as the file stays open.
+    let rc = unsafe { libc::flock(dir.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    if rc != 0 {
+        bail!(
+            "{}: another run is writing into this results folder; wait for it or choose another --out",
+            home.display()
+        );
+    }
+    Ok(dir)
 }
 
 /// This host's name, for staging folders on file systems shared by several machines.
@@ -31,13 +82,15 @@ fn host() -> String {
 }
 
 impl Outputs {
-    /// A fresh staging folder for `home` (`.NAME.staging.HOST.PID` beside it); staging folders
-    /// that killed runs of this host left behind are removed, after the state they were
-    /// carrying over ([`KEPT`]) is moved back into `home` where `home` lacks it.
+    /// A fresh staging folder for `home` (a folder [`resolve_home`] gave: `.NAME.staging.HOST.PID`
+    /// beside it), with `home` locked against other runs; staging folders that killed runs of
+    /// this host left behind are removed, after the state they were carrying over ([`KEPT`]) is
+    /// moved back into `home` where `home` lacks it.
     pub fn begin(home: &Path) -> anyhow::Result<Outputs> {
+        let lock = lock(home)?;
         let name = home
             .file_name()
-            .and_then(|n| n.to_str())
+            .map(|n| n.to_string_lossy())
             .with_context(|| format!("{}: the results folder needs a name", home.display()))?;
         let parent = home
             .parent()
@@ -73,6 +126,7 @@ impl Outputs {
             home: home.to_path_buf(),
             staging,
             committed: false,
+            _lock: lock,
         })
     }
 
@@ -279,11 +333,32 @@ mod tests {
     #[test]
     fn paths_stay_under_the_folder() {
         let dir = tempfile::tempdir().unwrap();
-        let out = Outputs::begin(&dir.path().join("r")).unwrap();
+        let out = Outputs::begin(&resolve_home(&dir.path().join("r")).unwrap()).unwrap();
         for bad in ["../x", "/abs", "a/../../b", "", "."] {
             assert!(out.path(bad).is_err(), "{bad}");
         }
         assert!(out.path("images/a.png").unwrap().starts_with(out.dir()));
+    }
+
+    #[test]
+    fn a_results_folder_is_resolved_to_the_folder_its_swap_acts_on() {
+        let dir = tempfile::tempdir().unwrap();
+        let made = resolve_home(&dir.path().join("a/b")).unwrap();
+        assert!(made.is_dir() && made.ends_with("a/b"), "parents made");
+        for bad in ["a/.", "a/..", "."] {
+            let e = resolve_home(&dir.path().join(bad)).unwrap_err();
+            assert!(e.contains("must end in a folder name"), "{bad}: {e}");
+        }
+        std::os::unix::fs::symlink(dir.path().join("a/b"), dir.path().join("link")).unwrap();
+        assert_eq!(resolve_home(&dir.path().join("link")).unwrap(), made, "links followed");
+        std::fs::write(dir.path().join("file"), b"x").unwrap();
+        assert!(resolve_home(&dir.path().join("file")).is_err(), "a file is no folder");
+        // One run at a time.
+        let first = Outputs::begin(&made).unwrap();
+        let e = Outputs::begin(&made).unwrap_err().to_string();
+        assert!(e.contains("another run is writing"), "{e}");
+        drop(first);
+        assert!(Outputs::begin(&made).is_ok());
     }
 
     #[test]

@@ -105,3 +105,32 @@ pub fn load(path: &Path) -> Result<MeshFile, MeshFileError> {
 
 /// Largest mesh file read (a 1 GiB text file already describes tens of millions of triangles).
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
+
+/// Most triangles a mesh file may expand into: polygons become fans, so a short file can ask
+/// for many; the count is checked face by face, before the fan is stored.
+pub const MAX_FILE_TRIANGLES: usize = 16 << 20;
+
+/// Largest magnitude of a finite vertex coordinate (metres, or the file's units): beyond it f32
+/// on the GPU and the structures' bounds lose the geometry; the scene file's bound too.
+pub const MAX_COORDINATE: f64 = 1e7;
+
+/// A vertex coordinate read from `word`, or why not (`inf` and `nan` pass: such triangles are
+/// dropped and counted later).
+pub fn coordinate(word: &str) -> Result<f64, String> {
+    let c: f64 = word.parse().map_err(|_| format!("bad vertex coordinate `{word}`"))?;
+    if c.is_finite() && c.abs() > MAX_COORDINATE {
+        return Err(format!("vertex coordinate {c:e} beyond +-{MAX_COORDINATE:e}"));
+    }
+    Ok(c)
+}
+
+/// Refuses a face of `corners` corners that would take the file past [`MAX_FILE_TRIANGLES`]
+/// when `stored` triangles are already kept.
+pub fn fan_fits(stored: usize, corners: usize) -> Result<(), String> {
+    if stored + corners.saturating_sub(2) > MAX_FILE_TRIANGLES {
+        return Err(format!(
+            "this face takes the file past {MAX_FILE_TRIANGLES} triangles (polygons count as fans of corners - 2)"
+        ));
+    }
+    Ok(())
+}

@@ -3,7 +3,8 @@
 //! Polygons are split into triangle fans. Everything else (normals, texture coordinates,
 //! materials) is ignored. Errors name the file and line.
 
-use super::file::{MeshFile, MeshFileError};
+use super::file::{coordinate, fan_fits, MeshFile, MeshFileError};
+use std::collections::HashMap;
 use std::path::Path;
 
 /// Parses OBJ text; `file` is only used in errors.
@@ -16,6 +17,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut mesh = MeshFile::default();
     let mut group: Option<u32> = None;
+    let mut group_ids: HashMap<String, u32> = HashMap::new();
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -27,9 +29,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                     let w = words
                         .next()
                         .ok_or_else(|| err(line_no, "vertex needs 3 coordinates".into()))?;
-                    *c = w
-                        .parse()
-                        .map_err(|_| err(line_no, format!("bad vertex coordinate `{w}`")))?;
+                    *c = coordinate(w).map_err(|e| err(line_no, e))?;
                 }
                 positions.push(p);
             }
@@ -54,10 +54,11 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                         format!("a face needs at least 3 vertices, got {}", corners.len()),
                     ));
                 }
-                let g = *group.get_or_insert_with(|| {
-                    mesh.groups.push("default".into());
-                    mesh.groups.len() as u32 - 1
-                });
+                fan_fits(mesh.triangles.len(), corners.len()).map_err(|e| err(line_no, e))?;
+                let g = match group {
+                    Some(g) => g,
+                    None => *group.insert(id_of(&mut mesh, &mut group_ids, "default".into())),
+                };
                 for k in 1..corners.len() - 1 {
                     mesh.triangles.push([corners[0], corners[k], corners[k + 1]]);
                     mesh.group_of.push(g);
@@ -66,18 +67,20 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
             Some("g") | Some("o") => {
                 let name = words.collect::<Vec<_>>().join(" ");
                 let name = if name.is_empty() { "default".to_string() } else { name };
-                group = Some(match mesh.groups.iter().position(|g| *g == name) {
-                    Some(i) => i as u32,
-                    None => {
-                        mesh.groups.push(name);
-                        mesh.groups.len() as u32 - 1
-                    }
-                });
+                group = Some(id_of(&mut mesh, &mut group_ids, name));
             }
             _ => {}
         }
     }
     Ok(mesh)
+}
+
+/// The index of group `name`, added on first sight (a map: files with many groups stay linear).
+fn id_of(mesh: &mut MeshFile, ids: &mut HashMap<String, u32>, name: String) -> u32 {
+    *ids.entry(name).or_insert_with_key(|name| {
+        mesh.groups.push(name.clone());
+        mesh.groups.len() as u32 - 1
+    })
 }
 
 #[cfg(test)]

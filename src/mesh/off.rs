@@ -4,7 +4,7 @@
 //! into triangle fans. OFF has no groups: every face is in group `default`. Errors name the file
 //! and line.
 
-use super::file::{MeshFile, MeshFileError};
+use super::file::{coordinate, fan_fits, MeshFile, MeshFileError};
 use std::path::Path;
 
 /// Parses OFF text; `file` is only used in errors.
@@ -57,7 +57,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
         let mut ws = l.split_whitespace();
         for c in &mut p {
             let w = ws.next().ok_or_else(|| err(n, "vertex needs 3 coordinates".into()))?;
-            *c = w.parse().map_err(|_| err(n, format!("bad vertex coordinate `{w}`")))?;
+            *c = coordinate(w).map_err(|e| err(n, e))?;
         }
         positions.push(p);
     }
@@ -75,6 +75,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
         if corners < 3 {
             return Err(err(n, format!("a face needs at least 3 vertices, got {corners}")));
         }
+        fan_fits(mesh.triangles.len(), corners).map_err(|e| err(n, e))?;
         // The count is checked against the words on the line before anything is sized by it.
         let listed: Vec<&str> = ws.collect();
         if listed.len() < corners {
@@ -125,13 +126,20 @@ mod tests {
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", 6, "at least 3"),
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "fewer than"),
             ("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 6, "after 1 of 2 faces"),
-            // Corner counts no line could hold: refused, never allocated.
+            // Corner counts no file may fan out into: refused, never allocated.
             (
                 "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n18446744073709551615 0 1 2\n",
                 6,
-                "fewer than",
+                "past 16777216 triangles",
             ),
-            ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n100000000000 0 1 2\n", 6, "fewer than"),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n100000000000 0 1 2\n",
+                6,
+                "past 16777216",
+            ),
+            // Within the budget but longer than its line.
+            ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000 0 1 2\n", 6, "fewer than"),
+            ("OFF\n3 1 0\n1e8 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 3, "beyond"),
             ("OFF\n18446744073709551615 1 0\n0 0 0\n", 3, "after 1 of"),
         ] {
             let e = parse(text, Path::new("m.off")).unwrap_err();

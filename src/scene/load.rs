@@ -197,7 +197,7 @@ impl Scene {
 /// Largest coordinate, size or scale a scene file may give (metres): a scene 20,000 km across
 /// is already beyond what f32 on the GPU resolves at a pixel; past it sizes are nonsense that
 /// would only exhaust memory or the exact answer's quadrature.
-pub const MAX_EXTENT: f64 = 1e7;
+pub const MAX_EXTENT: f64 = crate::mesh::file::MAX_COORDINATE;
 
 struct Validator<'a> {
     source: &'a Source,

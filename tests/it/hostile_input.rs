@@ -225,7 +225,7 @@ fn cases() -> Vec<Case> {
                 "\"bad.off\"",
                 1,
             ),
-            &["bad.off:6", "meshes[0].path", "fewer than"],
+            &["bad.off:6", "meshes[0].path", "past 16777216 triangles"],
         );
         c.files.push(("bad.off", off_claiming(corners)));
         v.push(c);
@@ -318,6 +318,112 @@ fn cases() -> Vec<Case> {
         frames.replace("frames = 3", "frames = 4294967295"),
         &["exp.toml", "path.frames"],
     ));
+    let no_field = frames
+        .split("[accel.vlf]")
+        .next()
+        .unwrap()
+        .replace(
+            "structures = [\"kdtree\", \"vlf\", \"bvh\", \"brute\"]",
+            "structures = [\"kdtree\", \"bvh\"]",
+        )
+        .replace("subject = \"vlf\"", "subject = \"bvh\"");
+    v.push(case(
+        "a moving part sent beyond any coordinate, with no structure that bounds it",
+        "frames-ci",
+        format!("{no_field}\n[motion]\npart = \"chrome-ball\"\nstep = [1e50, 0.0, 0.0]\n"),
+        &["exp.toml", "motion.step", "beyond"],
+    ));
+    let mut c = case(
+        "random-triangle scenes whose copies and structures outgrow a 1.5 GB share",
+        "frames-ci",
+        no_field
+            .replace(
+                "generator = \"classroom\"",
+                "generator = \"random-triangles\"\ntriangles = [4000000, 4000001]",
+            )
+            .replace("[path]\nframes = 3", "[path]\nframes = 3\nviewpoints = [\"outside\"]"),
+        &["exp.toml", "scene.triangles[0]", "scene copies"],
+    );
+    c.env = vec![("PENUMBRA_MEMORY_BYTES", "1500000000")];
+    v.push(c);
+    let long = |n: usize| (1..=n).map(|k| k.to_string()).collect::<Vec<_>>().join(", ");
+    v.push(case(
+        "a sweep of 25 million runs",
+        "tiny",
+        sweep
+            .replace("samples = [4, 16]", &format!("samples = [{}]", long(5000)))
+            .replace("seeds = [1, 2]", &format!("seeds = [{}]", long(5000))),
+        &["exp.toml", "key `sweep`", "runs"],
+    ));
+    let mut c = case(
+        "an OFF face fanning out to 17 million triangles",
+        "ao-ci",
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            "\"bad.off\"",
+            1,
+        ),
+        &["bad.off:6", "meshes[0].path", "triangles"],
+    );
+    c.files.push(("bad.off", off_claiming("17000000")));
+    v.push(c);
+    let mut c = case(
+        "a mesh vertex at 1.7e308",
+        "ao-ci",
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            "\"bad.off\"",
+            1,
+        ),
+        &["bad.off:3", "meshes[0].path", "beyond"],
+    );
+    c.files
+        .push(("bad.off", b"OFF\n3 1 0\n1.7e308 0 0\n1 0 0\n0 1 0\n3 0 1 2\n".to_vec()));
+    v.push(c);
+    let mut c = case(
+        "an OBJ of one triangle per group, 40000 groups (must stay linear)",
+        "ao-ci",
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            "\"groups.obj\"",
+            1,
+        )
+        .replacen("[[meshes]]", "[[meshes]]\ngroups = [\"none\"]", 1),
+        &["exp.toml", "meshes[0].groups", "none"],
+    );
+    let groups: String = (0..40_000)
+        .map(|g| format!("g g{g}\nv 0 0 {g}\nv 1 0 {g}\nv 0 1 {g}\nf -3 -2 -1\n"))
+        .collect();
+    c.files.push(("groups.obj", groups.into_bytes()));
+    v.push(c);
+    v.push(case(
+        "an fps light count listed twice",
+        "fps",
+        fps.replacen("lights = [1, 2]", "lights = [1, 1]", 1),
+        &["exp.toml", "scenes[0].lights[1]", "twice"],
+    ));
+    v.push(case(
+        "an fps light of radius 1e300",
+        "fps",
+        fps.replacen("light_radius = 0.02", "light_radius = 1e300", 1),
+        &["exp.toml", "light_radius"],
+    ));
+    let mut c = case(
+        "a results folder ending in `.`",
+        "tiny",
+        sweep.clone(),
+        &["must end in a folder name"],
+    );
+    c.args = vec!["--out", "fresh/."];
+    v.push(c);
+    let mut c = case(
+        "a results folder ending in `..`",
+        "tiny",
+        sweep.clone(),
+        &["must end in a folder name"],
+    );
+    c.args = vec!["--out", "fresh/.."];
+    v.push(c);
     let mut c = case("a merge of 99999999 shards", "tiny", sweep.clone(), &["--merge"]);
     c.args = vec!["--merge", "99999999"];
     v.push(c);
@@ -549,4 +655,36 @@ fn another_experiments_results_are_replaced_only_with_fresh() {
         "nothing of the sweep's results is left"
     );
     assert!(home.join("frames.csv").exists() && home.join("manifest.toml").exists());
+}
+
+/// `--out` through a symbolic link writes into the link's target and leaves the link a link; a
+/// results folder another run holds is refused before anything is done.
+#[test]
+fn a_linked_results_folder_is_followed_and_a_held_one_refused() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let target = s.work.join("target");
+    std::fs::create_dir(&target).unwrap();
+    std::os::unix::fs::symlink(&target, s.work.join("link")).unwrap();
+    let (code, stderr) = s.run(&["exp.toml", "--out", "link"]);
+    assert_eq!(code, 0, "{stderr}");
+    let link = std::fs::symlink_metadata(s.work.join("link")).unwrap();
+    assert!(link.file_type().is_symlink(), "the link is still a link");
+    assert!(target.join("manifest.toml").exists() && target.join("runs.csv").exists());
+    // Another process holds the folder: refused with status 2, nothing touched.
+    use std::os::fd::AsRawFd;
+    let home = s.work.join("results/tiny");
+    let held = std::fs::File::open(&home).unwrap();
+    // SAFETY: a valid open descriptor, unlocked when `held` is dropped.
+    assert_eq!(
+        unsafe { libc::flock(held.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) },
+        0
+    );
+    let before = snapshot(&s.root);
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("another run is writing"), "{stderr}");
+    assert_eq!(snapshot(&s.root), before);
+    drop(held);
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 0, "{stderr}");
 }

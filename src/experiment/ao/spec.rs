@@ -7,6 +7,7 @@ use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Source};
 use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
+use crate::mesh::file::MAX_FILE_TRIANGLES;
 use crate::mesh::{clean, Triangles};
 use crate::scene::ambient::{grid_level, AmbientOcclusion, AoDirections, Weighting};
 use glam::{DMat4, DVec3};
@@ -133,7 +134,7 @@ pub fn into_unit_ball(positions: Vec<[DVec3; 3]>) -> Triangles {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
-    let c = 0.5 * (lo + hi);
+    let c = 0.5 * lo + 0.5 * hi;
     let r = positions
         .iter()
         .flatten()
@@ -225,6 +226,7 @@ impl AoSpec {
             .collect();
         let dir = path.parent().unwrap_or(Path::new("."));
         let mut meshes = Vec::new();
+        let mut held = 0usize;
         for (i, m) in f.meshes.iter().enumerate() {
             plain_name(&m.name).map_err(|e| err(&key_path!["meshes", i, "name"], e))?;
             if f.meshes[..i].iter().any(|o| o.name == m.name) {
@@ -253,6 +255,14 @@ impl AoSpec {
             let (kept, _) = clean(raw, &DMat4::IDENTITY);
             if kept.is_empty() {
                 return Err(err(&at, format!("{} has no triangle a ray can hit", file.display())));
+            }
+            // Every mesh stays loaded for the whole run: their sum is bounded, not each alone.
+            held += kept.len();
+            if held > MAX_FILE_TRIANGLES {
+                return Err(err(
+                    &at,
+                    format!("the meshes up to this one hold {held} triangles, more than the {MAX_FILE_TRIANGLES} one run keeps loaded"),
+                ));
             }
             meshes.push(AoMesh {
                 name: m.name.clone(),

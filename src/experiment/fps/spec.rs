@@ -5,6 +5,7 @@ use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
 use crate::render::Sampling;
 use crate::sampling::{DiskScheme, Pattern};
+use crate::scene::load::MAX_EXTENT;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -88,8 +89,11 @@ impl FpsSpec {
                 format!("must be in 1..={MAX_SAMPLES}, got {}", f.samples),
             ));
         }
-        if !(f.light_radius.is_finite() && f.light_radius > 0.0) {
-            return Err(source.error(&key_path!["light_radius"], "must be positive"));
+        if !(f.light_radius.is_finite() && f.light_radius > 0.0 && f.light_radius <= MAX_EXTENT) {
+            return Err(source.error(
+                &key_path!["light_radius"],
+                format!("must be positive and at most {MAX_EXTENT:e} m, got {}", f.light_radius),
+            ));
         }
         if f.resolutions.is_empty() {
             return Err(source.error(&key_path!["resolutions"], "list at least one [width, height]"));
@@ -137,6 +141,25 @@ impl FpsSpec {
                 return Err(source.error(
                     &key_path!["scenes", i, "lights"],
                     format!("must be in 1..={}", scene.lights.len()),
+                ));
+            }
+            if let Some(k) = (0..e.lights.len()).find(|&k| e.lights[..k].contains(&e.lights[k])) {
+                return Err(source.error(
+                    &key_path!["scenes", i, "lights", k],
+                    format!("`{}` is listed twice", e.lights[k]),
+                ));
+            }
+            if let Some(k) = e.lights.iter().position(|&n| {
+                !scene.lights[..n as usize]
+                    .iter()
+                    .any(|l| matches!(l, crate::scene::Light::Disk(_)))
+            }) {
+                return Err(source.error(
+                    &key_path!["scenes", i, "lights", k],
+                    format!(
+                        "the scene's first {} light(s) hold no disk light: nothing would sample the scheme and radius",
+                        e.lights[k]
+                    ),
                 ));
             }
             if e.paper_fps.len() != e.lights.len() {

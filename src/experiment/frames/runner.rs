@@ -185,13 +185,13 @@ pub fn strip_frames(count: u32, frames: u32) -> Vec<u32> {
 pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<FramesOutcome> {
     let schedule = spec.header.schedule;
     let mut outcome = FramesOutcome::default();
-    let scenes = spec.scenes();
     let strip = strip_frames(spec.strip, spec.frames);
     let bar = progress.bar(
         "frames",
-        (scenes.len() * spec.shadings.len() * spec.viewpoints.len()) as u64 * spec.frames as u64,
+        (spec.scene_count() * spec.shadings.len() * spec.viewpoints.len()) as u64 * spec.frames as u64,
     );
-    for (s, generated) in scenes.iter().enumerate() {
+    for (s, generated) in spec.scenes().enumerate() {
+        let generated = &generated;
         bar.message(format!(
             "{}: building {} structures",
             generated.description,
@@ -277,7 +277,7 @@ pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progr
                             differing_pixels: differing(first, &frames[i]),
                         });
                     }
-                    if s + 1 == scenes.len() && vp == 0 && strip.contains(&frame) {
+                    if s + 1 == spec.scene_count() && vp == 0 && strip.contains(&frame) {
                         outcome.pictures.push(Picture {
                             shading: name,
                             frame,

@@ -10,6 +10,7 @@ use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
 use crate::experiment::header::Header;
 use crate::key_path;
+use crate::scene::load::MAX_EXTENT;
 use crate::scene::procedural::{classroom, random, Generated};
 use crate::scene::Shading;
 use glam::DVec3;
@@ -52,6 +53,9 @@ pub struct Claim {
 pub const MAX_FRAMES: u32 = 100_000;
 /// Most triangles a random-triangle scene may ask for.
 pub const MAX_TRIANGLES: usize = 16 << 20;
+
+/// Bytes of one copy of a generated scene per triangle: three f64 corners and an object id.
+const SCENE_BYTES_PER_TRIANGLE: u64 = 80;
 
 fn one() -> u32 {
     1
@@ -360,8 +364,8 @@ impl FramesSpec {
             motion,
             strip: f.strip,
         };
-        spec.check_path(source)?;
         spec.check_memory(source, &f.accel)?;
+        spec.check_path(source)?;
         Ok(spec)
     }
 
@@ -388,6 +392,19 @@ impl FramesSpec {
             }
         }
         let Some(m) = &self.motion else { return Ok(()) };
+        let travel = m.step * self.moving_frames() as f64;
+        let far = travel.abs().max_element();
+        if far.is_nan() || far > MAX_EXTENT {
+            return Err(source.error(
+                &key_path!["motion", "step"],
+                format!(
+                    "over {} frames (every shading and viewpoint) `{}` would travel {:?} m, beyond the +-{MAX_EXTENT:e} m any coordinate may reach: shorten the step",
+                    self.moving_frames(),
+                    m.part,
+                    travel.to_array()
+                ),
+            ));
+        }
         let bounded: Vec<_> = self
             .structures
             .iter()
@@ -396,7 +413,6 @@ impl FramesSpec {
         if bounded.is_empty() {
             return Ok(());
         }
-        let travel = m.step * self.moving_frames() as f64;
         for g in self.scenes() {
             let t = g.triangles();
             let (index, _) = g.part(&m.part).expect("validated part");
@@ -436,6 +452,32 @@ impl FramesSpec {
             Generator::RandomTriangles { counts, .. } => counts.clone(),
         };
         let available = crate::accel::memory::available_bytes();
+        // One scene is held at a time, with its triangle list, a copy per structure and every
+        // structure built over it.
+        for (k, &n) in counts.iter().enumerate() {
+            let scene = (2 + self.structures.len()) as u64 * SCENE_BYTES_PER_TRIANGLE * n as u64;
+            let structures: u64 = self
+                .structures
+                .iter()
+                .map(|s| crate::accel::memory::estimate(s, n))
+                .sum();
+            if let Some(free) = available.filter(|&free| scene + structures > free) {
+                let at: Vec<Seg> = match self.generator {
+                    Generator::Classroom => key_path!["structures"].to_vec(),
+                    Generator::RandomTriangles { .. } => key_path!["scene", "triangles", k].to_vec(),
+                };
+                return Err(source.error(
+                    &at,
+                    format!(
+                        "{n} triangles with every structure built over them need at least {:.1} GB ({:.1} GB of scene copies, {:.1} GB of structures), more than the {:.1} GB this machine has available",
+                        (scene + structures) as f64 / 1e9,
+                        scene as f64 / 1e9,
+                        structures as f64 / 1e9,
+                        free as f64 / 1e9
+                    ),
+                ));
+            }
+        }
         for (i, s) in self.structures.iter().enumerate() {
             for &n in &counts {
                 crate::accel::memory::check(s, n, available).map_err(|e| {
@@ -451,15 +493,21 @@ impl FramesSpec {
         Ok(())
     }
 
-    /// Every scene of the experiment, generated: the classroom once, or random triangles at
-    /// each count.
-    pub fn scenes(&self) -> Vec<Generated> {
+    /// How many scenes the experiment has.
+    pub fn scene_count(&self) -> usize {
         match &self.generator {
-            Generator::Classroom => vec![classroom::classroom()],
-            Generator::RandomTriangles { counts, seed } => {
-                counts.iter().map(|&n| random::random_triangles(n, *seed)).collect()
-            }
+            Generator::Classroom => 1,
+            Generator::RandomTriangles { counts, .. } => counts.len(),
         }
+    }
+
+    /// Every scene of the experiment, generated one at a time as the iterator is advanced (so
+    /// only one is held): the classroom once, or random triangles at each count.
+    pub fn scenes(&self) -> impl Iterator<Item = Generated> + '_ {
+        (0..self.scene_count()).map(|i| match &self.generator {
+            Generator::Classroom => classroom::classroom(),
+            Generator::RandomTriangles { counts, seed } => random::random_triangles(counts[i], *seed),
+        })
     }
 
     /// The camera of `frame` along `viewpoint` (looking at the file's `look_at` where it has

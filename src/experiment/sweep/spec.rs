@@ -69,6 +69,10 @@ pub struct Figures {
 /// measured plane.
 pub const MAX_RADIUS_PER_HEIGHT: f64 = 100.0;
 
+/// Most runs one sweep expands to (the product of its axes' lengths): every run is held in
+/// memory, keyed and journaled.
+pub const MAX_RUNS: usize = 1_000_000;
+
 /// A validated experiment.
 #[derive(Clone, Debug)]
 pub struct Spec {
@@ -148,6 +152,31 @@ impl Spec {
         if axes.accelerators.is_empty() {
             axes.accelerators = vec![scene.accel_settings.name.to_string()];
         }
+        // The lists are checked before anything is built or expanded over them.
+        let lists = axes.texts();
+        let mut runs = 1u128;
+        for (axis, values) in &lists {
+            if values.is_empty() {
+                return Err(err(
+                    &key_path!["sweep", axis.list_key()],
+                    "must list at least one value".into(),
+                ));
+            }
+            let mut seen = std::collections::HashSet::new();
+            if let Some(i) = values.iter().position(|v| !seen.insert(v)) {
+                return Err(err(
+                    &key_path!["sweep", axis.list_key(), i],
+                    format!("`{}` is listed twice", values[i]),
+                ));
+            }
+            runs *= values.len() as u128;
+        }
+        if runs > MAX_RUNS as u128 {
+            return Err(err(
+                &key_path!["sweep"],
+                format!("the axes multiply to {runs} runs, more than the {MAX_RUNS} one sweep may hold; split it with --filter or shorten the lists"),
+            ));
+        }
         let mut structures = BTreeMap::new();
         for (i, name) in axes.accelerators.iter().enumerate() {
             let Some(r) = crate::accel::registered(name) else {
@@ -209,15 +238,6 @@ impl Spec {
             ));
         }
         let a = &axes;
-        let lists = a.texts();
-        for (axis, values) in &lists {
-            if values.is_empty() {
-                return Err(err(
-                    &key_path!["sweep", axis.list_key()],
-                    "must list at least one value".into(),
-                ));
-            }
-        }
         for (i, &n) in a.samples.iter().enumerate() {
             if !(1..=MAX_SAMPLES).contains(&n) {
                 return Err(err(
@@ -252,16 +272,6 @@ impl Spec {
                         "a {r} m light is more than {MAX_RADIUS_PER_HEIGHT} times its {lowest:.3} m height over the measured plane"
                     ),
                 ));
-            }
-        }
-        for (axis, values) in &lists {
-            for (i, v) in values.iter().enumerate() {
-                if values[..i].contains(v) {
-                    return Err(err(
-                        &key_path!["sweep", axis.list_key(), i],
-                        format!("`{v}` is listed twice"),
-                    ));
-                }
             }
         }
         if !(1..=MAX_SAMPLES).contains(&f.ground_truth.samples) {
