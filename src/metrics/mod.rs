@@ -6,6 +6,7 @@ pub mod extent;
 pub mod flip;
 pub mod profile;
 pub mod seeds;
+pub mod spectrum;
 pub mod stats;
 pub mod throughput;
 

@@ -3,7 +3,7 @@
 //! scene asks ([`Weighting`]).
 
 use super::shading::{blocked, Receiver};
-use crate::sampling::Stream;
+use crate::sampling::Site;
 use crate::scene::ambient::{AmbientOcclusion, AoDirections, Weighting};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
@@ -42,7 +42,7 @@ pub fn occlusion(
     r: &Receiver,
     ao: &AmbientOcclusion,
     shared: Option<&[DVec2]>,
-    stream: Stream,
+    site: Site,
 ) -> (f64, u64) {
     let origin = r.origin();
     let open = |d: DVec3| !blocked(scene, origin, d, ao.max_distance, r);
@@ -70,7 +70,7 @@ pub fn occlusion(
             for k in 0..ao.rays {
                 let s = match shared {
                     Some(points) => points[k as usize],
-                    None => scheme.point(ao.rays, k, stream),
+                    None => scheme.point(ao.rays, k, site),
                 };
                 let l = lift(s, ao.weighting);
                 if open(t * l.x + b * l.y + r.n * l.z) {

@@ -8,7 +8,7 @@ use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::accel::work::{self, Work};
 use crate::render::plan::{Pass, RenderPlan};
-use crate::sampling::{shared_points, Pattern, Stream};
+use crate::sampling::{shared_points, Pattern, Site};
 use crate::scene::ambient::{AmbientOcclusion, AoDirections};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
@@ -87,10 +87,17 @@ pub fn closest_hit_skipping(scene: &Scene, origin: DVec3, dir: DVec3, skip: u32)
 struct LightTargets {
     shared: Vec<Option<Vec<DVec2>>>,
     sampling: Sampling,
+    width: u32,
+}
+
+/// Pixel `pixel`'s sampling site for stream `light` (a light's index, or the ambient pass's).
+fn site(sampling: Sampling, light: u32, pixel: usize, width: u32) -> Site {
+    let p = pixel as u32;
+    Site::pixel(sampling.seed, light, [p % width, p / width], p)
 }
 
 impl LightTargets {
-    fn new(scene: &Scene, sampling: Sampling) -> LightTargets {
+    fn new(scene: &Scene, sampling: Sampling, width: u32) -> LightTargets {
         let shared = scene
             .lights
             .iter()
@@ -100,7 +107,11 @@ impl LightTargets {
                     .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, i as u32))
             })
             .collect();
-        LightTargets { shared, sampling }
+        LightTargets {
+            shared,
+            sampling,
+            width,
+        }
     }
 
     fn of(&self, light: usize, pixel: usize) -> Targets<'_> {
@@ -108,7 +119,7 @@ impl LightTargets {
             Some(points) => Targets::Shared(points),
             None => Targets::PerPixel(
                 self.sampling.scheme,
-                Stream::new(self.sampling.seed, light as u32, Some(pixel as u32)),
+                site(self.sampling, light as u32, pixel, self.width),
             ),
         }
     }
@@ -149,6 +160,7 @@ fn ambient_image(
     ao: &AmbientOcclusion,
     receivers: &[Option<Receiver>],
     sampling: Sampling,
+    width: u32,
 ) -> (Vec<f32>, u64, Work) {
     let shared = match (&ao.directions, sampling.pattern) {
         (AoDirections::Disk(scheme), Pattern::Shared) => {
@@ -160,8 +172,8 @@ fn ambient_image(
         .par_iter()
         .enumerate()
         .map(|(pixel, r)| {
-            let stream = Stream::new(sampling.seed, AMBIENT_STREAM, Some(pixel as u32));
-            work::counted(|| r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), stream)))
+            let at = site(sampling, AMBIENT_STREAM, pixel, width);
+            work::counted(|| r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), at)))
         })
         .collect();
     let (values, work) = split_work(values);
@@ -202,7 +214,7 @@ impl Backend for CpuBackend {
         let mut receivers: Vec<Option<Receiver>> = vec![];
         let mut irradiance = vec![0f64; pixels];
         let mut reflected = vec![0f64; pixels];
-        let targets = LightTargets::new(scene, sampling);
+        let targets = LightTargets::new(scene, sampling, view.width);
         for pass in &plan.passes {
             self.dispatches += 1;
             match *pass {
@@ -259,7 +271,7 @@ impl Backend for CpuBackend {
                 }
                 Pass::Ambient { .. } => {
                     let ao = scene.ambient.as_ref().expect("the plan has the pass only then");
-                    let (image, rays, work) = ambient_image(scene, ao, &receivers, sampling);
+                    let (image, rays, work) = ambient_image(scene, ao, &receivers, sampling, view.width);
                     frame.work += work;
                     frame.ambient = Some(image);
                     frame.rays.ambient = rays;

@@ -3,7 +3,7 @@
 
 use crate::accel::work;
 use crate::geometry::offset_origin;
-use crate::sampling::{DiskScheme, Stream};
+use crate::sampling::{DiskScheme, Site};
 use crate::scene::{DiskLight, Light, Scene, Shape};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -83,8 +83,8 @@ pub fn disk_unreachable(p: DVec3, n: DVec3, l: &DiskLight) -> bool {
 
 /// Where a receiver's shadow rays land on the unit disk.
 pub enum Targets<'a> {
-    /// Drawn by `scheme` from this receiver's own stream.
-    PerPixel(DiskScheme, Stream),
+    /// Drawn by `scheme` at this receiver's pixel.
+    PerPixel(DiskScheme, Site),
     /// The precomputed set every receiver shares.
     Shared(&'a [DVec2]),
 }
@@ -129,7 +129,7 @@ pub fn shade_light(scene: &Scene, r: &Receiver, light: &Light, targets: Targets)
             for k in 0..l.samples {
                 let s = match targets {
                     Targets::Shared(points) => points[k as usize],
-                    Targets::PerPixel(scheme, stream) => scheme.point(l.samples, k, stream),
+                    Targets::PerPixel(scheme, site) => scheme.point(l.samples, k, site),
                 };
                 let q = l.center + l.radius * (s.x * u + s.y * v);
                 let d = q - p;

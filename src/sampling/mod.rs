@@ -1,16 +1,21 @@
 //! Where shadow rays land on a disk light: the schemes compared by the sweep.
 //!
-//! Each scheme maps (sample count n, sample index k, random stream) to a point on the unit disk;
-//! the renderer scales it by the light's radius and places it in the light's plane. A scheme is
-//! evaluated one sample at a time so that the GPU can do the same without storage.
+//! Each scheme maps (sample count n, sample index k, the pixel's [`Site`]: its random stream,
+//! its position and the run's seed) to a point on the unit disk; the renderer scales it by the
+//! light's radius and places it in the light's plane. A scheme is evaluated one sample at a
+//! time so that the GPU can do the same; the schemes arranged over the screen read tables the
+//! GPU gets as a buffer ([`tables`]).
 //!
 //! Adding a scheme: a variant in [`DiskScheme`] with its name in [`DiskScheme::ALL`], its point
 //! function in [`DiskScheme::point`], and the same function in
 //! `render/gpu/shaders/sampling.wgsl` under the matching `SCHEME_*` id. The property tests in
-//! `tests/sampling_properties.rs` and the CPU/GPU agreement test then cover it.
+//! `tests/it/sampling_properties.rs` and the CPU/GPU agreement test then cover it.
 
+pub mod bluenoise;
+pub mod pmj02;
 pub mod rng;
 pub mod sobol;
+pub mod tables;
 
 use glam::DVec2;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
@@ -39,17 +44,65 @@ pub enum DiskScheme {
     /// Golden-angle spiral with one random rotation and one random radial offset per pattern:
     /// sample k is uniform over the k-th of n equal-area annuli, so it is unbiased.
     Spiral,
+    /// Progressive multi-jittered (0,2) points (Christensen, Kensler & Kilpatrick 2018) from one
+    /// shared sequence, each pixel's under its own random digital shift, through the concentric
+    /// map ([`pmj02`]).
+    Pmj02,
+    /// A shared (0,2) set (unscrambled Sobol') shifted per pixel by a blue-noise mask's offset
+    /// plus one random shift per run and light, modulo 1 (Cranley-Patterson rotation; Georgiev
+    /// & Fajardo 2016), through the concentric map ([`bluenoise::offset`]).
+    BluenoiseCp,
+    /// Owen-scrambled Sobol' whose per-pixel scrambles are arranged over a tile so neighbouring
+    /// pixels' errors differ (after Heitz et al. 2019), through the concentric map
+    /// ([`bluenoise`]).
+    SobolBluenoise,
+}
+
+/// Where one pixel's samples come from: its random stream, and, for the schemes arranged over
+/// the screen, its position and the run's seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Site {
+    /// The pixel's (or the shared pattern's) random stream.
+    pub stream: Stream,
+    /// Pixel column and row.
+    pub pixel: [u32; 2],
+    /// Seed of the blue-noise tile's shift, from the run's seed and the light
+    /// ([`bluenoise::tile_seed`]), so that seeds and lights see independent arrangements.
+    pub tile_seed: u32,
+}
+
+impl Site {
+    /// The site of pixel `(x, y)` (index `index`) for light `light` in a run seeded with `seed`.
+    pub fn pixel(seed: u32, light: u32, [x, y]: [u32; 2], index: u32) -> Site {
+        Site {
+            stream: Stream::new(seed, light, Some(index)),
+            pixel: [x, y],
+            tile_seed: bluenoise::tile_seed(seed, light),
+        }
+    }
+
+    /// The site every pixel shares (the paper's precomputed buffer).
+    pub fn shared(seed: u32, light: u32) -> Site {
+        Site {
+            stream: Stream::new(seed, light, None),
+            pixel: [0, 0],
+            tile_seed: bluenoise::tile_seed(seed, light),
+        }
+    }
 }
 
 impl DiskScheme {
     /// Every scheme, in report order.
-    pub const ALL: [DiskScheme; 6] = [
+    pub const ALL: [DiskScheme; 9] = [
         DiskScheme::Uniform,
         DiskScheme::Paper,
         DiskScheme::PaperLiteral,
         DiskScheme::Jittered,
         DiskScheme::Sobol,
         DiskScheme::Spiral,
+        DiskScheme::Pmj02,
+        DiskScheme::BluenoiseCp,
+        DiskScheme::SobolBluenoise,
     ];
 
     /// The name used in experiment files and CSV columns.
@@ -61,7 +114,37 @@ impl DiskScheme {
             DiskScheme::Jittered => "jittered",
             DiskScheme::Sobol => "sobol",
             DiskScheme::Spiral => "spiral",
+            DiskScheme::Pmj02 => "pmj02",
+            DiskScheme::BluenoiseCp => "bluenoise-cp",
+            DiskScheme::SobolBluenoise => "sobol-bluenoise",
         }
+    }
+
+    /// Where the scheme comes from, for reports and the documentation of every output.
+    pub fn source(self) -> &'static str {
+        match self {
+            DiskScheme::Uniform => "eq. (1) of the soft-shadow paper: independent, area-uniform",
+            DiskScheme::Paper => "eq. (2) + (3) of the soft-shadow paper as intended",
+            DiskScheme::PaperLiteral => "eq. (3) of the soft-shadow paper as printed",
+            DiskScheme::Jittered => "stratified on a grid of the unit square, concentric map",
+            DiskScheme::Sobol => "Owen-scrambled Sobol' (Burley 2020), concentric map",
+            DiskScheme::Spiral => "golden-angle spiral over equal-area annuli",
+            DiskScheme::Pmj02 => "progressive multi-jittered (0,2) (Christensen et al. 2018), per-pixel digital shift",
+            DiskScheme::BluenoiseCp => {
+                "blue-noise mask (void-and-cluster) rotating a shared (0,2) set (Georgiev & Fajardo 2016)"
+            }
+            DiskScheme::SobolBluenoise => {
+                "Owen-scrambled Sobol' with blue-noise arranged scrambles (after Heitz et al. 2019)"
+            }
+        }
+    }
+
+    /// Whether the scheme reads per-pixel tables (which the GPU gets as a buffer).
+    pub fn uses_tables(self) -> bool {
+        matches!(
+            self,
+            DiskScheme::Pmj02 | DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise
+        )
     }
 
     /// Numeric id shared with the WGSL `SCHEME_*` constants.
@@ -75,9 +158,10 @@ impl DiskScheme {
         !matches!(self, DiskScheme::Paper | DiskScheme::PaperLiteral)
     }
 
-    /// Sample `k` of `n` on the unit disk, drawing its randomness from `stream`.
-    pub fn point(self, n: u32, k: u32, stream: Stream) -> DVec2 {
+    /// Sample `k` of `n` on the unit disk for the pixel at `site`.
+    pub fn point(self, n: u32, k: u32, site: Site) -> DVec2 {
         debug_assert!(k < n);
+        let stream = site.stream;
         match self {
             DiskScheme::Uniform => {
                 let (u, v) = (stream.unit(2 * k), stream.unit(2 * k + 1));
@@ -113,12 +197,29 @@ impl DiskScheme {
                 let r = ((k as f64 + offset) / n as f64).sqrt();
                 polar(r, TAU * rng::to_unit(turn))
             }
+            DiskScheme::Pmj02 => {
+                let shift = (stream.u32(0x7fff_fffc) >> 8, stream.u32(0x7fff_fffb) >> 8);
+                let (u, v) = pmj02::point(k, shift);
+                concentric(u, v)
+            }
+            DiskScheme::BluenoiseCp => {
+                let [x, y] = site.pixel;
+                let (ox, oy) = bluenoise::offset(x, y, site.tile_seed);
+                let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
+                let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
+                concentric(wrap(sx, ox), wrap(sy, oy))
+            }
+            DiskScheme::SobolBluenoise => {
+                let [x, y] = site.pixel;
+                let (sx, sy) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
+                concentric(rng::to_unit(sx), rng::to_unit(sy))
+            }
         }
     }
 
-    /// All `n` samples of one pattern.
-    pub fn points(self, n: u32, stream: Stream) -> Vec<DVec2> {
-        (0..n).map(|k| self.point(n, k, stream)).collect()
+    /// All `n` samples of one pixel.
+    pub fn points(self, n: u32, site: Site) -> Vec<DVec2> {
+        (0..n).map(|k| self.point(n, k, site)).collect()
     }
 }
 
@@ -229,10 +330,9 @@ macro_rules! named_enum {
 named_enum!(DiskScheme, "sampling scheme");
 named_enum!(Pattern, "pattern");
 
-/// Points on the disk of radius `radius` centred at the origin of the light's plane, for the
-/// shared pattern (the paper's precomputed buffer).
+/// Points on the unit disk for the shared pattern (the paper's precomputed buffer).
 pub fn shared_points(scheme: DiskScheme, n: u32, seed: u32, light: u32) -> Vec<DVec2> {
-    scheme.points(n, Stream::new(seed, light, None))
+    scheme.points(n, Site::shared(seed, light))
 }
 
 #[cfg(test)]
@@ -261,7 +361,7 @@ mod tests {
 
     #[test]
     fn paper_scheme_small_counts_are_defined() {
-        let s = Stream::new(1, 0, Some(0));
+        let s = Site::pixel(1, 0, [0, 0], 0);
         assert_eq!(DiskScheme::Paper.points(1, s), vec![DVec2::ZERO]);
         let two = DiskScheme::Paper.points(2, s);
         assert_eq!(two[0], DVec2::ZERO);
@@ -272,7 +372,7 @@ mod tests {
 
     #[test]
     fn paper_angles_are_evenly_spaced() {
-        let s = Stream::new(5, 0, Some(9));
+        let s = Site::pixel(5, 0, [9, 0], 9);
         let p = DiskScheme::Paper.points(16, s);
         for (k, q) in p.iter().enumerate().skip(1) {
             let expected = TAU * k as f64 / 15.0;
@@ -283,7 +383,7 @@ mod tests {
 
     #[test]
     fn literal_reading_is_the_intended_one_shifted() {
-        let s = Stream::new(2, 1, Some(3));
+        let s = Site::pixel(2, 1, [3, 0], 3);
         let a = DiskScheme::Paper.points(16, s);
         let b = DiskScheme::PaperLiteral.points(16, s);
         assert_eq!(b[0], DVec2::ZERO);

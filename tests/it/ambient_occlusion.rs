@@ -400,7 +400,7 @@ fn the_gpu_pass_matches_the_cpu_and_the_exact_answer() {
 fn the_grids_error_depends_on_position_and_normal() {
     use penumbra::render::ambient::{occlusion, AMBIENT_STREAM};
     use penumbra::render::shading::Receiver;
-    use penumbra::sampling::Stream;
+    use penumbra::sampling::Site;
     use penumbra::scene::ambient::{AmbientOcclusion, AoDirections, Weighting};
     use penumbra::scene::Sphere;
     let sphere = Sphere {
@@ -435,8 +435,9 @@ fn the_grids_error_depends_on_position_and_normal() {
                         object: u32::MAX,
                         triangle: u32::MAX,
                     };
-                    let stream = Stream::new(3, AMBIENT_STREAM, Some((k * 961 + i * 31 + j) as u32));
-                    let e = occlusion(&s, &r, &ao, None, stream).0 - exact;
+                    let pixel = (k * 961 + i * 31 + j) as u32;
+                    let site = Site::pixel(3, AMBIENT_STREAM, [i as u32, (k * 31 + j) as u32], pixel);
+                    let e = occlusion(&s, &r, &ao, None, site).0 - exact;
                     lo = lo.min(e);
                     hi = hi.max(e);
                 }

@@ -92,7 +92,7 @@ fn wgsl_samplers_match_rust() {
         for n in [1u32, 2, 3, 7, 16, 64, 257] {
             let (seed, pixel) = (1234, 77);
             let g = gpu.disk_points(scheme, n, seed, pixel).unwrap();
-            let c = scheme.points(n, penumbra::sampling::Stream::new(seed, 0, Some(pixel)));
+            let c = scheme.points(n, common::hook_site(seed, pixel));
             for (k, (a, b)) in g.iter().zip(&c).enumerate() {
                 let d = ((a[0] as f64 - b.x).powi(2) + (a[1] as f64 - b.y).powi(2)).sqrt();
                 assert!(d < 2e-6, "{scheme} n={n} k={k}: gpu {a:?} cpu {b}");

@@ -7,6 +7,7 @@ mod ambient_occlusion;
 mod ao_experiment;
 mod axis_list;
 mod bad_input;
+mod blue_noise;
 mod cache_keys;
 mod command_line;
 mod common;

@@ -1,10 +1,11 @@
 //! One run measured: render it, compare it with its reference, and assemble its record (its frame
 //! time stays unmeasured until the timing phase fills it in).
 
-use super::record::{Device, FrameTime, Metrics, Radial, RayCounts, Record, Status, StructureColumns};
+use super::record::{Device, FrameTime, Metrics, Radial, RayCounts, Record, SpectrumColumns, Status, StructureColumns};
 use super::reference::{shadow_image, Reference};
 use super::run::Run;
 use super::spec::Spec;
+use crate::metrics::spectrum::{blurred_rmse, error_spectrum};
 use crate::metrics::{penumbra_coverage, ErrorMetrics, RadialProfile};
 use crate::render::{Backend, Sampling, View};
 use anyhow::Context;
@@ -17,6 +18,7 @@ fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, stat
         run: run.clone(),
         radial: Radial::unmeasured(spec.measure.width, spec.measure.height),
         metrics: Metrics::NONE,
+        spectrum: SpectrumColumns::NONE,
         rays: RayCounts::default(),
         time: FrameTime::UNTIMED,
         structure: StructureColumns::NONE,
@@ -58,6 +60,7 @@ pub fn measure_run(
     let bits: Vec<u8> = image.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect();
     r.image_fnv1a = format!("{:016x}", crate::fingerprint::fnv1a(&bits));
     measure_radial(&image, reference, &mut r);
+    measure_spectrum(&image, reference, &mut r);
     let vs_gt = ErrorMetrics::measure(&image, &reference.ground_truth, &reference.mask);
     let rmse_exact = reference
         .exact
@@ -108,4 +111,21 @@ fn measure_radial(image: &[f32], reference: &Reference, r: &mut Record) {
     let m = &mut r.metrics;
     (m.extent_width, m.width_10_90) = (outer - inner, profile.width_10_90());
     (m.profile_bias, m.profile_abs_bias) = (bias, abs_bias);
+}
+
+/// Where the error goes: the radial spectrum of the signed error against the ground truth over
+/// the receiver pixels, its low-frequency share, and the error a small blur leaves over the
+/// penumbra ([`crate::metrics::spectrum`]).
+fn measure_spectrum(image: &[f32], reference: &Reference, r: &mut Record) {
+    let (w, h) = (r.radial.width as usize, r.radial.height as usize);
+    let mut receiver = vec![false; w * h];
+    let mut error = vec![0.0; w * h];
+    for &(i, _) in &reference.receivers.pixels {
+        receiver[i] = true;
+        error[i] = image[i] as f64 - reference.ground_truth[i] as f64;
+    }
+    let spectrum = error_spectrum(&error, &receiver, w, h);
+    r.spectrum = SpectrumColumns::of(&spectrum.radial);
+    r.metrics.lowfreq_share = spectrum.low_share;
+    r.metrics.rmse_blurred = blurred_rmse(&error, &receiver, &reference.mask.pixels, w, h);
 }

@@ -35,6 +35,8 @@ pub struct Record {
     pub radial: Radial,
     /// The metrics summary.csv aggregates over seeds.
     pub metrics: Metrics,
+    /// The radial power spectrum of its error image.
+    pub spectrum: SpectrumColumns,
     /// Rays traced.
     pub rays: RayCounts,
     /// Its configuration's frame time, from the timing phase.
@@ -69,6 +71,7 @@ type Parts = (
     Run,
     Radial,
     Metrics,
+    SpectrumColumns,
     RayCounts,
     FrameTime,
     StructureColumns,
@@ -91,6 +94,7 @@ impl Serialize for Record {
             &self.run,
             &self.radial,
             &self.metrics,
+            &self.spectrum,
             &self.rays,
             &self.time,
             &self.structure,
@@ -103,13 +107,14 @@ impl Serialize for Record {
 
 impl<'de> Deserialize<'de> for Record {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Record, D::Error> {
-        let (head, run, radial, metrics, rays, time, structure, device, tail) = Parts::deserialize(d)?;
+        let (head, run, radial, metrics, spectrum, rays, time, structure, device, tail) = Parts::deserialize(d)?;
         Ok(Record {
             run_key: head.run_key,
             status: head.status,
             run,
             radial,
             metrics,
+            spectrum,
             rays,
             time,
             structure,
@@ -225,7 +230,65 @@ aggregated_metrics! {
     penumbra_area_ratio,
     /// Share of the true penumbra shown fully lit or fully dark.
     penumbra_lost_share,
+    /// Share of the error's power below [`crate::metrics::spectrum::LOW_CUTOFF`] cycles per
+    /// pixel (white noise: 1/16).
+    lowfreq_share,
+    /// RMSE over the penumbra of the error after a Gaussian blur of
+    /// [`crate::metrics::spectrum::BLUR_SIGMA`] pixels (what a simple denoiser leaves).
+    rmse_blurred,
 }
+
+/// Declares the rings of the error's radial power spectrum as runs.csv columns, one per ring of
+/// [`crate::metrics::spectrum::BIN`] cycles per pixel, so that the table stays flat.
+macro_rules! spectrum_columns {
+    ($($ring:ident),*) => {
+        /// The mean power of the run's error image per ring of frequencies: column
+        /// `error_power_NN` covers [NN, NN + 1) / 32 cycles per pixel
+        /// ([`crate::metrics::spectrum::error_spectrum`]).
+        #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+        pub struct SpectrumColumns {
+            $(#[allow(missing_docs)] #[serde(with = "float")] pub $ring: f64,)*
+        }
+
+        impl SpectrumColumns {
+            /// Not measured.
+            pub const NONE: SpectrumColumns = SpectrumColumns { $($ring: f64::NAN,)* };
+
+            /// Rings of the spectrum.
+            pub const RINGS: usize = [$(stringify!($ring)),*].len();
+
+            /// The columns of a radial spectrum of [`SpectrumColumns::RINGS`] rings.
+            pub fn of(radial: &[f64]) -> SpectrumColumns {
+                let mut rings = radial.iter().copied();
+                SpectrumColumns { $($ring: rings.next().unwrap_or(f64::NAN),)* }
+            }
+
+            /// The ring powers, lowest frequency first.
+            pub fn rings(&self) -> Vec<f64> {
+                vec![$(self.$ring),*]
+            }
+        }
+    };
+}
+
+spectrum_columns!(
+    error_power_00,
+    error_power_01,
+    error_power_02,
+    error_power_03,
+    error_power_04,
+    error_power_05,
+    error_power_06,
+    error_power_07,
+    error_power_08,
+    error_power_09,
+    error_power_10,
+    error_power_11,
+    error_power_12,
+    error_power_13,
+    error_power_14,
+    error_power_15
+);
 
 /// Rays one frame of the run traced, and what their queries cost where the backend counts it
 /// (the CPU; empty on the GPU): deterministic work that does not move between runs.

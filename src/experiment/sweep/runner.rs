@@ -14,6 +14,7 @@ use crate::experiment::progress::{Bar, Progress};
 use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::render::{Backend, RenderPlan, View};
+use crate::sampling::DiskScheme;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -126,6 +127,11 @@ pub(super) fn render_groups(
     progress: &Progress,
 ) -> anyhow::Result<Outcome> {
     let fig_n = figure_samples(spec);
+    if spec.axes.schemes.contains(&DiskScheme::SobolBluenoise) {
+        let mut counts = spec.axes.samples.clone();
+        counts.extend(spec.figures.as_ref().map(|f| f.samples));
+        crate::sampling::bluenoise::prepare(&counts);
+    }
     let bar = progress.bar("runs", groups.iter().map(|g| g.runs.len() as u64).sum());
     let mut out = empty_outcome(spec)?;
     for ((lights, radius), share) in by_reference(groups) {

@@ -76,8 +76,9 @@ impl GpuBackend {
         self.submit(encoder, scope)
     }
 
-    /// Unit-disk points of `scheme` for pixel `pixel` with `seed`, computed by the WGSL sampler:
-    /// lets tests compare it with the Rust one ([`DiskScheme::point`]).
+    /// Unit-disk points of `scheme` for pixel `pixel` (index of a notional image 64 wide, light
+    /// 0) with `seed`, computed by the WGSL sampler: lets tests compare it with the Rust one
+    /// ([`DiskScheme::point`] at [`crate::sampling::Site::pixel`]).
     pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
         self.disk_points_of_id(scheme.gpu_id(), n, seed, pixel)
     }
@@ -100,6 +101,9 @@ impl GpuBackend {
         let mut packed = pack(&scene, view, sampling)?;
         packed.params.scheme = id;
         packed.params.height = pixel;
+        if let Some(&scheme) = DiskScheme::ALL.get(id as usize) {
+            packed.tables = crate::sampling::tables::pack(&[(scheme, n)]);
+        }
         let r = self.resources(&packed, View { height: 2, ..view }, 0)?;
         self.run_hook(false, &r, &[], n.div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);

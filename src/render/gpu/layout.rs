@@ -7,7 +7,7 @@ use crate::geometry::LocalFrame;
 use crate::render::ambient::AMBIENT_STREAM;
 use crate::render::{Sampling, View};
 use crate::sampling::{shared_points, Pattern};
-use crate::scene::ambient::{AoDirections, Weighting};
+use crate::scene::ambient::{AmbientOcclusion, AoDirections, Weighting};
 use crate::scene::{Light, Scene, Shape};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -171,6 +171,8 @@ pub struct Packed {
     pub ao_dirs: Vec<[f32; 4]>,
     /// The acceleration structure's name and buffers; None without triangles.
     pub accel: Option<(&'static str, GpuStructure)>,
+    /// The tables the per-pixel schemes read ([`crate::sampling::tables::pack`]).
+    pub tables: Vec<u32>,
 }
 
 /// Packs a scene, view and sampling choice into GPU structs; fails where the scene's
@@ -317,6 +319,19 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         Some(a) => Some((a.name(), a.gpu(&local)?)),
         None => None,
     };
+    // Per-pixel patterns read the tables on the GPU; shared ones were drawn above.
+    let mut uses: Vec<(crate::sampling::DiskScheme, u32)> = Vec::new();
+    if sampling.pattern == Pattern::PerPixel {
+        uses.extend(scene.lights.iter().map(|l| (sampling.scheme, l.samples())));
+        if let Some(AmbientOcclusion {
+            directions: AoDirections::Disk(s),
+            rays,
+            ..
+        }) = &scene.ambient
+        {
+            uses.push((*s, *rays));
+        }
+    }
     Ok(Packed {
         params,
         spheres,
@@ -326,5 +341,6 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         mesh_tris,
         ao_dirs,
         accel,
+        tables: crate::sampling::tables::pack(&uses),
     })
 }

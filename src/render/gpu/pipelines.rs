@@ -19,16 +19,18 @@ const RENDER: &str = concat!(
 /// Name of the structure-less module (no triangles in the scene).
 pub const NO_ACCEL: &str = "none";
 
-/// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`] and prepended
-/// to the shaders, so Rust and WGSL share one list.
+/// WGSL constants naming each disk scheme's id, generated from [`DiskScheme::ALL`], and the
+/// layout of the schemes' tables ([`crate::sampling::tables`]), prepended to the shaders, so
+/// Rust and WGSL share one list.
 pub fn scheme_prelude() -> String {
-    DiskScheme::ALL
+    let ids: String = DiskScheme::ALL
         .iter()
         .map(|s| {
             let name = s.name().to_uppercase().replace('-', "_");
             format!("const SCHEME_{name}: u32 = {}u;\n", s.gpu_id())
         })
-        .collect()
+        .collect();
+    ids + &crate::sampling::tables::wgsl_prelude()
 }
 
 /// The bind group layouts every pipeline shares: per frame (group 0), per dispatch (group 1),
@@ -81,12 +83,12 @@ fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
 impl Layouts {
     pub fn new(device: &wgpu::Device) -> Layouts {
         // params; spheres, planes, lights, shared points; hits, visibility, radiance, counters;
-        // mesh triangles.
+        // mesh triangles; AO directions and output; the sampling schemes' tables.
         let mut entries = vec![uniform(0)];
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
         entries.push(storage(9, true));
-        entries.extend([storage(10, true), storage(11, false)]);
+        entries.extend([storage(10, true), storage(11, false), storage(12, true)]);
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),

@@ -170,6 +170,7 @@ impl GpuBackend {
         let ao_dirs = self.storage("ambient-occlusion directions", &packed.ao_dirs, [0f32; 4]);
         let ao_on = packed.params.ao_rays > 0;
         let ambient = self.output("ambient occlusion", if ao_on { pixels * 8 } else { 16 });
+        let tables = self.storage("sampling tables", &packed.tables, 0u32);
         let buffers = [
             &params,
             &s.spheres,
@@ -183,6 +184,7 @@ impl GpuBackend {
             &s.mesh_tris,
             &ao_dirs,
             &ambient,
+            &tables,
         ];
         let entries: Vec<_> = buffers
             .iter()

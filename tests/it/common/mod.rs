@@ -203,3 +203,9 @@ impl penumbra::render::Backend for Flaky {
         self.0.time(scene, view, s, warmup, repeats)
     }
 }
+
+/// The sampling site the GPU's `disk_points` hook uses for pixel index `pixel` (light 0, an image
+/// 64 wide), for comparing it with the CPU's points.
+pub fn hook_site(seed: u32, pixel: u32) -> penumbra::sampling::Site {
+    penumbra::sampling::Site::pixel(seed, 0, [pixel % 64, pixel / 64], pixel)
+}

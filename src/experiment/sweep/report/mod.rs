@@ -8,6 +8,7 @@ pub mod markdown;
 pub mod pictures;
 pub mod plots;
 pub mod results;
+pub mod schemes;
 pub mod structures;
 pub mod summary;
 pub mod tables;

@@ -1,12 +1,14 @@
-//! The sweep's plots: RMSE and extent widths against rays and frame time, radial profiles at the
-//! figure ray count against the exact profile, and extent width against light radius.
+//! The sweep's plots: RMSE and extent widths against rays and frame time, the error's power
+//! spectrum per scheme at the figure ray count, radial profiles at that count against the exact
+//! profile, and extent width against light radius.
 
 use super::results::Results;
 use super::summary::Summary;
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
-use crate::experiment::sweep::record::Aggregated;
+use crate::experiment::sweep::record::{Aggregated, Status};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
-use crate::metrics::stats::MeanCi;
+use crate::metrics::spectrum::BIN;
+use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::plots::{line_plot, Axes, Reference as RefLine, Series};
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
@@ -114,6 +116,20 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             )
         },
         &series(summaries, at_radius, |s| s.frame.median * 1e3, |m| m.rmse, 1.0),
+        &[],
+    )?;
+    line_plot(
+        &file("error_spectrum"),
+        &Axes::new(
+            &title(&format!(
+                "Where the error goes at {n} rays, per-pixel (mean over seeds)"
+            )),
+            "frequency (cycles per pixel)",
+            "error power per ring",
+            false,
+            true,
+        ),
+        &spectra(r, slice, n, radius),
         &[],
     )?;
     let Some(reference) = r
@@ -260,4 +276,45 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         &profiles,
         &[exact_line],
     )
+}
+
+/// The mean radial power spectrum of the error over seeds, per scheme with the per-pixel pattern
+/// at `n` rays and light radius `radius`, each ring with its 95 % CI.
+fn spectra(r: &Results, slice: &Slice, n: u32, radius: f64) -> Vec<(usize, Series)> {
+    let mut out = Vec::new();
+    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+        let config = Config {
+            scheme: *scheme,
+            pattern: Pattern::PerPixel,
+            samples: n,
+            light_radius: radius,
+            ..slice.config.clone()
+        };
+        let rings: Vec<Vec<f64>> = r
+            .outcome
+            .records
+            .iter()
+            .filter(|x| x.status == Status::Ok && x.run.config() == config)
+            .map(|x| x.spectrum.rings())
+            .collect();
+        let Some(first) = rings.first() else {
+            continue;
+        };
+        let points = (0..first.len())
+            .map(|k| {
+                let m = mean_ci(&rings.iter().map(|x| x[k]).collect::<Vec<_>>());
+                ((k as f64 + 0.5) * BIN, m.mean, m.ci95)
+            })
+            .filter(|p| p.1.is_finite())
+            .collect();
+        out.push((
+            ci,
+            Series {
+                name: scheme.to_string(),
+                points,
+                dashed: false,
+            },
+        ));
+    }
+    out
 }

@@ -1,8 +1,9 @@
 // Test hooks, compiled only when a test calls them (render/gpu/hooks.rs): they expose the WGSL
 // sampler and the acceleration structure's queries to tests, bound at their own group 3.
 
-// Test hook: the unit-disk points a scheme gives pixel `seed`'s stream, for the CPU/GPU
-// sampler agreement test. Writes params.width points into `shared_points`' twin `visibility`.
+// Test hook: the unit-disk points a scheme gives pixel `params.height` (at column height % 64,
+// row height / 64 of a notional image 64 wide), for the CPU/GPU sampler agreement test. Writes
+// params.width points into `visibility`.
 @compute @workgroup_size(64)
 fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
@@ -10,7 +11,8 @@ fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let stream = stream_pixel(params.seed, 0u, params.height);
-    let s = disk_point(params.scheme, params.width, k, stream);
+    let pixel = vec2<u32>(params.height % 64u, params.height / 64u);
+    let s = disk_point(params.scheme, params.width, k, stream, pixel, tile_seed(params.seed, 0u));
     visibility[2u * k] = s.x;
     visibility[2u * k + 1u] = s.y;
 }

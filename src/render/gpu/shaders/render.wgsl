@@ -87,6 +87,7 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(9) var<storage, read> mesh_tris: array<MeshTri>;
 @group(0) @binding(10) var<storage, read> ao_dirs: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> ambient_out: array<f32>;
+@group(0) @binding(12) var<storage, read> scheme_tables: array<u32>;
 @group(1) @binding(0) var<uniform> pass_info: PassInfo;
 
 // Any-hit along origin -> origin + d, skipping the receiver's own sphere or plane (`skip`) or
@@ -248,7 +249,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                 if (params.shared_pattern != 0u) {
                     s = shared_points[light.shared_offset + k];
                 } else {
-                    s = disk_point(params.scheme, light.samples, k, stream);
+                    s = disk_point(params.scheme, light.samples, k, stream, gid.xy, tile_seed(params.seed, li));
                 }
                 let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
                 let d = q - p;
@@ -331,7 +332,7 @@ fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (params.shared_pattern != 0u) {
                 s = ao_dirs[k].xy;
             } else {
-                s = disk_point(params.ao_scheme, params.ao_rays, k, stream);
+                s = disk_point(params.ao_scheme, params.ao_rays, k, stream, gid.xy, tile_seed(params.seed, AMBIENT_STREAM));
             }
             let r2 = min(dot(s, s), 1.0);
             var l: vec3<f32>;

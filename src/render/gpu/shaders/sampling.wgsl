@@ -1,7 +1,9 @@
 // Disk sampling schemes and counter-based random numbers: the WGSL twin of src/sampling/.
 // Every function here must return, bit for bit in its integer part, what the Rust one does.
 
-// The SCHEME_* ids are generated from the Rust list (gpu::scheme_prelude) and prepended.
+// The SCHEME_* ids and the table layout's constants (PMJ02_POINTS, BLUE_TILE, TABLE_COUNTS) are
+// generated from the Rust side (gpu::scheme_prelude, sampling::tables) and prepended; the
+// tables themselves are `scheme_tables` (render.wgsl's binding, sampling::tables::pack).
 
 const TAU: f32 = 6.283185307179586;
 const PI: f32 = 3.141592653589793;
@@ -109,8 +111,55 @@ fn scrambled_sobol_2d(index: u32, seed: u32) -> vec2<u32> {
     return vec2<u32>(x, y);
 }
 
-// Sample k of n on the unit disk (see DiskScheme::point).
-fn disk_point(scheme: u32, n: u32, k: u32, stream: u32) -> vec2<f32> {
+// The pmj02 sequence's point k under a pixel's digital shift (sampling::pmj02::point).
+fn pmj02_point(k: u32, shift: vec2<u32>) -> vec2<f32> {
+    let at = scheme_tables[0] + 2u * (k % PMJ02_POINTS);
+    let x = (scheme_tables[at] ^ shift.x) << 8u;
+    let y = (scheme_tables[at + 1u] ^ shift.y) << 8u;
+    return vec2<f32>(to_unit(x), to_unit(y));
+}
+
+// The seed of a light's tile shift (bluenoise::tile_seed).
+fn tile_seed(seed: u32, light: u32) -> u32 {
+    return seed ^ (light * 0x9e3779b9u);
+}
+
+// A pixel's place in the blue-noise tile, shifted by its tile seed (bluenoise::tile_index).
+fn tile_index(pixel: vec2<u32>, tile_seed: u32) -> u32 {
+    let shift = pcg(tile_seed ^ 0x7ab1e5edu);
+    let sx = shift % BLUE_TILE;
+    let sy = (shift >> 16u) % BLUE_TILE;
+    return ((pixel.y + sy) % BLUE_TILE) * BLUE_TILE + (pixel.x + sx) % BLUE_TILE;
+}
+
+// A pixel's Cranley-Patterson offset: the two masks' values plus the tile seed's shared shift,
+// 24-bit (bluenoise::offset).
+fn bluenoise_offset(pixel: vec2<u32>, tile_seed: u32) -> vec2<u32> {
+    let i = tile_index(pixel, tile_seed);
+    let m = scheme_tables[1];
+    let shift = vec2<u32>(pcg(tile_seed ^ 0x0c9a5e01u) >> 8u, pcg(tile_seed ^ 0x0c9a5e02u) >> 8u);
+    let mask = vec2<u32>(scheme_tables[m + i], scheme_tables[m + BLUE_TILE * BLUE_TILE + i]);
+    return (mask + shift) & vec2<u32>(0x00ffffffu);
+}
+
+// A pixel's Sobol' scramble for n samples from the table of n (bluenoise::scramble).
+fn bluenoise_scramble(pixel: vec2<u32>, n: u32, tile_seed: u32) -> u32 {
+    // The table fitted for the power of two at or above n (bluenoise::table_rays).
+    var rays = 1u;
+    while (rays < n) {
+        rays = rays * 2u;
+    }
+    for (var d = 0u; d < min(scheme_tables[2], TABLE_COUNTS); d = d + 1u) {
+        if (scheme_tables[3u + 2u * d] == rays) {
+            return scheme_tables[scheme_tables[4u + 2u * d] + tile_index(pixel, tile_seed)];
+        }
+    }
+    return 0u;
+}
+
+// Sample k of n on the unit disk for the pixel at `pixel` under the tile shift of `tile_seed`,
+// drawing its randomness from `stream` (see DiskScheme::point and Site).
+fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
     switch scheme {
         case SCHEME_UNIFORM: {
             let u = stream_unit(stream, 2u * k);
@@ -144,6 +193,23 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32) -> vec2<f32> {
             let offset = stream_unit(stream, 0x7ffffffdu);
             let r = sqrt((f32(k) + offset) / f32(n));
             return polar(r, TAU * to_unit(turn));
+        }
+        case SCHEME_PMJ02: {
+            let shift = vec2<u32>(stream_u32(stream, 0x7ffffffcu) >> 8u, stream_u32(stream, 0x7ffffffbu) >> 8u);
+            let p = pmj02_point(k, shift);
+            return concentric(p.x, p.y);
+        }
+        case SCHEME_BLUENOISE_CP: {
+            let o = bluenoise_offset(pixel, tile_seed);
+            let sx = reverseBits(k) >> 8u;
+            let sy = sobol_dim1(k) >> 8u;
+            let u = to_unit(((sx + o.x) & 0x00ffffffu) << 8u);
+            let v = to_unit(((sy + o.y) & 0x00ffffffu) << 8u);
+            return concentric(u, v);
+        }
+        case SCHEME_SOBOL_BLUENOISE: {
+            let s = scrambled_sobol_2d(k, bluenoise_scramble(pixel, n, tile_seed));
+            return concentric(to_unit(s.x), to_unit(s.y));
         }
         default: {
             // An id no scheme has: NaN, which no test or metric mistakes for a point.

@@ -1,0 +1,302 @@
+//! Which scheme to use at few rays: every swept scheme ranked, at the figure ray count and at
+//! equal time, by the error a viewer sees (FLIP), the error a simple denoiser leaves (blurred
+//! RMSE), where the error sits in frequency (low-frequency share) and plain RMSE, with each
+//! scheme's penumbra width against the exact one.
+//!
+//! A scheme is named best by a metric when its mean is the lowest; it is "clearly" best when its
+//! 95 % interval over seeds lies below every other scheme's, and otherwise the schemes whose
+//! intervals overlap its are named with it.
+
+use super::markdown::ms_ci;
+use super::summary::{find, Summary};
+use crate::experiment::sweep::axes::{Axis, Config, Slice};
+use crate::experiment::sweep::timing::compare;
+use crate::experiment::timing::Comparison;
+use crate::metrics::stats::MeanCi;
+use crate::output::numbers::{or_na, with_ci};
+use crate::sampling::{DiskScheme, Pattern};
+
+/// A metric the schemes are ranked by (lower is better).
+struct Metric {
+    /// What it is called in the report.
+    label: &'static str,
+    /// Its value for a configuration.
+    value: fn(&Summary) -> MeanCi,
+    /// Its number format.
+    show: fn(f64) -> String,
+}
+
+const METRICS: [Metric; 4] = [
+    Metric {
+        label: "perceptual error (FLIP of the Fig. 2 picture)",
+        value: |s| s.flip,
+        show: |x| format!("{x:.4}"),
+    },
+    Metric {
+        label: "error left after a 1-pixel Gaussian blur (RMSE over the penumbra)",
+        value: |s| s.metrics.rmse_blurred,
+        show: |x| format!("{x:.4}"),
+    },
+    Metric {
+        label: "low-frequency share of the error's power (below 0.125 cycles per pixel; white noise 0.0625)",
+        value: |s| s.metrics.lowfreq_share,
+        show: |x| format!("{x:.3}"),
+    },
+    Metric {
+        label: "RMSE over the penumbra",
+        value: |s| s.metrics.rmse,
+        show: |x| format!("{x:.4}"),
+    },
+];
+
+/// The schemes ranked by one metric: (scheme, value), lowest mean first, measured ones only.
+fn ranked(rows: &[(DiskScheme, &Summary)], value: fn(&Summary) -> MeanCi) -> Vec<(DiskScheme, MeanCi)> {
+    let mut out: Vec<(DiskScheme, MeanCi)> = rows
+        .iter()
+        .map(|(s, x)| (*s, value(x)))
+        .filter(|(_, m)| m.mean.is_finite())
+        .collect();
+    out.sort_by(|a, b| a.1.mean.total_cmp(&b.1.mean));
+    out
+}
+
+/// Whether `a`'s interval lies wholly below `b`'s.
+fn clearly_below(a: MeanCi, b: MeanCi) -> bool {
+    a.ci95.is_finite() && b.ci95.is_finite() && a.mean + a.ci95 < b.mean - b.ci95
+}
+
+/// "n-th of m": an ordinal.
+fn ordinal(k: usize) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// One sentence per metric ([`sentence`]).
+fn rank_sentences(rows: &[(DiskScheme, &Summary)]) -> String {
+    METRICS.iter().map(|m| sentence(m, &ranked(rows, m.value))).collect()
+}
+
+/// The best scheme by `m` in `r` (ranked, lowest first) with its interval, the schemes tied
+/// with it, and the paper's rank.
+fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)]) -> String {
+    let Some(&(best, b)) = r.first() else {
+        return format!("- *Least {}:* not measured here.\n", m.label);
+    };
+    let tied: Vec<String> = r[1..]
+        .iter()
+        .filter(|(_, x)| !clearly_below(b, *x))
+        .map(|(name, _)| name.to_string())
+        .collect();
+    let call = if !b.ci95.is_finite() {
+        "no interval (fewer than two seeds), so no scheme is called best".to_string()
+    } else if tied.is_empty() {
+        "below every other scheme, 95 % intervals disjoint".to_string()
+    } else {
+        format!("tied within the intervals with {}", tied.join(", "))
+    };
+    let paper = match r.iter().position(|(name, _)| *name == DiskScheme::Paper) {
+        Some(k) => {
+            let p = r[k].1;
+            let better = r.iter().filter(|(_, x)| clearly_below(*x, p)).count();
+            format!(
+                " The paper's pattern ranks {} of {} ({}, {better} scheme(s) clearly below it).",
+                ordinal(k + 1),
+                r.len(),
+                with_ci(p.mean, p.ci95, m.show)
+            )
+        }
+        None => String::new(),
+    };
+    format!(
+        "- *Least {}:* **{best}**, {}; {call}.{paper}\n",
+        m.label,
+        with_ci(b.mean, b.ci95, m.show)
+    )
+}
+
+/// A width against the exact one, as a signed percentage with its interval.
+fn against_exact(x: MeanCi, exact: f64) -> String {
+    with_ci(100.0 * (x.mean / exact - 1.0), 100.0 * x.ci95 / exact, |d| {
+        format!("{d:+.1} %")
+    })
+}
+
+/// The per-pixel configuration of `scheme` at `samples` rays in the slice.
+fn config(slice: &Slice, scheme: DiskScheme, samples: u32, radius: f64) -> Config {
+    Config {
+        scheme,
+        pattern: Pattern::PerPixel,
+        samples,
+        light_radius: radius,
+        ..slice.config.clone()
+    }
+}
+
+/// The most rays at which `scheme` does not take clearly longer than `budget` (uniform sampling
+/// at the figure count) by the timing rule, with that configuration.
+fn within_time<'a>(
+    summaries: &'a [Summary],
+    slice: &Slice,
+    scheme: DiskScheme,
+    radius: f64,
+    budget: &Summary,
+) -> Option<&'a Summary> {
+    let budget_timing = budget.timing.as_ref()?;
+    summaries
+        .iter()
+        .filter(|x| {
+            x.config
+                .agrees_except(&config(slice, scheme, 1, radius), &[Axis::Samples])
+        })
+        .filter(|x| {
+            x.timing
+                .as_ref()
+                .is_some_and(|t| compare(t, budget_timing).1 != Comparison::Slower)
+        })
+        .max_by_key(|x| x.config.samples)
+}
+
+/// The section: at `n` rays, then at uniform@n's frame time.
+pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
+    let at_n: Vec<(DiskScheme, &Summary)> = DiskScheme::ALL
+        .iter()
+        .filter_map(|&s| find(summaries, &config(slice, s, n, radius)).map(|x| (s, x)))
+        .collect();
+    if at_n.len() < 2 {
+        return String::new();
+    }
+    let label = match slice.label(&[]) {
+        l if l.is_empty() => l,
+        l => format!(" ({l})"),
+    };
+    let mut s = format!(
+        "\n## Which scheme at {n} rays{label}\n\nPer-pixel pattern, light radius {radius} m, means over seeds with 95 % intervals. Blurred error: the error against the ground truth blurred by a Gaussian of 1 pixel (what a denoiser that averages neighbours leaves), RMSE over the penumbra. Low-frequency share: the power of the error's spectrum below 0.125 cycles per pixel over all of it up to 0.5 (receiver pixels, Hann window, its mean removed): white noise puts 1/16 there, blue noise less, a pattern shared by neighbours (banding, bias) more. Widths against the exact image's.\n\n"
+    );
+    if at_n
+        .iter()
+        .any(|(scheme, _)| matches!(scheme, DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise))
+    {
+        s += &format!("Blue-noise tables: {}.\n\n", crate::sampling::bluenoise::settings());
+    }
+    s += &rank_sentences(&at_n);
+    let exact = at_n
+        .iter()
+        .find_map(|(_, x)| (x.exact_width_10_90.is_finite()).then_some((x.exact_width_10_90, x.exact_extent_width)));
+    s += "\n| scheme | source | RMSE | FLIP | blurred RMSE | low-freq share | 10-90 width vs exact | extent vs exact | frame time |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (scheme, x) in &at_n {
+        let four = |v: f64| format!("{v:.4}");
+        let m = &x.metrics;
+        let (w, e) = exact.map_or(("n/a".into(), "n/a".into()), |(w, e)| {
+            (against_exact(m.width_10_90, w), against_exact(m.extent_width, e))
+        });
+        s += &format!(
+            "| {scheme} | {} | {} | {} | {} | {} | {w} | {e} | {} |\n",
+            scheme.source(),
+            with_ci(m.rmse.mean, m.rmse.ci95, four),
+            with_ci(x.flip.mean, x.flip.ci95, four),
+            with_ci(m.rmse_blurred.mean, m.rmse_blurred.ci95, four),
+            with_ci(m.lowfreq_share.mean, m.lowfreq_share.ci95, |v| format!("{v:.3}")),
+            ms_ci(&x.frame),
+        );
+    }
+    let Some(budget) = find(summaries, &config(slice, DiskScheme::Uniform, n, radius)) else {
+        return s;
+    };
+    let equal: Vec<(DiskScheme, &Summary)> = DiskScheme::ALL
+        .iter()
+        .filter_map(|&sc| within_time(summaries, slice, sc, radius, budget).map(|x| (sc, x)))
+        .collect();
+    if equal.len() < 2 {
+        return s;
+    }
+    s += &format!(
+        "\n### At equal time\n\nEach scheme at the most swept rays whose frame time is not clearly longer than uniform@{n}'s ({}) by the timing rule; FLIP only where that is {n} rays (the pictures are rendered there).\n\n",
+        ms_ci(&budget.frame)
+    );
+    s += &rank_sentences(&equal);
+    s += "\n| scheme | rays | time vs uniform | RMSE | blurred RMSE | low-freq share |\n|---|---|---|---|---|---|\n";
+    for (scheme, x) in &equal {
+        let ratio = match (&x.timing, &budget.timing) {
+            (Some(a), Some(b)) => {
+                let (r, word) = compare(a, b);
+                format!("{}x: {}", r.show(2), word.word())
+            }
+            _ => "untimed".into(),
+        };
+        let m = &x.metrics;
+        s += &format!(
+            "| {scheme} | {} | {ratio} | {} | {} | {} |\n",
+            x.config.samples,
+            or_na(m.rmse.mean, |v| format!("{v:.4}")),
+            or_na(m.rmse_blurred.mean, |v| format!("{v:.4}")),
+            or_na(m.lowfreq_share.mean, |v| format!("{v:.3}")),
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mci(mean: f64, ci95: f64) -> MeanCi {
+        MeanCi { mean, ci95 }
+    }
+
+    #[test]
+    fn only_disjoint_intervals_are_clearly_below() {
+        assert!(clearly_below(mci(1.0, 0.1), mci(1.5, 0.1)));
+        assert!(!clearly_below(mci(1.0, 0.3), mci(1.5, 0.3)));
+        assert!(!clearly_below(mci(1.0, f64::NAN), mci(5.0, 0.1)));
+        assert!(!clearly_below(mci(1.5, 0.1), mci(1.0, 0.1)));
+    }
+
+    #[test]
+    fn the_best_is_named_with_those_its_interval_overlaps_and_the_paper_is_ranked() {
+        let m = &METRICS[3];
+        let clear = [
+            (DiskScheme::Sobol, mci(0.030, 0.001)),
+            (DiskScheme::Paper, mci(0.050, 0.002)),
+            (DiskScheme::Uniform, mci(0.096, 0.004)),
+        ];
+        let s = sentence(m, &clear);
+        assert!(
+            s.contains("**sobol**, 0.0300 ± 0.0010; below every other scheme"),
+            "{s}"
+        );
+        assert!(
+            s.contains("ranks 2nd of 3 (0.0500 ± 0.0020, 1 scheme(s) clearly below it)"),
+            "{s}"
+        );
+        let tie = [
+            (DiskScheme::Sobol, mci(0.030, 0.005)),
+            (DiskScheme::Pmj02, mci(0.033, 0.005)),
+            (DiskScheme::Paper, mci(0.050, 0.002)),
+        ];
+        let s = sentence(m, &tie);
+        assert!(s.contains("tied within the intervals with pmj02."), "{s}");
+        assert!(s.contains("ranks 3rd of 3 (0.0500 ± 0.0020, 2 scheme(s)"), "{s}");
+        let single = [
+            (DiskScheme::Sobol, mci(0.03, f64::NAN)),
+            (DiskScheme::Uniform, mci(0.09, f64::NAN)),
+        ];
+        assert!(sentence(m, &single).contains("no scheme is called best"));
+        assert!(!sentence(m, &single).contains("ranks"), "no paper, no rank");
+        assert!(sentence(m, &[]).contains("not measured here"));
+    }
+
+    #[test]
+    fn ordinals_read_as_english() {
+        let words: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22].map(ordinal).to_vec();
+        assert_eq!(
+            words,
+            ["1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd"]
+        );
+    }
+}

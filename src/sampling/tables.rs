@@ -1,0 +1,80 @@
+//! The tables the screen-arranged schemes read, packed into one buffer for the GPU, which reads
+//! exactly the values the CPU computes from ([`super::pmj02`], [`super::bluenoise`]).
+//!
+//! Layout (u32 words): `[pmj02 offset, mask offset, D, n_1, offset_1, .., n_D, offset_D]`, then
+//! the pmj02 sequence (x, y per point, 24-bit), the two masks ([`TILE`]^2 offsets each, 24-bit),
+//! and one scramble table ([`TILE`]^2 seeds) per table ray count `n_i` the frame uses
+//! ([`bluenoise::table_rays`]). A region a frame's
+//! schemes do not read is left out (its offset is 0 and nothing reads it).
+
+use super::bluenoise::{self, TILE};
+use super::pmj02;
+use super::DiskScheme;
+
+/// Most distinct ray counts one frame's tables carry (a light's and the ambient pass's each).
+pub const MAX_COUNTS: usize = 8;
+
+/// The WGSL constants of the layout, prepended to the shaders with the scheme ids.
+pub fn wgsl_prelude() -> String {
+    format!(
+        "const PMJ02_POINTS: u32 = {}u;\nconst BLUE_TILE: u32 = {}u;\nconst TABLE_COUNTS: u32 = {}u;\n",
+        pmj02::MAX_POINTS,
+        TILE,
+        MAX_COUNTS
+    )
+}
+
+/// The tables for a frame whose schemes sample `uses` (scheme, ray count) pairs; a single zero
+/// word when none reads a table.
+pub fn pack(uses: &[(DiskScheme, u32)]) -> Vec<u32> {
+    let mut counts: Vec<u32> = uses
+        .iter()
+        .filter(|(s, _)| *s == DiskScheme::SobolBluenoise)
+        .map(|&(_, n)| bluenoise::table_rays(n))
+        .collect();
+    counts.sort_unstable();
+    counts.dedup();
+    counts.truncate(MAX_COUNTS);
+    let needs = |s: DiskScheme| uses.iter().any(|u| u.0 == s);
+    let mut out = vec![0u32; 3 + 2 * MAX_COUNTS];
+    if needs(DiskScheme::Pmj02) {
+        out[0] = out.len() as u32;
+        out.extend(pmj02::shared().iter().flatten());
+    }
+    if needs(DiskScheme::BluenoiseCp) {
+        out[1] = out.len() as u32;
+        let fix = |v: f64| (v * (1u32 << 24) as f64) as u32;
+        for m in bluenoise::masks() {
+            out.extend(m.iter().map(|&v| fix(v)));
+        }
+    }
+    out[2] = counts.len() as u32;
+    for (i, &n) in counts.iter().enumerate() {
+        let offset = out.len() as u32;
+        out[3 + 2 * i] = n;
+        out[4 + 2 * i] = offset;
+        out.extend(bluenoise::scrambles(n).iter());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_layout_points_at_each_table() {
+        let t = pack(&[
+            (DiskScheme::Pmj02, 16),
+            (DiskScheme::SobolBluenoise, 4),
+            (DiskScheme::SobolBluenoise, 16),
+        ]);
+        let pmj = t[0] as usize;
+        assert_eq!(&t[pmj..pmj + 2], &pmj02::shared()[0][..]);
+        assert_eq!(t[1], 0, "no mask asked for");
+        assert_eq!((t[2], t[3], t[5]), (2, 4, 16));
+        let sixteen = t[6] as usize;
+        assert_eq!(&t[sixteen..sixteen + TILE * TILE], &bluenoise::scrambles(16)[..]);
+        assert_eq!(pack(&[(DiskScheme::Uniform, 16)]).len(), 3 + 2 * MAX_COUNTS);
+    }
+}
