@@ -9,16 +9,15 @@
 //! - [`scrambles`]: per-pixel Owen-scrambling seeds of Sobol' arranged over a tile so that the
 //!   errors of neighbouring pixels on a set of test integrands cancel under a small blur (after
 //!   Heitz, Belcour, Ostromoukhov, Coeurjolly & Iehl 2019, whose 128 x 128 tables come from
-//!   simulated annealing on a pairwise energy; here a 64 x 64 tile, one table per ray count,
-//!   from a seeded greedy swap search on the blurred error itself, under a second each).
+//!   simulated annealing on a pairwise energy; here a 64 x 64 tile, one table per power-of-two
+//!   ray count, from a seeded greedy swap search on the blurred error itself, under a second each).
 //!
 //! Everything is deterministic from the seeds below, generated on first use and kept for the
 //! process; the GPU gets the same tables as buffers.
 
 use super::rng::{pcg, to_unit};
 use super::sobol::scrambled_sobol_2d;
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::OnceLock;
 
 /// Side of every tile (pixels); masks and scramble tables repeat with this period.
 pub const TILE: usize = 64;
@@ -144,9 +143,20 @@ pub fn tile_seed(seed: u32, light: u32) -> u32 {
 /// Index of pixel (x, y) of the image in a tile shifted by `tile_seed` ([`tile_seed`]: so that
 /// seeds and lights give independent realisations of the same blue-noise arrangement).
 pub fn tile_index(x: u32, y: u32, tile_seed: u32) -> usize {
+    tile_index_in(x, y, tile_seed, TILE as u32)
+}
+
+/// [`tile_index`] in a tile of `side` pixels (a points file's tile, [`super::points`]).
+pub fn tile_index_in(x: u32, y: u32, tile_seed: u32, side: u32) -> usize {
     let shift = pcg(tile_seed ^ 0x7ab1_e5ed);
-    let (sx, sy) = (shift as usize % TILE, (shift >> 16) as usize % TILE);
-    ((y as usize + sy) % TILE) * TILE + (x as usize + sx) % TILE
+    let (sx, sy) = (shift % side, (shift >> 16) % side);
+    (((y % side + sy) % side) * side + (x % side + sx) % side) as usize
+}
+
+/// The random shift, modulo 1 as 24-bit fractions, that every pixel's Cranley-Patterson offset
+/// gets under `tile_seed`: over seeds it makes each pixel's offset uniform.
+pub fn cp_shift(tile_seed: u32) -> (u32, u32) {
+    (pcg(tile_seed ^ 0x0c9a_5e01) >> 8, pcg(tile_seed ^ 0x5b1d_93c7) >> 8)
 }
 
 /// A pixel's Cranley-Patterson offset, as 24-bit fractions: the masks' values at its place in
@@ -157,7 +167,7 @@ pub fn offset(x: u32, y: u32, tile_seed: u32) -> (u32, u32) {
     let m = masks();
     let i = tile_index(x, y, tile_seed);
     let fix = |v: f64| (v * (1u32 << 24) as f64) as u32;
-    let (sx, sy) = (pcg(tile_seed ^ 0x0c9a_5e01) >> 8, pcg(tile_seed ^ 0x0c9a_5e02) >> 8);
+    let (sx, sy) = cp_shift(tile_seed);
     let wrap = |a: u32, b: u32| a.wrapping_add(b) & 0x00ff_ffff;
     (wrap(fix(m[0][i]), sx), wrap(fix(m[1][i]), sy))
 }
@@ -207,19 +217,12 @@ fn errors(n: u32, seed: u32, tests: &[(f64, f64, f64)]) -> Vec<f32> {
 /// carries to other integrands falls with the ray count: the error vector of 16 points over
 /// many edges has too many independent parts for 4096 pixels to cancel (tests/it/blue_noise.rs
 /// measures both).
-pub fn scrambles(n: u32) -> Arc<Vec<u32>> {
+pub fn scrambles(n: u32) -> &'static [u32] {
+    // One slot per power of two up to 2^31: reading a built table takes no lock (every sample
+    // of a CPU render reads one); a table is built once, outside any lock but its own slot's.
+    static TABLES: [OnceLock<Vec<u32>>; 32] = [const { OnceLock::new() }; 32];
     let n = table_rays(n);
-    type Slot = Arc<OnceLock<Arc<Vec<u32>>>>;
-    static TABLES: OnceLock<Mutex<HashMap<u32, Slot>>> = OnceLock::new();
-    let slot = TABLES
-        .get_or_init(Default::default)
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .entry(n)
-        .or_default()
-        .clone();
-    // Built outside the map's lock, once: other ray counts build beside it meanwhile.
-    slot.get_or_init(|| Arc::new(optimise(n, SCRAMBLE_SEED))).clone()
+    TABLES[n.trailing_zeros() as usize].get_or_init(|| optimise(n, SCRAMBLE_SEED))
 }
 
 /// The ray count whose table serves `n` rays: the power of two at or above it (a Sobol' prefix
@@ -329,8 +332,8 @@ fn optimise(n: u32, seed: u32) -> Vec<u32> {
             }
         }
     };
-    for p in 0..count {
-        spread(&mut g, p, e(err[p]), 1.0);
+    for (p, &row) in err.iter().enumerate() {
+        spread(&mut g, p, e(row), 1.0);
     }
     let mut rng = pcg(seed ^ 0x0005_3a9e ^ n);
     let mut d = vec![0f32; t];
@@ -374,7 +377,7 @@ fn optimise(n: u32, seed: u32) -> Vec<u32> {
 pub fn settings() -> String {
     format!(
         "tiles of {TILE} x {TILE} pixels shifted per seed and light; masks by void-and-cluster (Gaussian sigma {SIGMA} px, seeds {:#x}, {:#x}); \
-         Sobol' scrambles fitted per ray count to {EDGES} disk-edge integrands (seed {SCRAMBLE_SEED:#x}) by {SWEEPS} sweeps of best-of-{CANDIDATES} swaps minimising the squared error after a Gaussian blur of {BLUR} px",
+         Sobol' scrambles fitted per power-of-two ray count to {EDGES} disk-edge integrands (seed {SCRAMBLE_SEED:#x}) by {SWEEPS} sweeps of best-of-{CANDIDATES} swaps minimising the squared error after a Gaussian blur of {BLUR} px",
         MASK_SEEDS[0], MASK_SEEDS[1]
     )
 }
@@ -422,8 +425,8 @@ mod tests {
         for n in [1u32, 16] {
             let arranged = scrambles(n);
             let random = initial_scrambles(n, SCRAMBLE_SEED);
-            let (fit, fit_random) = (low_share(n, &arranged, &fitted), low_share(n, &random, &fitted));
-            let (new, new_random) = (low_share(n, &arranged, &unseen), low_share(n, &random, &unseen));
+            let (fit, fit_random) = (low_share(n, arranged, &fitted), low_share(n, &random, &fitted));
+            let (new, new_random) = (low_share(n, arranged, &unseen), low_share(n, &random, &unseen));
             eprintln!("{n} rays: fitted {fit:.4} vs {fit_random:.4}; unseen {new:.4} vs {new_random:.4}");
             assert!(
                 (fit_random - 1.0 / 16.0).abs() < 0.02,

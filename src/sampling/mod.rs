@@ -147,6 +147,14 @@ impl DiskScheme {
         )
     }
 
+    /// The most samples per pixel the scheme can give (its table's size; otherwise unbounded).
+    pub fn max_samples(self) -> u32 {
+        match self {
+            DiskScheme::Pmj02 => pmj02::MAX_POINTS as u32,
+            _ => u32::MAX,
+        }
+    }
+
     /// Numeric id shared with the WGSL `SCHEME_*` constants.
     pub fn gpu_id(self) -> u32 {
         self as u32

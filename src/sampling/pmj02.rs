@@ -10,7 +10,8 @@
 
 use super::rng::{pcg, to_unit};
 
-/// Points in the shared sequence: every swept ray count up to the largest the GPU takes.
+/// Points in the shared sequence, and so the most rays pmj02 samples (experiments asking for
+/// more are refused: point k would repeat point k - 4096).
 pub const MAX_POINTS: usize = 4096;
 
 /// Seed of the shared sequence (recorded in the report).

@@ -11,8 +11,9 @@ use super::bluenoise::{self, TILE};
 use super::pmj02;
 use super::DiskScheme;
 
-/// Most distinct ray counts one frame's tables carry (a light's and the ambient pass's each).
-pub const MAX_COUNTS: usize = 8;
+/// Most distinct scramble tables one frame carries: one per light and one for the ambient
+/// pass, so no frame can ask for more.
+pub const MAX_COUNTS: usize = crate::render::plan::MAX_LIGHTS + 1;
 
 /// The WGSL constants of the layout, prepended to the shaders with the scheme ids.
 pub fn wgsl_prelude() -> String {
@@ -34,7 +35,10 @@ pub fn pack(uses: &[(DiskScheme, u32)]) -> Vec<u32> {
         .collect();
     counts.sort_unstable();
     counts.dedup();
-    counts.truncate(MAX_COUNTS);
+    assert!(
+        counts.len() <= MAX_COUNTS,
+        "a frame's lights and ambient pass use at most {MAX_COUNTS} ray counts"
+    );
     let needs = |s: DiskScheme| uses.iter().any(|u| u.0 == s);
     let mut out = vec![0u32; 3 + 2 * MAX_COUNTS];
     if needs(DiskScheme::Pmj02) {
@@ -74,7 +78,7 @@ mod tests {
         assert_eq!(t[1], 0, "no mask asked for");
         assert_eq!((t[2], t[3], t[5]), (2, 4, 16));
         let sixteen = t[6] as usize;
-        assert_eq!(&t[sixteen..sixteen + TILE * TILE], &bluenoise::scrambles(16)[..]);
+        assert_eq!(&t[sixteen..sixteen + TILE * TILE], bluenoise::scrambles(16));
         assert_eq!(pack(&[(DiskScheme::Uniform, 16)]).len(), 3 + 2 * MAX_COUNTS);
     }
 }

@@ -304,6 +304,16 @@ fn ambient(a: &AmbientDesc, v: &Validator) -> Result<AmbientOcclusion, ConfigErr
                 ),
             )
         })?;
+        if a.rays > scheme.max_samples() {
+            return Err(v.source.error(
+                &at("rays"),
+                format!(
+                    "{scheme} gives at most {} directions, got {}",
+                    scheme.max_samples(),
+                    a.rays
+                ),
+            ));
+        }
         AoDirections::Disk(scheme)
     };
     let max_distance = match a.max_distance {

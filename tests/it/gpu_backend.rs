@@ -31,6 +31,9 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
             (DiskScheme::Uniform, Pattern::PerPixel),
             (DiskScheme::Paper, Pattern::Shared),
             (DiskScheme::Sobol, Pattern::PerPixel),
+            (DiskScheme::Pmj02, Pattern::PerPixel),
+            (DiskScheme::BluenoiseCp, Pattern::PerPixel),
+            (DiskScheme::SobolBluenoise, Pattern::PerPixel),
         ] {
             let view = View {
                 camera: &scene.cameras[camera],
@@ -93,6 +96,7 @@ fn wgsl_samplers_match_rust() {
             let (seed, pixel) = (1234, 77);
             let g = gpu.disk_points(scheme, n, seed, pixel).unwrap();
             let c = scheme.points(n, common::hook_site(seed, pixel));
+            assert_eq!(g.len(), c.len(), "{scheme} n={n}: one GPU point per sample");
             for (k, (a, b)) in g.iter().zip(&c).enumerate() {
                 let d = ((a[0] as f64 - b.x).powi(2) + (a[1] as f64 - b.y).powi(2)).sqrt();
                 assert!(d < 2e-6, "{scheme} n={n} k={k}: gpu {a:?} cpu {b}");

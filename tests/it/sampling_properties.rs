@@ -84,6 +84,29 @@ fn area_uniform_schemes_pass_chi_square() {
     }
 }
 
+/// Over seeds, each sample of one pixel of a screen-arranged scheme is uniform on the disk:
+/// what makes its estimator unbiased (the tile's per-seed shift and, for the rotated set, the
+/// per-seed Cranley-Patterson shift). A scheme that forgot either would put a pixel's sample k
+/// at one place for every seed. sobol-bluenoise draws from the tile's 4096 scrambles, so 3000
+/// seeds see few repeats.
+#[test]
+fn screen_arranged_samples_are_uniform_over_seeds() {
+    for scheme in [DiskScheme::Pmj02, DiskScheme::BluenoiseCp, DiskScheme::SobolBluenoise] {
+        for pixel in [[0u32, 0], [63, 0], [1000, 777]] {
+            for (n, k) in [(1u32, 0u32), (16, 5), (16, 15)] {
+                let pts: Vec<DVec2> = (0..3000u32)
+                    .map(|seed| scheme.point(n, k, Site::pixel(seed.wrapping_mul(0x9e37_79b9) ^ 0x5eed, 1, pixel, 7)))
+                    .collect();
+                let (x2, dof) = chi_square(&pts, 4, 8);
+                assert!(
+                    x2 < chi_square_bound(dof),
+                    "{scheme} pixel {pixel:?} k={k} of {n}: chi2 = {x2:.1} on {dof} dof"
+                );
+            }
+        }
+    }
+}
+
 /// Independent and Owen-scrambled samples are each uniform on their own (stratified ones are
 /// uniform only pooled over their strata): sample k alone, over many pixels.
 #[test]

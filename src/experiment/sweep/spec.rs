@@ -245,6 +245,12 @@ impl Spec {
                     format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}"),
                 ));
             }
+            if let Some(s) = a.schemes.iter().find(|s| n > s.max_samples()) {
+                return Err(err(
+                    &key_path!["sweep", "samples", i],
+                    format!("{s} gives at most {} samples per pixel, got {n}", s.max_samples()),
+                ));
+            }
         }
         // A disk light far larger than its height over the measured plane is no light over
         // this scene (and would only exhaust the exact answer's quadrature).
@@ -303,6 +309,16 @@ impl Spec {
                         format!("must be in 1..={MAX_SAMPLES}, got {v}"),
                     ));
                 }
+            }
+            if let Some(s) = a.schemes.iter().find(|s| fig.samples > s.max_samples()) {
+                return Err(err(
+                    &key_path!["figures", "samples"],
+                    format!(
+                        "{s} gives at most {} samples per pixel, got {}",
+                        s.max_samples(),
+                        fig.samples
+                    ),
+                ));
             }
         }
         Ok(Spec {

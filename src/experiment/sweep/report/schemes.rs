@@ -93,7 +93,9 @@ fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)]) -> String {
         .filter(|(_, x)| !clearly_below(b, *x))
         .map(|(name, _)| name.to_string())
         .collect();
-    let call = if !b.ci95.is_finite() {
+    let call = if r.len() < 2 {
+        "the only scheme measured by it here, so none is called best".to_string()
+    } else if !b.ci95.is_finite() {
         "no interval (fewer than two seeds), so no scheme is called best".to_string()
     } else if tied.is_empty() {
         "below every other scheme, 95 % intervals disjoint".to_string()
@@ -289,6 +291,11 @@ mod tests {
         assert!(sentence(m, &single).contains("no scheme is called best"));
         assert!(!sentence(m, &single).contains("ranks"), "no paper, no rank");
         assert!(sentence(m, &[]).contains("not measured here"));
+        let alone = sentence(m, &[(DiskScheme::Uniform, mci(0.09, 0.01))]);
+        assert!(
+            alone.contains("the only scheme measured") && !alone.contains("below every"),
+            "{alone}"
+        );
     }
 
     #[test]

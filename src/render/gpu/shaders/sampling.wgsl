@@ -124,12 +124,22 @@ fn tile_seed(seed: u32, light: u32) -> u32 {
     return seed ^ (light * 0x9e3779b9u);
 }
 
-// A pixel's place in the blue-noise tile, shifted by its tile seed (bluenoise::tile_index).
-fn tile_index(pixel: vec2<u32>, tile_seed: u32) -> u32 {
+// A pixel's place in a tile of `side` pixels, shifted by its tile seed (bluenoise::tile_index_in).
+fn tile_index_in(pixel: vec2<u32>, tile_seed: u32, side: u32) -> u32 {
     let shift = pcg(tile_seed ^ 0x7ab1e5edu);
-    let sx = shift % BLUE_TILE;
-    let sy = (shift >> 16u) % BLUE_TILE;
-    return ((pixel.y + sy) % BLUE_TILE) * BLUE_TILE + (pixel.x + sx) % BLUE_TILE;
+    let sx = shift % side;
+    let sy = (shift >> 16u) % side;
+    return ((pixel.y % side + sy) % side) * side + (pixel.x % side + sx) % side;
+}
+
+// A pixel's place in the blue-noise tile (bluenoise::tile_index).
+fn tile_index(pixel: vec2<u32>, tile_seed: u32) -> u32 {
+    return tile_index_in(pixel, tile_seed, BLUE_TILE);
+}
+
+// The tile seed's shared Cranley-Patterson shift, 24-bit (bluenoise::cp_shift).
+fn cp_shift(tile_seed: u32) -> vec2<u32> {
+    return vec2<u32>(pcg(tile_seed ^ 0x0c9a5e01u) >> 8u, pcg(tile_seed ^ 0x5b1d93c7u) >> 8u);
 }
 
 // A pixel's Cranley-Patterson offset: the two masks' values plus the tile seed's shared shift,
@@ -137,21 +147,21 @@ fn tile_index(pixel: vec2<u32>, tile_seed: u32) -> u32 {
 fn bluenoise_offset(pixel: vec2<u32>, tile_seed: u32) -> vec2<u32> {
     let i = tile_index(pixel, tile_seed);
     let m = scheme_tables[1];
-    let shift = vec2<u32>(pcg(tile_seed ^ 0x0c9a5e01u) >> 8u, pcg(tile_seed ^ 0x0c9a5e02u) >> 8u);
     let mask = vec2<u32>(scheme_tables[m + i], scheme_tables[m + BLUE_TILE * BLUE_TILE + i]);
-    return (mask + shift) & vec2<u32>(0x00ffffffu);
+    return (mask + cp_shift(tile_seed)) & vec2<u32>(0x00ffffffu);
 }
 
-// A pixel's Sobol' scramble for n samples from the table of n (bluenoise::scramble).
-fn bluenoise_scramble(pixel: vec2<u32>, n: u32, tile_seed: u32) -> u32 {
-    // The table fitted for the power of two at or above n (bluenoise::table_rays).
+// Where the scramble table serving n rays starts in scheme_tables, or 0 (the header's place,
+// never a table's) when the frame carries none: the table fitted for the power of two at or
+// above n (bluenoise::table_rays).
+fn bluenoise_table(n: u32) -> u32 {
     var rays = 1u;
     while (rays < n) {
         rays = rays * 2u;
     }
     for (var d = 0u; d < min(scheme_tables[2], TABLE_COUNTS); d = d + 1u) {
         if (scheme_tables[3u + 2u * d] == rays) {
-            return scheme_tables[scheme_tables[4u + 2u * d] + tile_index(pixel, tile_seed)];
+            return scheme_tables[4u + 2u * d];
         }
     }
     return 0u;
@@ -208,7 +218,13 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_s
             return concentric(u, v);
         }
         case SCHEME_SOBOL_BLUENOISE: {
-            let s = scrambled_sobol_2d(k, bluenoise_scramble(pixel, n, tile_seed));
+            let table = bluenoise_table(n);
+            if (table == 0u) {
+                // No table packed for n (sampling::tables::pack packs every count a frame uses):
+                // NaN, which no test or metric mistakes for a point.
+                return vec2<f32>(bitcast<f32>(0x7fc00000u));
+            }
+            let s = scrambled_sobol_2d(k, scheme_tables[table + tile_index(pixel, tile_seed)]);
             return concentric(to_unit(s.x), to_unit(s.y));
         }
         default: {
