@@ -10,9 +10,13 @@
 //! function in [`DiskScheme::point`], and the same function in
 //! `render/gpu/shaders/sampling.wgsl` under the matching `SCHEME_*` id. The property tests in
 //! `tests/it/sampling_properties.rs` and the CPU/GPU agreement test then cover it.
+//!
+//! A user's own point set needs no code: a `points:NAME` scheme reads it from a file
+//! ([`points`]), and both backends sample it from the tables buffer.
 
 pub mod bluenoise;
 pub mod pmj02;
+pub mod points;
 pub mod rng;
 pub mod sobol;
 pub mod tables;
@@ -56,6 +60,8 @@ pub enum DiskScheme {
     /// pixels' errors differ (after Heitz et al. 2019), through the concentric map
     /// ([`bluenoise`]).
     SobolBluenoise,
+    /// A user's own pattern, `points:NAME`, read from a points file ([`points`]).
+    Points(points::PointsId),
 }
 
 /// Where one pixel's samples come from: its random stream, and, for the schemes arranged over
@@ -117,12 +123,19 @@ impl DiskScheme {
             DiskScheme::Pmj02 => "pmj02",
             DiskScheme::BluenoiseCp => "bluenoise-cp",
             DiskScheme::SobolBluenoise => "sobol-bluenoise",
+            DiskScheme::Points(id) => id.label(),
         }
     }
 
     /// Where the scheme comes from, for reports and the documentation of every output.
-    pub fn source(self) -> &'static str {
-        match self {
+    pub fn source(self) -> String {
+        let built_in = match self {
+            DiskScheme::Points(id) => {
+                return match id.set() {
+                    Some(set) => set.describe(),
+                    None => "a points file (not loaded)".into(),
+                }
+            }
             DiskScheme::Uniform => "eq. (1) of the soft-shadow paper: independent, area-uniform",
             DiskScheme::Paper => "eq. (2) + (3) of the soft-shadow paper as intended",
             DiskScheme::PaperLiteral => "eq. (3) of the soft-shadow paper as printed",
@@ -136,34 +149,49 @@ impl DiskScheme {
             DiskScheme::SobolBluenoise => {
                 "Owen-scrambled Sobol' with blue-noise arranged scrambles (after Heitz et al. 2019)"
             }
-        }
+        };
+        built_in.into()
     }
 
     /// Whether the scheme reads per-pixel tables (which the GPU gets as a buffer).
     pub fn uses_tables(self) -> bool {
         matches!(
             self,
-            DiskScheme::Pmj02 | DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise
+            DiskScheme::Pmj02 | DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise | DiskScheme::Points(_)
         )
+    }
+
+    /// Whether the scheme is one of [`DiskScheme::ALL`] (not a points file).
+    pub fn is_built_in(self) -> bool {
+        !matches!(self, DiskScheme::Points(_))
     }
 
     /// The most samples per pixel the scheme can give (its table's size; otherwise unbounded).
     pub fn max_samples(self) -> u32 {
         match self {
             DiskScheme::Pmj02 => pmj02::MAX_POINTS as u32,
+            DiskScheme::Points(id) => id.set().map_or(0, |s| s.count),
             _ => u32::MAX,
         }
     }
 
-    /// Numeric id shared with the WGSL `SCHEME_*` constants.
+    /// Numeric id shared with the WGSL `SCHEME_*` constants: a built-in's place in
+    /// [`DiskScheme::ALL`]; every points scheme shares [`POINTS_GPU_ID`] (a frame's tables
+    /// carry its one set).
     pub fn gpu_id(self) -> u32 {
-        self as u32
+        DiskScheme::ALL
+            .iter()
+            .position(|&s| s == self)
+            .map_or(POINTS_GPU_ID, |i| i as u32)
     }
 
     /// Whether each sample is area-uniform on the disk, making the equal-weight estimator of
     /// visibility unbiased. The paper's schemes are not: they weight the rim more (known-facts.md).
     pub fn is_area_uniform(self) -> bool {
-        !matches!(self, DiskScheme::Paper | DiskScheme::PaperLiteral)
+        !matches!(
+            self,
+            DiskScheme::Paper | DiskScheme::PaperLiteral | DiskScheme::Points(_)
+        )
     }
 
     /// Sample `k` of `n` on the unit disk for the pixel at `site`.
@@ -222,6 +250,7 @@ impl DiskScheme {
                 let (sx, sy) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
                 concentric(rng::to_unit(sx), rng::to_unit(sy))
             }
+            DiskScheme::Points(id) => id.loaded().point(k, site.pixel, site.tile_seed),
         }
     }
 
@@ -230,6 +259,9 @@ impl DiskScheme {
         (0..n).map(|k| self.point(n, k, site)).collect()
     }
 }
+
+/// The WGSL id every `points:` scheme samples under (`SCHEME_POINTS`), past the built-ins'.
+pub const POINTS_GPU_ID: u32 = DiskScheme::ALL.len() as u32;
 
 /// The golden angle pi (3 - sqrt 5) as a 32-bit fraction of a turn, round(2^32 (3 - sqrt 5) / 2):
 /// successive spiral points never line up radially (Vogel 1979).
@@ -316,9 +348,17 @@ macro_rules! named_enum {
         impl FromStr for $ty {
             type Err = String;
             fn from_str(s: &str) -> Result<Self, String> {
+                if let Some(user) = <$ty>::user_named(s) {
+                    return user;
+                }
                 <$ty>::ALL.iter().copied().find(|x| x.name() == s).ok_or_else(|| {
                     let names: Vec<_> = <$ty>::ALL.iter().map(|x| x.name()).collect();
-                    format!("unknown {} `{s}`; expected one of {}", $what, names.join(", "))
+                    format!(
+                        "unknown {} `{s}`; expected one of {}{}",
+                        $what,
+                        names.join(", "),
+                        <$ty>::USER_NAMES
+                    )
                 })
             }
         }
@@ -335,6 +375,31 @@ macro_rules! named_enum {
         }
     };
 }
+impl DiskScheme {
+    /// What a user may name besides the built-ins, for error messages.
+    const USER_NAMES: &'static str = ", or points:NAME";
+
+    /// `points:NAME`, a user's scheme, by name (the experiment naming it loads its set).
+    fn user_named(s: &str) -> Option<Result<DiskScheme, String>> {
+        let name = s.strip_prefix("points:")?;
+        Some(if points::valid_name(name) {
+            Ok(DiskScheme::Points(points::PointsId::named(name)))
+        } else {
+            Err(format!(
+                "`{s}`: a points scheme's name is 1 to 64 letters, digits, `-` or `_` (its [points.NAME] table names the file)"
+            ))
+        })
+    }
+}
+
+impl Pattern {
+    const USER_NAMES: &'static str = "";
+
+    fn user_named(_: &str) -> Option<Result<Pattern, String>> {
+        None
+    }
+}
+
 named_enum!(DiskScheme, "sampling scheme");
 named_enum!(Pattern, "pattern");
 

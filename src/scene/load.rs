@@ -304,6 +304,12 @@ fn ambient(a: &AmbientDesc, v: &Validator) -> Result<AmbientOcclusion, ConfigErr
                 ),
             )
         })?;
+        if !scheme.is_built_in() {
+            return Err(v.source.error(
+                &at("directions"),
+                format!("`{scheme}`: points files are swept by sweep experiments; ambient occlusion takes a built-in scheme"),
+            ));
+        }
         if a.rays > scheme.max_samples() {
             return Err(v.source.error(
                 &at("rays"),

@@ -195,12 +195,22 @@ fn scheme_ids_come_from_one_list_and_unknown_ids_give_nan() {
         );
         assert!(prelude.contains(&line), "{line} missing from\n{prelude}");
     }
+    // The built-ins and the one id every points file shares.
+    let points = format!("const SCHEME_POINTS: u32 = {}u;", penumbra::sampling::POINTS_GPU_ID);
+    assert!(prelude.contains(&points), "{points} missing from\n{prelude}");
     let ids = prelude.lines().filter(|l| l.starts_with("const SCHEME_")).count();
-    assert_eq!(ids, DiskScheme::ALL.len(), "{prelude}");
+    assert_eq!(ids, DiskScheme::ALL.len() + 1, "{prelude}");
     #[cfg(feature = "test-hooks")]
     {
         let Some(mut gpu) = common::gpu() else { return };
-        let unknown = DiskScheme::ALL.len() as u32;
+        let unloaded = gpu
+            .disk_points_of_id(penumbra::sampling::POINTS_GPU_ID, 8, 1, 0)
+            .unwrap();
+        assert!(
+            unloaded.iter().all(|p| p[0].is_nan() && p[1].is_nan()),
+            "no set packed: {unloaded:?}"
+        );
+        let unknown = penumbra::sampling::POINTS_GPU_ID + 1;
         let pts = gpu.disk_points_of_id(unknown, 8, 1, 0).unwrap();
         assert!(pts.iter().all(|p| p[0].is_nan() && p[1].is_nan()), "{pts:?}");
     }

@@ -66,7 +66,12 @@ fn summaries_match_the_runs_recomputed_by_hand() {
 #[test]
 fn the_verdict_needs_two_seeds_and_never_prints_nan() {
     let (_, one) = sweep("seeds = [1]");
-    let v = Verdict::new(&one, &at(&one, DiskScheme::Paper)).unwrap();
+    let v = Verdict::new(
+        &one,
+        &at(&one, DiskScheme::Paper),
+        (DiskScheme::Paper, DiskScheme::Uniform),
+    )
+    .unwrap();
     let text = v.markdown();
     assert!(text.contains("No verdict"), "{text}");
     assert!(
@@ -77,7 +82,12 @@ fn the_verdict_needs_two_seeds_and_never_prints_nan() {
     assert!(!v.wider() && !v.extent.a_below());
 
     let (_, three) = sweep("seeds = [1, 2, 3]");
-    let v = Verdict::new(&three, &at(&three, DiskScheme::Paper)).unwrap();
+    let v = Verdict::new(
+        &three,
+        &at(&three, DiskScheme::Paper),
+        (DiskScheme::Paper, DiskScheme::Uniform),
+    )
+    .unwrap();
     let text = v.markdown();
     assert!(!text.contains("No verdict") && !text.contains("NaN"), "{text}");
     // Squared biases read as values with their intervals, never bare (or negative) numbers.

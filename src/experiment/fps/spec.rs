@@ -83,6 +83,26 @@ impl FpsSpec {
     pub fn from_source(source: &Source, header: Header) -> Result<FpsSpec, ConfigError> {
         let path = source.path.as_path();
         let f: File = source.parse()?;
+        if !f.scheme.is_built_in() {
+            return Err(source.error(
+                &key_path!["scheme"],
+                format!(
+                    "`{}`: points files are swept by sweep experiments; fps takes a built-in scheme",
+                    f.scheme
+                ),
+            ));
+        }
+        if f.samples > f.scheme.max_samples() {
+            return Err(source.error(
+                &key_path!["samples"],
+                format!(
+                    "{} gives at most {} samples per pixel, got {}",
+                    f.scheme,
+                    f.scheme.max_samples(),
+                    f.samples
+                ),
+            ));
+        }
         if !(1..=MAX_SAMPLES).contains(&f.samples) {
             return Err(source.error(
                 &key_path!["samples"],

@@ -28,7 +28,15 @@ pub trait AxisValue: Clone + PartialEq + Debug + Display + FromStr + for<'de> De
     }
 }
 
-impl AxisValue for DiskScheme {}
+impl AxisValue for DiskScheme {
+    /// A points scheme's key carries its file's hash: an edited file never reuses a run.
+    fn key_text(&self) -> String {
+        match self {
+            DiskScheme::Points(id) => format!("{}@{}", id.label(), id.set().map_or("unloaded", |s| s.hash.as_str())),
+            s => s.to_string(),
+        }
+    }
+}
 impl AxisValue for Pattern {}
 impl AxisValue for u32 {}
 impl AxisValue for String {}

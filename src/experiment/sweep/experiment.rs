@@ -39,6 +39,7 @@ impl Experiment for Spec {
     fn inputs(&self) -> Vec<PathBuf> {
         let mut v = vec![self.path.clone(), self.scene_path.clone()];
         v.extend(self.scene.meshes().map(|m| PathBuf::from(&m.source)));
+        v.extend(self.points_files());
         v
     }
 

@@ -8,6 +8,8 @@ use crate::experiment::header::Header;
 use crate::experiment::timing::Schedule;
 use crate::key_path;
 use crate::render::BackendChoice;
+use crate::sampling::points::{Domain, Layout, PointSet, PointsId, Settings, MAX_TILE};
+use crate::sampling::DiskScheme;
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
 use serde::Deserialize;
@@ -23,7 +25,40 @@ crate::experiment_file! {
         sweep: Axes,
         ground_truth: GroundTruth,
         figures: Option<Figures>,
+        #[serde(default)]
+        points: BTreeMap<String, PointsTable>,
+        verdict: Option<VerdictPair>,
     }
+}
+
+/// A `[points.NAME]` table: the file (relative to the experiment) a `points:NAME` scheme reads
+/// and how ([`crate::sampling::points`]).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PointsTable {
+    /// The points file.
+    pub path: PathBuf,
+    /// `square` (default; mapped to the disk by the concentric map) or `disk`.
+    #[serde(default)]
+    pub domain: Option<String>,
+    /// `shared` (default), `tile` or `mask`.
+    #[serde(default)]
+    pub layout: Option<String>,
+    /// The tile's side in pixels (`tile` and `mask` layouts).
+    pub tile: Option<u32>,
+    /// The mask file (`mask` layout), relative to the experiment.
+    pub mask: Option<PathBuf>,
+}
+
+/// `[verdict]`: the two schemes the verdict compares (default: the paper's pattern against
+/// uniform sampling, the 2012 paper's claim).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct VerdictPair {
+    /// The scheme whose claim is judged.
+    pub subject: DiskScheme,
+    /// What it is judged against.
+    pub baseline: DiskScheme,
 }
 
 /// The measuring view: an orthographic camera over the receiver plane.
@@ -103,6 +138,8 @@ pub struct Spec {
     pub timing: Schedule,
     /// Optional pictures.
     pub figures: Option<Figures>,
+    /// The verdict's (subject, baseline).
+    pub verdict: (DiskScheme, DiskScheme),
 }
 
 impl Spec {
@@ -245,7 +282,7 @@ impl Spec {
                     format!("shadow-ray count must be in 1..={MAX_SAMPLES}, got {n}"),
                 ));
             }
-            if let Some(s) = a.schemes.iter().find(|s| n > s.max_samples()) {
+            if let Some(s) = a.schemes.iter().find(|s| s.is_built_in() && n > s.max_samples()) {
                 return Err(err(
                     &key_path!["sweep", "samples", i],
                     format!("{s} gives at most {} samples per pixel, got {n}", s.max_samples()),
@@ -310,7 +347,11 @@ impl Spec {
                     ));
                 }
             }
-            if let Some(s) = a.schemes.iter().find(|s| fig.samples > s.max_samples()) {
+            if let Some(s) = a
+                .schemes
+                .iter()
+                .find(|s| s.is_built_in() && fig.samples > s.max_samples())
+            {
                 return Err(err(
                     &key_path!["figures", "samples"],
                     format!(
@@ -321,7 +362,36 @@ impl Spec {
                 ));
             }
         }
+        let needed = a
+            .samples
+            .iter()
+            .chain(f.figures.as_ref().map(|f| &f.samples))
+            .copied()
+            .max()
+            .unwrap_or(1);
+        load_points(source, &mut axes.schemes, &f.points, needed)?;
+        let verdict = match &f.verdict {
+            None => (DiskScheme::Paper, DiskScheme::Uniform),
+            Some(v) => {
+                for (key, scheme) in [("subject", v.subject), ("baseline", v.baseline)] {
+                    if !axes.schemes.contains(&scheme) {
+                        return Err(err(
+                            &key_path!["verdict", key],
+                            format!("`{scheme}` is not in sweep.schemes"),
+                        ));
+                    }
+                }
+                if v.subject == v.baseline {
+                    return Err(err(
+                        &key_path!["verdict", "baseline"],
+                        "the verdict compares two different schemes".into(),
+                    ));
+                }
+                (v.subject, v.baseline)
+            }
+        };
         Ok(Spec {
+            verdict,
             name: header.name.clone(),
             path: path.to_path_buf(),
             scene_path,
@@ -336,6 +406,19 @@ impl Spec {
             ground_truth: f.ground_truth,
             figures: f.figures,
         })
+    }
+
+    /// Every points file the sweep reads, for the manifest.
+    pub fn points_files(&self) -> Vec<PathBuf> {
+        self.axes
+            .schemes
+            .iter()
+            .filter_map(|s| match s {
+                DiskScheme::Points(id) => id.set().map(|set| set.files.clone()),
+                _ => None,
+            })
+            .flatten()
+            .collect()
     }
 
     /// The scene with its first `lights` lights on, every disk light among them set to `radius`
@@ -365,4 +448,81 @@ fn read_as_sweep(mut e: ConfigError, header: &Header) -> ConfigError {
             " (a file without `kind` is read as kind = \"sweep\"; a frame-rate experiment says kind = \"fps\")";
     }
     e
+}
+
+/// Loads the set of every `points:NAME` in `schemes` from its `[points.NAME]` table (paths
+/// relative to the experiment), checking it holds `needed` samples per pixel; a table no scheme
+/// names is an error too (a misspelt name would otherwise be silently unused).
+fn load_points(
+    source: &Source,
+    schemes: &mut [DiskScheme],
+    tables: &BTreeMap<String, PointsTable>,
+    needed: u32,
+) -> Result<(), ConfigError> {
+    let dir = source.path.parent().unwrap_or(Path::new("."));
+    for name in tables.keys() {
+        let listed = schemes.iter().any(|s| s.to_string() == format!("points:{name}"));
+        if !listed {
+            return Err(source.error(
+                &key_path!["points", name.as_str()],
+                format!("no `points:{name}` in sweep.schemes uses this table"),
+            ));
+        }
+    }
+    for (i, scheme) in schemes.iter_mut().enumerate() {
+        let DiskScheme::Points(_) = scheme else { continue };
+        let label = scheme.to_string();
+        let name = &label["points:".len()..];
+        let Some(t) = tables.get(name) else {
+            return Err(source.error(
+                &key_path!["sweep", "schemes", i],
+                format!("`{label}` needs a [points.{name}] table with the file's `path`"),
+            ));
+        };
+        let at = |key: &str| key_path!["points", name, key];
+        let domain = match t.domain.as_deref() {
+            None | Some("square") => Domain::Square,
+            Some("disk") => Domain::Disk,
+            Some(other) => {
+                return Err(source.error(&at("domain"), format!("`{other}`: expected \"square\" or \"disk\"")))
+            }
+        };
+        let side = |what: &str| match t.tile {
+            Some(side) if (1..=MAX_TILE).contains(&side) => Ok(side),
+            Some(side) => Err(source.error(&at("tile"), format!("tile side must be in 1..={MAX_TILE}, got {side}"))),
+            None => Err(source.error(
+                &at("layout"),
+                format!("the {what} layout needs `tile`, the tile's side in pixels"),
+            )),
+        };
+        let layout = match t.layout.as_deref() {
+            None | Some("shared") => Layout::Shared,
+            Some("tile") => Layout::Tile(side("tile")?),
+            Some("mask") => Layout::Mask(side("mask")?),
+            Some(other) => {
+                return Err(source.error(
+                    &at("layout"),
+                    format!("`{other}`: expected \"shared\", \"tile\" or \"mask\""),
+                ))
+            }
+        };
+        if matches!(layout, Layout::Mask(_)) != t.mask.is_some() {
+            return Err(source.error(
+                &at("mask"),
+                "a mask file goes with layout = \"mask\", and only with it".to_string(),
+            ));
+        }
+        if matches!(layout, Layout::Shared) && t.tile.is_some() {
+            return Err(source.error(&at("tile"), "a shared set has no tile".to_string()));
+        }
+        let settings = Settings {
+            path: dir.join(&t.path),
+            domain,
+            layout,
+            mask: t.mask.as_ref().map(|m| dir.join(m)),
+        };
+        let set = PointSet::load(name, &settings, needed)?;
+        *scheme = DiskScheme::Points(PointsId::install(set).map_err(|e| source.error(&at("path"), e))?);
+    }
+    Ok(())
 }

@@ -80,12 +80,24 @@ impl GpuBackend {
     /// 0) with `seed`, computed by the WGSL sampler: lets tests compare it with the Rust one
     /// ([`DiskScheme::point`] at [`crate::sampling::Site::pixel`]).
     pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
-        self.disk_points_of_id(scheme.gpu_id(), n, seed, pixel)
+        self.sample_disk(scheme.gpu_id(), Some(scheme), n, seed, pixel)
     }
 
     /// [`GpuBackend::disk_points`] for a raw scheme id, known or not (an unknown id must give
     /// NaN points, never another scheme's).
     pub fn disk_points_of_id(&mut self, id: u32, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
+        self.sample_disk(id, DiskScheme::ALL.get(id as usize).copied(), n, seed, pixel)
+    }
+
+    /// Runs the sampler hook for scheme id `id`, with the tables of `scheme` where known.
+    fn sample_disk(
+        &mut self,
+        id: u32,
+        scheme: Option<DiskScheme>,
+        n: u32,
+        seed: u32,
+        pixel: u32,
+    ) -> anyhow::Result<Vec<[f32; 2]>> {
         let scene = crate::scene::Scene::analytic(vec![], vec![], vec![]);
         let cam = dummy_camera();
         let view = View {
@@ -101,7 +113,7 @@ impl GpuBackend {
         let mut packed = pack(&scene, view, sampling)?;
         packed.params.scheme = id;
         packed.params.height = pixel;
-        if let Some(&scheme) = DiskScheme::ALL.get(id as usize) {
+        if let Some(scheme) = scheme {
             packed.tables = crate::sampling::tables::pack(&[(scheme, n)]);
         }
         let r = self.resources(&packed, View { height: 2, ..view }, 0)?;

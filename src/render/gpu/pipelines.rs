@@ -30,7 +30,8 @@ pub fn scheme_prelude() -> String {
             format!("const SCHEME_{name}: u32 = {}u;\n", s.gpu_id())
         })
         .collect();
-    ids + &crate::sampling::tables::wgsl_prelude()
+    let points = format!("const SCHEME_POINTS: u32 = {}u;\n", crate::sampling::POINTS_GPU_ID);
+    ids + &points + &crate::sampling::tables::wgsl_prelude()
 }
 
 /// The bind group layouts every pipeline shares: per frame (group 0), per dispatch (group 1),

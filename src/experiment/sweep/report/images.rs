@@ -2,12 +2,11 @@
 //! ground truth and the exact image, with error maps) with EXR files of each, and the Fig. 2
 //! picture.
 
-use super::pictures::write_fig2_picture;
+use super::pictures::{shown, write_fig2_picture};
 use super::results::Results;
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::output::images::{diverging, grey, write_exr, Rgb};
 use crate::output::plots::image_grid;
-use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
 /// Writes the images into `dir`.
@@ -27,12 +26,7 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
         write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
         let mut tiles: Vec<(String, Rgb)> = Vec::new();
         let mut errors: Vec<(String, Rgb)> = Vec::new();
-        for (scheme, pattern) in [
-            (DiskScheme::Uniform, Pattern::PerPixel),
-            (DiskScheme::Paper, Pattern::PerPixel),
-            (DiskScheme::Paper, Pattern::Shared),
-            (DiskScheme::Sobol, Pattern::PerPixel),
-        ] {
+        for (scheme, pattern) in shown(spec) {
             // The first swept structure's image (every structure's answers are exact, so the
             // images differ only where a structure is wrong, which the tests catch).
             let kept = r.outcome.keep.iter().find(|(c, _)| {
@@ -43,7 +37,12 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
                     && c.accelerator == spec.axes.accelerators[0]
             });
             if let Some((_, img)) = kept {
-                write_exr(&dir.join(format!("{scheme}_{pattern}_{n}.exr")), img, w, h)?;
+                write_exr(
+                    &dir.join(format!("{}_{pattern}_{n}.exr", scheme.to_string().replace(':', "-"))),
+                    img,
+                    w,
+                    h,
+                )?;
                 tiles.push((format!("{scheme} ({pattern}), {n} rays"), grey(img, w, h)));
                 errors.push((
                     format!("{scheme} ({pattern}) - ground truth"),
@@ -65,7 +64,7 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
         image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
     }
     if let Some(p) = r.pictures {
-        write_fig2_picture(p, spec.axes.seeds[0], &dir.join("fig2_picture.png"))?;
+        write_fig2_picture(spec, p, spec.axes.seeds[0], &dir.join("fig2_picture.png"))?;
     }
     Ok(())
 }

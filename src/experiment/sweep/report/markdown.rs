@@ -1,7 +1,7 @@
 //! report.md: what was run, the scene's acceleration structure, how far the ground truth is
 //! from the exact answer, the verdict, what accuracy costs in time, and where the outputs are.
 
-use super::summary::{find, Summary};
+use super::summary::{find, swept_schemes, Summary};
 use super::verdict::Verdict;
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius, Outcome};
@@ -78,11 +78,22 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
                 .map_or("n/a".into(), |q| q.depth_limited_pixels.to_string()),
         );
     }
-    let verdicts = verdicts(summaries, n, radius);
+    let pair = spec.verdict;
+    let verdicts = verdicts(summaries, n, radius, pair);
     if outcome.references.iter().any(|r| r.on_axis.is_some()) {
-        s += "\n## Verdict\n\nThe claim (Vassilev 2012, Fig. 2): with eq. (2)+(3) the penumbra at 16 rays is wider than with eq. (1), at the same quality.\n\n";
+        if pair == (DiskScheme::Paper, DiskScheme::Uniform) {
+            s += "\n## Verdict\n\nThe claim (Vassilev 2012, Fig. 2): with eq. (2)+(3) the penumbra at 16 rays is wider than with eq. (1), at the same quality.\n\n";
+        } else {
+            s += &format!(
+                "\n## Verdict\n\nThe experiment's comparison (`[verdict]`): `{}` against `{}` at {n} rays, asked as the 2012 paper asked of its pattern: a wider penumbra, and at what quality?\n\n",
+                pair.0, pair.1
+            );
+        }
         if verdicts.is_empty() {
-            s += "The sweep does not hold both `uniform` and `paper` at this sample count and radius, so no verdict.\n\n";
+            s += &format!(
+                "The sweep does not hold both `{}` and `{}` at this sample count and radius, so no verdict.\n\n",
+                pair.1, pair.0
+            );
         }
         for (label, v) in &verdicts {
             if !label.is_empty() {
@@ -96,7 +107,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
         s += &timing_section(outcome);
     }
     for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
-        s += &super::schemes::scheme_section(summaries, &slice, n, radius);
+        s += &super::schemes::scheme_section(summaries, &slice, n, radius, spec.verdict.0);
         s += &cost_section(summaries, &slice, n, radius);
     }
     s += &super::structures::structure_section(spec, outcome, summaries);
@@ -184,7 +195,7 @@ const VERDICT_NAMES: [Axis; 5] = [
 
 /// The verdict of each pattern at `n` rays and light radius `radius`, in each slice of the axes
 /// it does not name, with the slice's label (empty when there is one slice).
-fn verdicts(summaries: &[Summary], n: u32, radius: f64) -> Vec<(String, Verdict)> {
+fn verdicts(summaries: &[Summary], n: u32, radius: f64, pair: (DiskScheme, DiskScheme)) -> Vec<(String, Verdict)> {
     let mut out = Vec::new();
     for slice in slices(summaries.iter().map(|x| &x.config), &VERDICT_NAMES) {
         for pattern in [Pattern::PerPixel, Pattern::Shared] {
@@ -195,7 +206,7 @@ fn verdicts(summaries: &[Summary], n: u32, radius: f64) -> Vec<(String, Verdict)
                 lights: 1,
                 ..slice.config.clone()
             };
-            out.extend(Verdict::new(summaries, &at).map(|v| (slice.label(&[]), v)));
+            out.extend(Verdict::new(summaries, &at, pair).map(|v| (slice.label(&[]), v)));
         }
     }
     out
@@ -230,7 +241,7 @@ fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> St
             ..base.clone()
         },
     );
-    for scheme in DiskScheme::ALL {
+    for scheme in swept_schemes(summaries) {
         let Some(at) = find(summaries, &Config { scheme, ..base.clone() }) else {
             continue;
         };

@@ -4,6 +4,7 @@
 
 use super::summary::PictureFlip;
 use crate::experiment::sweep::pictures::{Picture, Pictures};
+use crate::experiment::sweep::Spec;
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::output::images::{exposure, tonemap_with, Rgb};
 use crate::output::plots::image_grid;
@@ -39,17 +40,34 @@ pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
     Ok(out)
 }
 
-/// fig2_picture.png: uniform (per-pixel), the paper's pattern (shared and per-pixel) at the first
-/// seed, and the ground truth, all at the ground truth's exposure.
-pub fn write_fig2_picture(pictures: &Pictures, seed: u32, path: &Path) -> anyhow::Result<()> {
+/// The (scheme, pattern) pairs the Fig. 2 images show, in order: the verdict's subject
+/// (per-pixel, then shared), its baseline, then every other swept scheme per-pixel; only what
+/// was swept.
+pub fn shown(spec: &Spec) -> Vec<(DiskScheme, Pattern)> {
+    let (subject, baseline) = spec.verdict;
+    let mut out = vec![
+        (subject, Pattern::PerPixel),
+        (subject, Pattern::Shared),
+        (baseline, Pattern::PerPixel),
+    ];
+    out.extend(
+        spec.axes
+            .schemes
+            .iter()
+            .filter(|&&s| s != subject && s != baseline)
+            .map(|&s| (s, Pattern::PerPixel)),
+    );
+    out.retain(|(s, p)| spec.axes.schemes.contains(s) && spec.axes.patterns.contains(p));
+    out
+}
+
+/// fig2_picture.png: the [`shown`] schemes at the first seed, and the ground truth, all at the
+/// ground truth's exposure.
+pub fn write_fig2_picture(spec: &Spec, pictures: &Pictures, seed: u32, path: &Path) -> anyhow::Result<()> {
     let gt = &pictures.ground_truth;
     let p99 = exposure(&gt.frame.radiance);
     let mut tiles: Vec<(String, Rgb)> = Vec::new();
-    for (scheme, pattern) in [
-        (DiskScheme::Uniform, Pattern::PerPixel),
-        (DiskScheme::Paper, Pattern::Shared),
-        (DiskScheme::Paper, Pattern::PerPixel),
-    ] {
+    for (scheme, pattern) in shown(spec) {
         let found = pictures
             .runs
             .iter()

@@ -3,14 +3,14 @@
 //! profile, and extent width against light radius.
 
 use super::results::Results;
-use super::summary::Summary;
+use super::summary::{swept_schemes, Summary};
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::record::{Aggregated, Status};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::metrics::spectrum::BIN;
 use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::plots::{line_plot, Axes, Reference as RefLine, Series};
-use crate::sampling::{DiskScheme, Pattern};
+use crate::sampling::Pattern;
 use std::path::Path;
 
 /// The axes the plots name; each plot is drawn once per value of the others.
@@ -33,7 +33,7 @@ fn series(
     scale: f64,
 ) -> Vec<(usize, Series)> {
     let mut out = Vec::new();
-    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+    for (ci, scheme) in swept_schemes(summaries).iter().enumerate() {
         for pattern in Pattern::ALL {
             let mut pts: Vec<(f64, f64, f64)> = summaries
                 .iter()
@@ -218,7 +218,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         }],
     )?;
     let mut profiles = Vec::new();
-    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+    for (ci, scheme) in swept_schemes(summaries).iter().enumerate() {
         for pattern in Pattern::ALL {
             let config = Config {
                 scheme: *scheme,
@@ -282,7 +282,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
 /// at `n` rays and light radius `radius`, each ring with its 95 % CI.
 fn spectra(r: &Results, slice: &Slice, n: u32, radius: f64) -> Vec<(usize, Series)> {
     let mut out = Vec::new();
-    for (ci, scheme) in DiskScheme::ALL.iter().enumerate() {
+    for (ci, scheme) in r.spec.axes.schemes.iter().enumerate() {
         let config = Config {
             scheme: *scheme,
             pattern: Pattern::PerPixel,

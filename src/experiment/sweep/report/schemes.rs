@@ -8,7 +8,7 @@
 //! intervals overlap its are named with it.
 
 use super::markdown::ms_ci;
-use super::summary::{find, Summary};
+use super::summary::{find, swept_schemes, Summary};
 use crate::experiment::sweep::axes::{Axis, Config, Slice};
 use crate::experiment::sweep::timing::compare;
 use crate::experiment::timing::Comparison;
@@ -78,13 +78,16 @@ fn ordinal(k: usize) -> String {
 }
 
 /// One sentence per metric ([`sentence`]).
-fn rank_sentences(rows: &[(DiskScheme, &Summary)]) -> String {
-    METRICS.iter().map(|m| sentence(m, &ranked(rows, m.value))).collect()
+fn rank_sentences(rows: &[(DiskScheme, &Summary)], subject: DiskScheme) -> String {
+    METRICS
+        .iter()
+        .map(|m| sentence(m, &ranked(rows, m.value), subject))
+        .collect()
 }
 
 /// The best scheme by `m` in `r` (ranked, lowest first) with its interval, the schemes tied
-/// with it, and the paper's rank.
-fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)]) -> String {
+/// with it, and the rank of `subject` (the verdict's: the paper's pattern by default).
+fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)], subject: DiskScheme) -> String {
     let Some(&(best, b)) = r.first() else {
         return format!("- *Least {}:* not measured here.\n", m.label);
     };
@@ -102,12 +105,16 @@ fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)]) -> String {
     } else {
         format!("tied within the intervals with {}", tied.join(", "))
     };
-    let paper = match r.iter().position(|(name, _)| *name == DiskScheme::Paper) {
+    let paper = match r.iter().position(|(name, _)| *name == subject) {
         Some(k) => {
             let p = r[k].1;
             let better = r.iter().filter(|(_, x)| clearly_below(*x, p)).count();
+            let who = match subject {
+                DiskScheme::Paper => "The paper's pattern".to_string(),
+                s => format!("`{s}`"),
+            };
             format!(
-                " The paper's pattern ranks {} of {} ({}, {better} scheme(s) clearly below it).",
+                " {who} ranks {} of {} ({}, {better} scheme(s) clearly below it).",
                 ordinal(k + 1),
                 r.len(),
                 with_ci(p.mean, p.ci95, m.show)
@@ -165,8 +172,8 @@ fn within_time<'a>(
 }
 
 /// The section: at `n` rays, then at uniform@n's frame time.
-pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
-    let at_n: Vec<(DiskScheme, &Summary)> = DiskScheme::ALL
+pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64, subject: DiskScheme) -> String {
+    let at_n: Vec<(DiskScheme, &Summary)> = swept_schemes(summaries)
         .iter()
         .filter_map(|&s| find(summaries, &config(slice, s, n, radius)).map(|x| (s, x)))
         .collect();
@@ -186,7 +193,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64)
     {
         s += &format!("Blue-noise tables: {}.\n\n", crate::sampling::bluenoise::settings());
     }
-    s += &rank_sentences(&at_n);
+    s += &rank_sentences(&at_n, subject);
     let exact = at_n
         .iter()
         .find_map(|(_, x)| (x.exact_width_10_90.is_finite()).then_some((x.exact_width_10_90, x.exact_extent_width)));
@@ -210,7 +217,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64)
     let Some(budget) = find(summaries, &config(slice, DiskScheme::Uniform, n, radius)) else {
         return s;
     };
-    let equal: Vec<(DiskScheme, &Summary)> = DiskScheme::ALL
+    let equal: Vec<(DiskScheme, &Summary)> = swept_schemes(summaries)
         .iter()
         .filter_map(|&sc| within_time(summaries, slice, sc, radius, budget).map(|x| (sc, x)))
         .collect();
@@ -221,7 +228,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64)
         "\n### At equal time\n\nEach scheme at the most swept rays whose frame time is not clearly longer than uniform@{n}'s ({}) by the timing rule; FLIP only where that is {n} rays (the pictures are rendered there).\n\n",
         ms_ci(&budget.frame)
     );
-    s += &rank_sentences(&equal);
+    s += &rank_sentences(&equal, subject);
     s += "\n| scheme | rays | time vs uniform | RMSE | blurred RMSE | low-freq share |\n|---|---|---|---|---|---|\n";
     for (scheme, x) in &equal {
         let ratio = match (&x.timing, &budget.timing) {
@@ -267,7 +274,7 @@ mod tests {
             (DiskScheme::Paper, mci(0.050, 0.002)),
             (DiskScheme::Uniform, mci(0.096, 0.004)),
         ];
-        let s = sentence(m, &clear);
+        let s = sentence(m, &clear, DiskScheme::Paper);
         assert!(
             s.contains("**sobol**, 0.0300 ± 0.0010; below every other scheme"),
             "{s}"
@@ -281,17 +288,25 @@ mod tests {
             (DiskScheme::Pmj02, mci(0.033, 0.005)),
             (DiskScheme::Paper, mci(0.050, 0.002)),
         ];
-        let s = sentence(m, &tie);
+        let s = sentence(m, &tie, DiskScheme::Paper);
         assert!(s.contains("tied within the intervals with pmj02."), "{s}");
         assert!(s.contains("ranks 3rd of 3 (0.0500 ± 0.0020, 2 scheme(s)"), "{s}");
         let single = [
             (DiskScheme::Sobol, mci(0.03, f64::NAN)),
             (DiskScheme::Uniform, mci(0.09, f64::NAN)),
         ];
-        assert!(sentence(m, &single).contains("no scheme is called best"));
-        assert!(!sentence(m, &single).contains("ranks"), "no paper, no rank");
-        assert!(sentence(m, &[]).contains("not measured here"));
-        let alone = sentence(m, &[(DiskScheme::Uniform, mci(0.09, 0.01))]);
+        assert!(sentence(m, &single, DiskScheme::Paper).contains("no scheme is called best"));
+        assert!(
+            !sentence(m, &single, DiskScheme::Paper).contains("ranks"),
+            "no paper, no rank"
+        );
+        assert!(sentence(m, &[], DiskScheme::Paper).contains("not measured here"));
+        let own = sentence(m, &tie, DiskScheme::Pmj02);
+        assert!(
+            own.contains("`pmj02` ranks 2nd of 3") && !own.contains("paper's pattern ranks"),
+            "{own}"
+        );
+        let alone = sentence(m, &[(DiskScheme::Uniform, mci(0.09, 0.01))], DiskScheme::Paper);
         assert!(
             alone.contains("the only scheme measured") && !alone.contains("below every"),
             "{alone}"

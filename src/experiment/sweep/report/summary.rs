@@ -10,6 +10,7 @@ use crate::experiment::sweep::timing::ConfigTiming;
 use crate::experiment::timing::Estimate;
 use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::table::float;
+use crate::sampling::DiskScheme;
 use serde::{Serialize, Serializer};
 
 /// FLIP of each seed's picture, per configuration that has pictures.
@@ -98,6 +99,18 @@ pub fn summarise(outcome: &Outcome, flip: &PictureFlip) -> Vec<Summary> {
             }
         })
         .collect()
+}
+
+/// The schemes the summaries hold, in the experiment's order (built-ins and points files alike:
+/// every table, plot and picture lists what was swept).
+pub fn swept_schemes(summaries: &[Summary]) -> Vec<DiskScheme> {
+    let mut out: Vec<DiskScheme> = Vec::new();
+    for s in summaries {
+        if !out.contains(&s.config.scheme) {
+            out.push(s.config.scheme);
+        }
+    }
+    out
 }
 
 /// The summary of `config`, if swept.

@@ -57,6 +57,8 @@ impl Compare {
 pub struct Verdict {
     /// Shadow rays per pixel compared.
     pub samples: u32,
+    /// The scheme whose claim is judged (the paper's pattern by default) and its baseline.
+    pub pair: (DiskScheme, DiskScheme),
     /// Light radius compared (m).
     pub light_radius: f64,
     /// Pattern compared.
@@ -84,14 +86,15 @@ pub struct Verdict {
 impl Verdict {
     /// Builds the verdict at configuration `at` (whatever its scheme), if both schemes were swept
     /// there.
-    pub fn new(summaries: &[Summary], at: &Config) -> Option<Verdict> {
+    pub fn new(summaries: &[Summary], at: &Config, (subject, baseline): (DiskScheme, DiskScheme)) -> Option<Verdict> {
         let with = |scheme| find(summaries, &Config { scheme, ..at.clone() });
-        let (p, u) = (with(DiskScheme::Paper)?, with(DiskScheme::Uniform)?);
+        let (p, u) = (with(subject)?, with(baseline)?);
         let cmp = |m: fn(&Aggregated) -> MeanCi| Compare {
             a: m(&p.metrics),
             b: m(&u.metrics),
         };
         Some(Verdict {
+            pair: (subject, baseline),
             samples: at.samples,
             light_radius: at.light_radius,
             pattern: at.pattern,
@@ -107,13 +110,16 @@ impl Verdict {
         })
     }
 
-    /// Whether the paper's visible penumbra is wider (CIs exist and are disjoint).
+    /// Whether the subject's visible penumbra is wider (CIs exist and are disjoint).
     pub fn wider(&self) -> bool {
         self.extent.a_above()
     }
 
     /// The verdict as markdown sentences, every claim with its numbers.
     pub fn markdown(&self) -> String {
+        let ((a, a_short, a_s), (b, b_short, b_s)) = (names(self.pair.0), names(self.pair.1));
+        let upper = |x: &str| x[..1].to_uppercase() + &x[1..];
+        let big_a_s = upper(&a_s);
         let mm = |x: f64| format!("{:.2} mm", x * 1e3);
         let pm = |x: MeanCi| with_ci(x.mean, x.ci95, mm);
         let mut s = format!(
@@ -125,21 +131,21 @@ impl Verdict {
         }
         let (e, w) = self.exact;
         s += &format!(
-            "- *Wider?* The visible penumbra (how far partial shadow reaches, read with a sliding one-pixel annulus) is {} with the paper's pattern and {} with uniform sampling; the exact image reads {} (closed form r_p - max(r_u, 0) = {}; the annulus adds 0.9 pixel at an umbra edge). {}\n",
+            "- *Wider?* The visible penumbra (how far partial shadow reaches, read with a sliding one-pixel annulus) is {} with {a} and {} with {b}; the exact image reads {} (closed form r_p - max(r_u, 0) = {}; the annulus adds 0.9 pixel at an umbra edge). {}\n",
             pm(self.extent.a),
             pm(self.extent.b),
             or_na(e, mm),
             or_na(self.closed_form_width, mm),
             if self.wider() {
-                "The paper's penumbra is wider (95 % intervals disjoint)."
+                format!("{big_a_s} penumbra is wider (95 % intervals disjoint).")
             } else if self.extent.a_below() {
-                "The paper's penumbra is narrower (95 % intervals disjoint)."
+                format!("{big_a_s} penumbra is narrower (95 % intervals disjoint).")
             } else if self.seeds < 2 {
-                "Without intervals no difference can be called."
+                "Without intervals no difference can be called.".into()
             } else if !self.extent.comparable() {
-                "No difference can be called: an extent is missing (no penumbra, or beyond the measured patch)."
+                "No difference can be called: an extent is missing (no penumbra, or beyond the measured patch).".into()
             } else {
-                "The difference is within the seed-to-seed noise."
+                "The difference is within the seed-to-seed noise.".into()
             }
         );
         let dev = |x: f64| or_na(x / w - 1.0, |d| format!("{:+.1} %", 100.0 * d));
@@ -149,28 +155,28 @@ impl Verdict {
         let departs =
             wa.ci95.is_finite() && wb.ci95.is_finite() && (wa.mean - w).abs() > (wb.mean - w).abs() + wa.ci95 + wb.ci95;
         s += &format!(
-            "- *Closer to the truth, or bias?* The 10-90 % width of the mean radial profile is {} (paper, {} vs exact) and {} (uniform, {}); exact {}. {}\n",
+            "- *Closer to the truth, or bias?* The 10-90 % width of the mean radial profile is {} ({a_short}, {} vs exact) and {} ({b_short}, {}); exact {}. {}\n",
             pm(wa),
             dev(wa.mean),
             pm(wb),
             dev(wb.mean),
             or_na(w, mm),
             if departs && wa.mean > w {
-                "The paper's extra width is a departure from the exact profile: a bias, not a truer penumbra."
+                format!("{big_a_s} extra width is a departure from the exact profile: a bias, not a truer penumbra.")
             } else if departs {
-                "The paper's profile is narrower than the exact one by more than uniform's departs, beyond noise: a bias."
+                format!("{big_a_s} profile is narrower than the exact one by more than {b_s} departs, beyond noise: a bias.")
             } else if self.seeds < 2 {
-                "Without intervals no difference can be called."
+                "Without intervals no difference can be called.".into()
             } else if !self.width_10_90.comparable() || !w.is_finite() {
-                "No difference can be called: a 10-90 % width is missing (no penumbra, or beyond the measured patch)."
+                "No difference can be called: a 10-90 % width is missing (no penumbra, or beyond the measured patch).".into()
             } else {
-                "Neither profile departs from the exact one by more than the other beyond noise."
+                "Neither profile departs from the exact one by more than the other beyond noise.".into()
             }
         );
         let four = |x: f64| format!("{x:.4}");
         let e2 = |x: f64| format!("{x:.2e}");
         s += &format!(
-            "- *Equal quality?* RMSE against the ground truth over the penumbra: {} (paper) vs {} (uniform), ratio {}; against the exact image {} vs {}. Perceptual error (FLIP, mean over the Fig. 2 picture against the ground-truth picture): {} vs {}{}. Per pixel over seeds, squared bias {} vs {} and variance {} vs {}.\n",
+            "- *Equal quality?* RMSE against the ground truth over the penumbra: {} ({a_short}) vs {} ({b_short}), ratio {}; against the exact image {} vs {}. Perceptual error (FLIP, mean over the Fig. 2 picture against the ground-truth picture): {} vs {}{}. Per pixel over seeds, squared bias {} vs {} and variance {} vs {}.\n",
             with_ci(self.rmse.a.mean, self.rmse.a.ci95, four),
             with_ci(self.rmse.b.mean, self.rmse.b.ci95, four),
             or_na(self.rmse.ratio(), |r| format!("{r:.2}")),
@@ -179,11 +185,11 @@ impl Verdict {
             with_ci(self.flip.a.mean, self.flip.a.ci95, four),
             with_ci(self.flip.b.mean, self.flip.b.ci95, four),
             if self.flip.a_below() {
-                " (the paper's picture is closer, intervals disjoint)"
+                format!(" ({a_s} picture is closer, intervals disjoint)")
             } else if self.flip.a_above() {
-                " (uniform's picture is closer, intervals disjoint)"
+                format!(" ({b_s} picture is closer, intervals disjoint)")
             } else {
-                ""
+                String::new()
             },
             bias2(&self.split.0),
             bias2(&self.split.1),
@@ -191,6 +197,16 @@ impl Verdict {
             or_na(self.split.1.variance, e2),
         );
         s
+    }
+}
+
+/// How the verdict names a scheme: (in a phrase, in parentheses, possessive); the paper's two
+/// by what they are, others by name.
+fn names(scheme: DiskScheme) -> (String, String, String) {
+    match scheme {
+        DiskScheme::Paper => ("the paper's pattern".into(), "paper".into(), "the paper's".into()),
+        DiskScheme::Uniform => ("uniform sampling".into(), "uniform".into(), "uniform's".into()),
+        s => (format!("`{s}`"), s.to_string(), format!("`{s}`'s")),
     }
 }
 
@@ -219,6 +235,7 @@ mod tests {
             b: MeanCi { mean: b, ci95: cb },
         };
         Verdict {
+            pair: (DiskScheme::Paper, DiskScheme::Uniform),
             samples: 16,
             light_radius: 0.02,
             pattern: Pattern::PerPixel,

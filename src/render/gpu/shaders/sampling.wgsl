@@ -1,9 +1,9 @@
 // Disk sampling schemes and counter-based random numbers: the WGSL twin of src/sampling/.
 // Every function here must return, bit for bit in its integer part, what the Rust one does.
 
-// The SCHEME_* ids and the table layout's constants (PMJ02_POINTS, BLUE_TILE, TABLE_COUNTS) are
-// generated from the Rust side (gpu::scheme_prelude, sampling::tables) and prepended; the
-// tables themselves are `scheme_tables` (render.wgsl's binding, sampling::tables::pack).
+// The SCHEME_* ids and the table layout's constants (PMJ02_POINTS, BLUE_TILE, TABLE_COUNTS,
+// POINTS_HEADER) are generated from the Rust side (gpu::scheme_prelude, sampling::tables) and
+// prepended; the tables themselves are `scheme_tables` (render.wgsl's binding, sampling::tables::pack).
 
 const TAU: f32 = 6.283185307179586;
 const PI: f32 = 3.141592653589793;
@@ -167,6 +167,34 @@ fn bluenoise_table(n: u32) -> u32 {
     return 0u;
 }
 
+// Sample k of a points file's set for the pixel at `pixel` (sampling::points::PointSet::point):
+// its header at POINTS_HEADER holds the data's offset, the layout (0 shared, 1 tile, 2 mask),
+// the points per pixel, the tile's side, the domain (0 square, 1 disk) and the mask's offset.
+fn points_point(k: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
+    let base = scheme_tables[POINTS_HEADER];
+    if (base == 0u) {
+        // No set packed (sampling::tables::pack packs the frame's): NaN, never stray numbers.
+        return vec2<f32>(bitcast<f32>(0x7fc00000u));
+    }
+    let arrangement = scheme_tables[POINTS_HEADER + 1u];
+    let count = scheme_tables[POINTS_HEADER + 2u];
+    let side = max(scheme_tables[POINTS_HEADER + 3u], 1u);
+    var at = base + 2u * k;
+    if (arrangement == 1u) {
+        at = base + 2u * (tile_index_in(pixel, tile_seed, side) * count + k);
+    }
+    var q = vec2<u32>(scheme_tables[at], scheme_tables[at + 1u]);
+    if (arrangement == 2u) {
+        let m = scheme_tables[POINTS_HEADER + 5u] + 2u * tile_index_in(pixel, tile_seed, side);
+        let offset = vec2<u32>(scheme_tables[m], scheme_tables[m + 1u]);
+        q = (q + offset + cp_shift(tile_seed)) & vec2<u32>(0x00ffffffu);
+    }
+    if (scheme_tables[POINTS_HEADER + 4u] == 1u) {
+        return vec2<f32>(f32(bitcast<i32>(q.x)), f32(bitcast<i32>(q.y))) * (1.0 / 8388608.0);
+    }
+    return concentric(to_unit(q.x << 8u), to_unit(q.y << 8u));
+}
+
 // Sample k of n on the unit disk for the pixel at `pixel` under the tile shift of `tile_seed`,
 // drawing its randomness from `stream` (see DiskScheme::point and Site).
 fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
@@ -226,6 +254,9 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_s
             }
             let s = scrambled_sobol_2d(k, scheme_tables[table + tile_index(pixel, tile_seed)]);
             return concentric(to_unit(s.x), to_unit(s.y));
+        }
+        case SCHEME_POINTS: {
+            return points_point(k, pixel, tile_seed);
         }
         default: {
             // An id no scheme has: NaN, which no test or metric mistakes for a point.
