@@ -105,7 +105,7 @@ fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)], subject: DiskScheme) -> Stri
     } else {
         format!("tied within the intervals with {}", tied.join(", "))
     };
-    let paper = match r.iter().position(|(name, _)| *name == subject) {
+    let rank = match r.iter().position(|(name, _)| *name == subject) {
         Some(k) => {
             let p = r[k].1;
             let better = r.iter().filter(|(_, x)| clearly_below(*x, p)).count();
@@ -123,7 +123,7 @@ fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)], subject: DiskScheme) -> Stri
         None => String::new(),
     };
     format!(
-        "- *Least {}:* **{best}**, {}; {call}.{paper}\n",
+        "- *Least {}:* **{best}**, {}; {call}.{rank}\n",
         m.label,
         with_ci(b.mean, b.ci95, m.show)
     )

@@ -1,6 +1,7 @@
 //! The verdict on the soft-shadow paper's claim, computed from the summaries: at the paper's
 //! 16 rays and 2 cm light, is the pseudo-random pattern's penumbra wider than uniform sampling's
-//! at equal quality, and is the extra width closer to the exact penumbra or a bias?
+//! at equal quality, and is the extra width closer to the exact penumbra or a bias? An
+//! experiment's `[verdict]` may ask the same of another pair (its own pattern against uniform).
 //!
 //! Two means are called different only when their 95 % intervals are disjoint; without intervals
 //! (fewer than two seeds) nothing is called different, and the verdict says it needs more seeds.
@@ -65,17 +66,17 @@ pub struct Verdict {
     pub pattern: Pattern,
     /// Seeds behind the smaller of the two configurations.
     pub seeds: usize,
-    /// Visible extent width, paper vs uniform.
+    /// Visible extent width, subject vs baseline.
     pub extent: Compare,
-    /// 10-90 % width, paper vs uniform.
+    /// 10-90 % width, subject vs baseline.
     pub width_10_90: Compare,
-    /// RMSE against the ground truth, paper vs uniform.
+    /// RMSE against the ground truth, subject vs baseline.
     pub rmse: Compare,
-    /// RMSE against the exact image, paper vs uniform.
+    /// RMSE against the exact image, subject vs baseline.
     pub rmse_exact: Compare,
-    /// FLIP of the Fig. 2 pictures against the ground-truth picture, paper vs uniform.
+    /// FLIP of the Fig. 2 pictures against the ground-truth picture, subject vs baseline.
     pub flip: Compare,
-    /// Squared bias (with interval) and variance per pixel over seeds: paper, uniform.
+    /// Squared bias (with interval) and variance per pixel over seeds: subject, baseline.
     pub split: (BiasVariance, BiasVariance),
     /// Exact image's extent width and exact 10-90 width.
     pub exact: (f64, f64),
