@@ -101,6 +101,16 @@ const DISK_SCALE: f64 = (1u32 << 23) as f64;
 /// Scale of square coordinates: u is stored as floor(u 2^24).
 const SQUARE_SCALE: f64 = (1u32 << 24) as f64;
 
+/// An error about a points file as a whole.
+fn whole_file(file: &Path, message: String) -> ConfigError {
+    ConfigError {
+        file: file.to_path_buf(),
+        position: None,
+        key: String::new(),
+        message,
+    }
+}
+
 /// An error about a line of a points file.
 fn at_line(file: &Path, line: usize, message: String) -> ConfigError {
     ConfigError {
@@ -123,28 +133,24 @@ type Pairs = (Vec<Pair>, Vec<u8>);
 
 /// Reads a points or mask file, refusing what is not a text file of number pairs.
 fn read_pairs(file: &Path) -> Result<Pairs, ConfigError> {
-    let whole = |message: String| ConfigError {
-        file: file.to_path_buf(),
-        position: None,
-        key: String::new(),
-        message,
-    };
-    let meta = std::fs::metadata(file).map_err(|e| whole(format!("cannot read: {e}")))?;
+    let meta = std::fs::metadata(file).map_err(|e| whole_file(file, format!("cannot read: {e}")))?;
     if !meta.is_file() {
-        return Err(whole("not a regular file".into()));
+        return Err(whole_file(file, "not a regular file".into()));
     }
     if meta.len() > MAX_POINTS_BYTES {
-        return Err(whole(format!(
-            "larger than {MAX_POINTS_BYTES} bytes: not a points file"
-        )));
+        return Err(whole_file(
+            file,
+            format!("larger than {MAX_POINTS_BYTES} bytes: not a points file"),
+        ));
     }
-    let bytes = std::fs::read(file).map_err(|e| whole(format!("cannot read: {e}")))?;
+    let bytes = std::fs::read(file).map_err(|e| whole_file(file, format!("cannot read: {e}")))?;
     if bytes.contains(&0) {
-        return Err(whole(
+        return Err(whole_file(
+            file,
             "a binary file (it holds NUL bytes), not a text file of points".into(),
         ));
     }
-    let text = std::str::from_utf8(&bytes).map_err(|e| whole(format!("not UTF-8 text: {e}")))?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| whole_file(file, format!("not UTF-8 text: {e}")))?;
     // Spreadsheets write a byte-order mark first: it is not part of the first value.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut pairs = Vec::new();
@@ -191,7 +197,7 @@ fn read_pairs(file: &Path) -> Result<Pairs, ConfigError> {
         });
     }
     if pairs.is_empty() {
-        return Err(whole("holds no points".into()));
+        return Err(whole_file(file, "holds no points".into()));
     }
     Ok((pairs, bytes))
 }
@@ -216,16 +222,14 @@ impl PointSet {
         let (pairs, bytes) = read_pairs(file)?;
         let mut points = Vec::with_capacity(pairs.len());
         if pairs.len() as u64 * 2 > MAX_POINTS_WORDS {
-            return Err(ConfigError {
-                file: file.to_path_buf(),
-                position: None,
-                key: String::new(),
-                message: format!(
+            return Err(whole_file(
+                file,
+                format!(
                     "{} points, more than the {} one GPU buffer holds",
                     pairs.len(),
                     MAX_POINTS_WORDS / 2
                 ),
-            });
+            ));
         }
         for p in &pairs {
             let ([a, b], [ta, tb]) = (p.values, &p.texts);
@@ -247,12 +251,6 @@ impl PointSet {
                 }
             });
         }
-        let whole = |message: String| ConfigError {
-            file: file.to_path_buf(),
-            position: None,
-            key: String::new(),
-            message,
-        };
         let mut files = vec![settings.path.clone()];
         let mut hashed = bytes;
         let mut offsets = Vec::new();
@@ -261,10 +259,13 @@ impl PointSet {
             Layout::Tile(side) => {
                 let pixels = (side * side) as usize;
                 if points.len() % pixels != 0 {
-                    return Err(whole(format!(
-                        "{} points do not split evenly over the {side} x {side} tile's {pixels} pixels",
-                        points.len()
-                    )));
+                    return Err(whole_file(
+                        file,
+                        format!(
+                            "{} points do not split evenly over the {side} x {side} tile's {pixels} pixels",
+                            points.len()
+                        ),
+                    ));
                 }
                 points.len() / pixels
             }
@@ -275,22 +276,21 @@ impl PointSet {
                 .as_deref()
                 .expect("validated: a mask layout names its mask");
             if settings.domain == Domain::Disk {
-                return Err(whole(
+                return Err(whole_file(
+                    file,
                     "a mask rotates points modulo 1 in the unit square: use domain = \"square\"".into(),
                 ));
             }
             let (pairs, bytes) = read_pairs(mask)?;
             if pairs.len() != (side * side) as usize {
-                return Err(ConfigError {
-                    file: mask.to_path_buf(),
-                    position: None,
-                    key: String::new(),
-                    message: format!(
+                return Err(whole_file(
+                    mask,
+                    format!(
                         "{} offsets for a {side} x {side} tile of {} pixels",
                         pairs.len(),
                         side * side
                     ),
-                });
+                ));
             }
             for p in &pairs {
                 let ([a, b], [ta, tb]) = (p.values, &p.texts);
@@ -300,9 +300,10 @@ impl PointSet {
             hashed.extend_from_slice(&bytes);
         }
         if (count as u64) < needed as u64 {
-            return Err(whole(format!(
-                "{count} points per pixel, fewer than the {needed} rays the experiment sweeps"
-            )));
+            return Err(whole_file(
+                file,
+                format!("{count} points per pixel, fewer than the {needed} rays the experiment sweeps"),
+            ));
         }
         hashed.extend_from_slice(format!("{:?} {:?}", settings.domain, settings.layout).as_bytes());
         Ok(PointSet {
