@@ -62,6 +62,22 @@ pub fn read_rows<T: Serialize + DeserializeOwned>(path: &Path) -> Vec<T> {
     }
 }
 
+/// A row as (column, cell) pairs, the text a table holds: how a picture names the table rows it
+/// belongs to.
+pub fn cells<T: Serialize>(row: &T) -> anyhow::Result<Vec<(String, String)>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.serialize(row)?;
+    let bytes = w.into_inner()?;
+    let mut r = csv::Reader::from_reader(bytes.as_slice());
+    let header = r.headers()?.clone();
+    let record = r.records().next().transpose()?.unwrap_or_default();
+    Ok(header
+        .iter()
+        .zip(record.iter())
+        .map(|(h, c)| (h.to_string(), c.to_string()))
+        .collect())
+}
+
 /// The header csv writes for `row`.
 fn header_of<T: Serialize>(row: &T) -> anyhow::Result<csv::StringRecord> {
     let mut w = csv::Writer::from_writer(Vec::new());

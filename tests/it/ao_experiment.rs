@@ -33,12 +33,15 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     for file in [
         "report.md",
         "manifest.toml",
-        "images/cow.png",
-        "images/mech-holes-shark.png",
+        "images/cow_brute.exr",
+        "images/cow_vlf.png",
+        "images/mech-holes-shark_kdtree.exr",
         "plots/frame_time.png",
+        "index.html",
     ] {
         assert!(out.join(file).exists(), "{file} missing");
     }
+    common::browser::check_page(&out);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
     assert!(

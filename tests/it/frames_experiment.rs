@@ -75,9 +75,12 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
         "plots/frame_time_whitted.png",
         "images/strip_opengl.png",
         "images/strip_whitted.png",
+        "images/strip_whitted_0.exr",
+        "index.html",
     ] {
         assert!(out.join(file).exists(), "{file} missing");
     }
+    common::browser::check_page(&out);
     assert!(
         report.contains("equals the first structure's pixel for pixel"),
         "{report}"

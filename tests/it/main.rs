@@ -21,6 +21,7 @@ mod hard_cases;
 mod hostile_input;
 mod kdtree;
 mod mesh_scene;
+mod pages;
 mod points_file;
 mod receiver_masks;
 mod regression;

@@ -1,5 +1,5 @@
-//! Outputs of an ambient-occlusion experiment: ao.csv, tuning.csv, the AO images, a plot of
-//! frame time per mesh, and report.md with the paper's Table 1 beside ours and a verdict
+//! Outputs of an ambient-occlusion experiment: ao.csv, tuning.csv, each structure's AO image per
+//! mesh (EXR and PNG), a plot of frame time per mesh, the comparison page, and report.md with the paper's Table 1 beside ours and a verdict
 //! computed from the rows by the one timing rule.
 
 use super::runner::{AoRow, TuningRow};
@@ -8,7 +8,7 @@ use crate::experiment::outputs::Outputs;
 use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
-use crate::output::images::{grey, write_png};
+use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{line_plot, Axes, Series};
 use crate::output::table::{float, write_rows};
 use serde::Serialize;
@@ -167,7 +167,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     out
 }
 
-/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png and report.md into `outputs`
+/// Writes ao.csv, tuning.csv, images/, plots/frame_time.png, report.md and index.html into `outputs`
 /// (each path checked to stay in it: mesh names become file names).
 pub fn write_ao(
     spec: &AoSpec,
@@ -213,13 +213,13 @@ pub fn write_ao(
         same_image_as_first: r.same_image,
     });
     write_rows(&out("ao.csv")?, csv)?;
-    for m in &spec.meshes {
-        if let Some(r) = rows.iter().find(|r| r.mesh == m.name) {
-            write_png(
-                &out(&format!("images/{}.png", m.name))?,
-                &grey(&r.image, spec.width, spec.height),
-            )?;
+    let galleries = galleries(spec, rows);
+    for g in &galleries {
+        for s in &g.shots {
+            out(&s.exr)?;
+            out(&s.png)?;
         }
+        write_shots(outputs.dir(), g)?;
     }
     let series: Vec<(usize, Series)> = spec
         .structures
@@ -256,7 +256,53 @@ pub fn write_ao(
         &series,
         &[],
     )?;
-    write_atomic(&out("report.md")?, report(spec, rows, threads, seconds).as_bytes())
+    let report = report(spec, rows, threads, seconds);
+    write_atomic(&out("report.md")?, report.as_bytes())?;
+    page::write(
+        outputs.dir(),
+        &Page {
+            title: format!("{}: ambient occlusion per structure", spec.name),
+            report,
+            galleries,
+        },
+    )
+}
+
+/// One gallery per mesh: its AO image from each structure (`images/MESH_STRUCTURE.exr`), brute
+/// force the reference where it ran (else the first structure).
+fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
+    spec.meshes
+        .iter()
+        .filter_map(|m| {
+            let shots: Vec<Shot> = rows
+                .iter()
+                .filter(|r| r.mesh == m.name)
+                .map(|r| Shot {
+                    label: format!("{}: {}", r.mesh, r.structure),
+                    exr: format!("images/{}_{}.exr", r.mesh, r.structure),
+                    png: format!("images/{}_{}.png", r.mesh, r.structure),
+                    values: r.image.clone(),
+                    key: vec![
+                        ("mesh".into(), r.mesh.clone()),
+                        ("structure".into(), r.structure.into()),
+                    ],
+                })
+                .collect();
+            let reference = rows
+                .iter()
+                .filter(|r| r.mesh == m.name)
+                .position(|r| r.structure == "brute")
+                .unwrap_or(0);
+            (!shots.is_empty()).then(|| Gallery {
+                title: format!("{}: ambient occlusion", m.name),
+                width: spec.width,
+                height: spec.height,
+                tone: Tone::Linear,
+                reference: Some(reference),
+                shots,
+            })
+        })
+        .collect()
 }
 
 fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {
@@ -335,6 +381,6 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `tuning.csv` (every candidate of the tuning sweep), `images/MESH.png` (the AO image), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
     md
 }

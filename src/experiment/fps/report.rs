@@ -1,16 +1,17 @@
 //! Outputs of a frame-rate experiment: fps.csv, a plot with the paper's Table 1 beside our
-//! numbers, and report.md.
+//! numbers, report.md and the page (index.html).
 
 use super::{FpsRow, FpsSpec};
 use crate::experiment::timing::RULE;
 use crate::files::write_atomic;
+use crate::output::page::{self, Page};
 use crate::output::plots::{line_plot, Axes, Reference, Series};
 use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
 use serde::Serialize;
 use std::path::Path;
 
-/// Writes fps.csv, plots/fps.png and report.md under `out`.
+/// Writes fps.csv, plots/fps.png, report.md and index.html under `out`.
 pub fn write_fps(
     spec: &FpsSpec,
     rows: &[FpsRow],
@@ -100,8 +101,16 @@ pub fn write_fps(
             r.shadow_rays_per_s()
         );
     }
-    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`; nodes and tests are counted on the CPU backend only (n/a on the GPU).\n";
-    write_atomic(&out.join("report.md"), md.as_bytes())
+    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`, `index.html` (the page); nodes and tests are counted on the CPU backend only (n/a on the GPU).\n";
+    write_atomic(&out.join("report.md"), md.as_bytes())?;
+    page::write(
+        out,
+        &Page {
+            title: format!("{}: frame rates", spec.name),
+            report: md,
+            galleries: vec![],
+        },
+    )
 }
 
 /// A row of fps.csv: one timed configuration, with the device.

@@ -9,7 +9,8 @@ use super::verdict::{label, labels, median_at, verdict};
 use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
-use crate::output::images::tonemap;
+use crate::output::images::{exposure, tonemap};
+use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{image_grid, line_plot, Axes, Series};
 use crate::output::table::{float, write_rows};
 use crate::scene::procedural::random;
@@ -56,7 +57,7 @@ struct BuildCsv<'a> {
     memory_bytes: u64,
 }
 
-/// Writes frames.csv, builds.csv, plots/, images/ and report.md under `out`.
+/// Writes frames.csv, builds.csv, plots/, images/, report.md and index.html under `out`.
 pub fn write_frames(
     spec: &FramesSpec,
     outcome: &FramesOutcome,
@@ -244,10 +245,54 @@ pub fn write_frames(
             tiles.len().max(1),
         )?;
     }
-    write_atomic(
-        &out.join("report.md"),
-        report(spec, outcome, threads, seconds).as_bytes(),
+    let galleries = strips(spec, outcome);
+    for g in &galleries {
+        write_shots(out, g)?;
+    }
+    let report = report(spec, outcome, threads, seconds);
+    write_atomic(&out.join("report.md"), report.as_bytes())?;
+    page::write(
+        out,
+        &Page {
+            title: format!("{}: frames along a camera path", spec.name),
+            report,
+            galleries,
+        },
     )
+}
+
+/// One gallery per shading: the strip's frames (`images/strip_SHADING_FRAME.exr`, radiance,
+/// the first structure's), shown at the first frame's exposure.
+fn strips(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Gallery> {
+    spec.shadings
+        .iter()
+        .filter_map(|&(shading, _)| {
+            let frames: Vec<_> = outcome.pictures.iter().filter(|p| p.shading == shading).collect();
+            let first = frames.first()?;
+            Some(Gallery {
+                title: format!("{} frames along the path", shading.name()),
+                width: spec.width,
+                height: spec.height,
+                tone: Tone::Radiance {
+                    p99: exposure(&first.radiance),
+                },
+                reference: None,
+                shots: frames
+                    .iter()
+                    .map(|p| Shot {
+                        label: format!("{} frame {}", shading.name(), p.frame),
+                        exr: format!("images/strip_{}_{}.exr", shading.name(), p.frame),
+                        png: format!("images/strip_{}_{}.png", shading.name(), p.frame),
+                        values: p.radiance.clone(),
+                        key: vec![
+                            ("shading".into(), shading.name().into()),
+                            ("frame".into(), p.frame.to_string()),
+                        ],
+                    })
+                    .collect(),
+            })
+        })
+        .collect()
 }
 
 /// One structure (and way of following motion) at one scene size and shading, over its path:
@@ -406,6 +451,6 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
     if sizes.len() > 1 {
         md += ", `plots/scaling_SHADING.png`, `plots/memory.png`, `plots/build_time.png` (log-log against triangle count)";
     }
-    md += ", `images/strip_SHADING.png` (frames along the path, first structure).\n";
+    md += ", `images/strip_SHADING.png` (frames along the path, first structure; each frame also as `images/strip_SHADING_FRAME.exr` and `.png`), `index.html` (the comparison page).\n";
     md
 }

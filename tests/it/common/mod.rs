@@ -6,6 +6,7 @@ use penumbra::render::gpu::GpuBackend;
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
+pub mod browser;
 pub mod rays;
 pub mod updates;
 

@@ -1,70 +1,176 @@
-//! The measuring view's images: fig2_measure.png (the schemes at the figure ray count beside the
-//! ground truth and the exact image, with error maps) with EXR files of each, and the Fig. 2
-//! picture.
+//! The sweep's images: every scheme x pattern of the measuring view at the figure ray count with
+//! the ground truth and the exact image, and the Fig. 2 pictures, each as EXR (the values) and
+//! PNG (what the page shows), gathered into the page's galleries; plus the grids
+//! fig2_measure.png (with error maps and their colour bars) and fig2_picture.png.
 
 use super::pictures::{shown, write_fig2_picture};
 use super::results::Results;
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
-use crate::output::images::{diverging, grey, write_exr, Rgb};
+use crate::output::images::{diverging, exposure, grey, Rgb};
+use crate::output::page::{write_shots, Gallery, Shot, Tone};
 use crate::output::plots::image_grid;
+use crate::output::table::cells;
 use std::path::Path;
 
-/// Writes the images into `dir`.
-pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
+/// A file name part for a scheme (`points:NAME` has a colon no file system likes).
+fn file_part(scheme: &impl ToString) -> String {
+    scheme.to_string().replace(':', "-")
+}
+
+/// Writes the images into `dir` (the folder's images/) and returns the page's galleries.
+pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<Vec<Gallery>> {
+    let mut galleries = Vec::new();
+    if let Some(g) = measuring_view(r)? {
+        write_shots(dir.parent().expect("images/ is inside the results folder"), &g)?;
+        write_measure_grid(r, &g, &dir.join("fig2_measure.png"))?;
+        galleries.push(g);
+    }
+    if let Some(p) = r.pictures {
+        let g = pictures_gallery(r, p)?;
+        write_shots(dir.parent().expect("images/ is inside the results folder"), &g)?;
+        galleries.push(g);
+        write_fig2_picture(r.spec, p, r.spec.axes.seeds[0], &dir.join("fig2_picture.png"))?;
+    }
+    Ok(galleries)
+}
+
+/// The measuring view at the verdict's light radius with every light on: each swept scheme and
+/// pattern at the figure ray count (the first swept structure's image; every structure's answers
+/// are exact, which the tests check), then the ground truth (the gallery's reference) and the
+/// exact image.
+fn measuring_view(r: &Results) -> anyhow::Result<Option<Gallery>> {
     let spec = r.spec;
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
-    let (w, h) = (spec.measure.width, spec.measure.height);
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    if let Some(reference) = r
+    let Some(reference) = r
         .outcome
         .references
         .iter()
         .find(|x| x.light_radius == radius && x.lights == lights)
-    {
-        let gt = &reference.ground_truth;
-        write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
-        let mut tiles: Vec<(String, Rgb)> = Vec::new();
-        let mut errors: Vec<(String, Rgb)> = Vec::new();
-        for (scheme, pattern) in shown(spec) {
-            // The first swept structure's image (every structure's answers are exact, so the
-            // images differ only where a structure is wrong, which the tests catch).
+    else {
+        return Ok(None);
+    };
+    let mut shots = Vec::new();
+    for &scheme in &spec.axes.schemes {
+        for &pattern in &spec.axes.patterns {
             let kept = r.outcome.keep.iter().find(|(c, _)| {
                 c.scheme == scheme
                     && c.pattern == pattern
+                    && c.samples == n
                     && c.light_radius == radius
                     && c.lights == lights
                     && c.accelerator == spec.axes.accelerators[0]
             });
-            if let Some((_, img)) = kept {
-                write_exr(
-                    &dir.join(format!("{}_{pattern}_{n}.exr", scheme.to_string().replace(':', "-"))),
-                    img,
-                    w,
-                    h,
-                )?;
-                tiles.push((format!("{scheme} ({pattern}), {n} rays"), grey(img, w, h)));
-                errors.push((
-                    format!("{scheme} ({pattern}) - ground truth"),
-                    diverging(img, gt, 0.5, w, h),
-                ));
+            if let Some((config, img)) = kept {
+                let stem = format!("images/{}_{pattern}_{n}", file_part(&scheme));
+                shots.push(Shot {
+                    label: format!("{scheme} ({pattern}), {n} rays"),
+                    exr: format!("{stem}.exr"),
+                    png: format!("{stem}.png"),
+                    values: img.clone(),
+                    key: cells(config)?,
+                });
             }
         }
-        tiles.push((
-            format!("ground truth, {} rays", spec.ground_truth.samples),
-            grey(gt, w, h),
-        ));
-        if let Some(exact) = &reference.exact {
-            write_exr(&dir.join("exact.exr"), exact, w, h)?;
-            tiles.push(("exact".into(), grey(exact, w, h)));
-            errors.push(("ground truth - exact (x100)".into(), diverging(gt, exact, 0.005, w, h)));
+    }
+    let plain = |label: String, stem: &str, values: &Vec<f32>| Shot {
+        label,
+        exr: format!("images/{stem}.exr"),
+        png: format!("images/{stem}.png"),
+        values: values.clone(),
+        key: vec![],
+    };
+    shots.push(plain(
+        format!("ground truth, {} rays", spec.ground_truth.samples),
+        "ground_truth",
+        &reference.ground_truth,
+    ));
+    let gt = shots.len() - 1;
+    if let Some(exact) = &reference.exact {
+        shots.push(plain("exact".into(), "exact", exact));
+    }
+    Ok(Some(Gallery {
+        title: format!("measuring view: {n} rays, light radius {radius} m, {lights} light(s)"),
+        width: spec.measure.width,
+        height: spec.measure.height,
+        tone: Tone::Linear,
+        reference: Some(gt),
+        shots,
+    }))
+}
+
+/// fig2_measure.png: the schemes [`shown`] beside the ground truth and the exact image, with
+/// their signed errors underneath on a +-0.5 scale (ground truth - exact on +-0.005).
+fn write_measure_grid(r: &Results, g: &Gallery, path: &Path) -> anyhow::Result<()> {
+    let (w, h) = (g.width, g.height);
+    let n = figure_samples(r.spec);
+    let gt = &g.shots[g.reference.expect("the measuring view has a reference")];
+    let mut tiles: Vec<(String, Rgb)> = Vec::new();
+    let mut errors: Vec<(String, Rgb)> = Vec::new();
+    for (scheme, pattern) in shown(r.spec) {
+        let label = format!("{scheme} ({pattern}), {n} rays");
+        if let Some(s) = g.shots.iter().find(|s| s.label == label) {
+            tiles.push((label, grey(&s.values, w, h)));
+            errors.push((
+                format!("{scheme} ({pattern}) - ground truth, +-0.5"),
+                diverging(&s.values, &gt.values, 0.5, w, h),
+            ));
         }
-        let columns = tiles.len().max(errors.len());
-        let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
-        image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
     }
-    if let Some(p) = r.pictures {
-        write_fig2_picture(spec, p, spec.axes.seeds[0], &dir.join("fig2_picture.png"))?;
+    tiles.push((gt.label.clone(), grey(&gt.values, w, h)));
+    if let Some(exact) = g.shots.iter().find(|s| s.label == "exact") {
+        tiles.push(("exact".into(), grey(&exact.values, w, h)));
+        errors.push((
+            "ground truth - exact, +-0.005".into(),
+            diverging(&gt.values, &exact.values, 0.005, w, h),
+        ));
     }
-    Ok(())
+    let columns = tiles.len().max(errors.len());
+    let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
+    image_grid(path, &all, columns)
+}
+
+/// The Fig. 2 pictures at the first seed, tone-mapped with the ground-truth picture's exposure,
+/// the ground truth last (the gallery's reference, against which FLIP is measured).
+fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Pictures) -> anyhow::Result<Gallery> {
+    let seed = r.spec.axes.seeds[0];
+    let gt = &p.ground_truth;
+    let mut shots: Vec<Shot> = p
+        .runs
+        .iter()
+        .filter(|(run, _)| run.seed == seed && run.accelerator == r.spec.axes.accelerators[0])
+        .map(|(run, pic)| {
+            let stem = format!(
+                "images/picture_{}_{}_{}",
+                file_part(&run.scheme),
+                run.pattern,
+                pic.samples
+            );
+            Shot {
+                label: format!("{} ({}), {} rays", run.scheme, run.pattern, pic.samples),
+                exr: format!("{stem}.exr"),
+                png: format!("{stem}.png"),
+                values: pic.frame.radiance.clone(),
+                key: vec![],
+            }
+        })
+        .collect();
+    shots.push(Shot {
+        label: format!("jittered (ground truth), {} rays", gt.samples),
+        exr: "images/picture_ground_truth.exr".into(),
+        png: "images/picture_ground_truth.png".into(),
+        values: gt.frame.radiance.clone(),
+        key: vec![],
+    });
+    Ok(Gallery {
+        title: format!("Fig. 2 pictures, seed {seed} (radiance)"),
+        width: gt.frame.width,
+        height: gt.frame.height,
+        tone: Tone::Radiance {
+            p99: exposure(&gt.frame.radiance),
+        },
+        reference: Some(shots.len() - 1),
+        shots,
+    })
 }

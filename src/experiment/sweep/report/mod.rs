@@ -1,5 +1,5 @@
-//! The sweep's outputs: CSV tables, plots, images, the markdown report with its verdict, and the
-//! regression thresholds checked against them, written into the run's staging folder (the
+//! The sweep's outputs: CSV tables, plots, images, the markdown report with its verdict, the
+//! comparison page (index.html), and the regression thresholds checked against them, written into the run's staging folder (the
 //! driver adds the manifest and swaps the set in).
 
 pub mod images;
@@ -17,6 +17,7 @@ pub mod verdict;
 
 use crate::experiment::outputs::Outputs;
 use crate::files::write_atomic;
+use crate::output::page::{self, Page};
 use markdown::report;
 use pictures::picture_flip;
 pub use results::Results;
@@ -31,9 +32,15 @@ pub fn write_all(r: &Results, outputs: &Outputs) -> anyhow::Result<()> {
     let summaries = summary::summarise(r.outcome, &flip);
     tables::write_tables(r, &summaries, out)?;
     plots::write_plots(r, &summaries, &out.join("plots"))?;
-    images::write_images(r, &out.join("images"))?;
-    write_atomic(
-        &out.join("report.md"),
-        report(r.spec, r.outcome, &summaries, r.adapter, r.seconds).as_bytes(),
+    let galleries = images::write_images(r, &out.join("images"))?;
+    let report = report(r.spec, r.outcome, &summaries, r.adapter, r.seconds);
+    write_atomic(&out.join("report.md"), report.as_bytes())?;
+    page::write(
+        out,
+        &Page {
+            title: format!("{}: soft-shadow sampling sweep", r.spec.name),
+            report,
+            galleries,
+        },
     )
 }

@@ -1,0 +1,28 @@
+//! `page RESULTS_FOLDER...`: rebuilds each results folder's comparison page (index.html) from
+//! the files in it, without rerunning its experiment: for folders written before pages existed,
+//! or after the page changed. A fresh run writes a richer page (labels, table links, FLIP maps
+//! against each gallery's reference) than one rebuilt from file names.
+
+use clap::Parser;
+use std::path::PathBuf;
+
+/// Rebuild results folders' comparison pages from their files.
+#[derive(Parser)]
+#[command(version, about)]
+struct Args {
+    /// Results folders (each with a report.md).
+    #[arg(required = true)]
+    folders: Vec<PathBuf>,
+}
+
+fn main() -> std::process::ExitCode {
+    let args = Args::parse();
+    for dir in &args.folders {
+        if let Err(e) = penumbra::output::page::rebuild(dir) {
+            eprintln!("error: {e:#}");
+            return std::process::ExitCode::FAILURE;
+        }
+        println!("wrote {}", dir.join("index.html").display());
+    }
+    std::process::ExitCode::SUCCESS
+}

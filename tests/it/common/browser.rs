@@ -1,0 +1,237 @@
+//! A results page opened in a real browser (Debian's headless `chromium`): the page's self-test
+//! (`index.html#selftest`) hovers every image, moves the slider, flips, and checks that every
+//! <img> decoded; this module reads what it wrote and checks it against the files: each readout
+//! against the EXR beside the image, the error view's readout against the two EXRs' difference.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The browser, or `None` with a note when it is not installed. Where the environment sets
+/// `PENUMBRA_REQUIRE_BROWSER=1` (CI installs chromium and does), a missing browser fails.
+pub fn chromium() -> Option<PathBuf> {
+    let found = std::env::var_os("PENUMBRA_CHROMIUM").map(PathBuf::from).or_else(|| {
+        std::env::split_paths(&std::env::var_os("PATH")?)
+            .flat_map(|d| ["chromium", "chromium-browser"].map(|n| d.join(n)))
+            .find(|p| p.is_file())
+    });
+    if found.is_none() {
+        assert!(
+            std::env::var("PENUMBRA_REQUIRE_BROWSER").as_deref() != Ok("1"),
+            "PENUMBRA_REQUIRE_BROWSER=1 but no chromium on PATH (nor PENUMBRA_CHROMIUM)"
+        );
+        eprintln!("skipping browser checks: no chromium on PATH");
+    }
+    found
+}
+
+/// What the page's self-test wrote, as JSON, with the browser's log of the page's console
+/// (`console`).
+pub fn self_test(browser: &Path, page: &Path) -> Result<Value, String> {
+    let profile = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let url = format!(
+        "file://{}#selftest",
+        page.canonicalize().map_err(|e| e.to_string())?.display()
+    );
+    let mut child = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--virtual-time-budget=60000",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--dump-dom",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg(&url)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("starting {}: {e}", browser.display()))?;
+    // Drain the page's DOM while waiting (it is larger than a pipe holds).
+    let mut stdout = child.stdout.take().expect("piped");
+    let reader = std::thread::spawn(move || {
+        let mut dom = String::new();
+        std::io::Read::read_to_string(&mut stdout, &mut dom).map(|_| dom)
+    });
+    let mut stderr = child.stderr.take().expect("piped");
+    let log = std::thread::spawn(move || {
+        let mut text = String::new();
+        let _ = std::io::Read::read_to_string(&mut stderr, &mut text);
+        text
+    });
+    let start = Instant::now();
+    while child.try_wait().map_err(|e| e.to_string())?.is_none() {
+        if start.elapsed() > Duration::from_secs(180) {
+            let _ = child.kill();
+            return Err(format!("{url}: the browser did not finish in 180 s"));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let dom = reader.join().expect("reader").map_err(|e| e.to_string())?;
+    // The browser logs every console message of the page (the page itself writes none), even
+    // one written before the page's own error capture starts.
+    let console: Vec<String> = log
+        .join()
+        .expect("log reader")
+        .lines()
+        .filter(|l| l.contains(":CONSOLE"))
+        .map(str::to_string)
+        .collect();
+    let open = "<pre id=\"selftest\">";
+    let start = dom
+        .find(open)
+        .ok_or_else(|| format!("{url}: the self-test wrote nothing (page did not run?)"))?
+        + open.len();
+    let end = dom[start..].find("</pre>").ok_or("unterminated self-test output")? + start;
+    let text = dom[start..end]
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&nbsp;", "\u{a0}")
+        .replace("&amp;", "&");
+    let mut report: Value =
+        serde_json::from_str(&text).map_err(|e| format!("{url}: self-test output is not JSON ({e}): {text}"))?;
+    report["console"] = console.into();
+    Ok(report)
+}
+
+/// A one-channel EXR's values and width.
+fn exr(path: &Path) -> Result<(Vec<f32>, usize), String> {
+    let img = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let width = img.layer_data.size.width();
+    let ch = &img.layer_data.channel_data.list[0];
+    Ok((ch.sample_data.values_as_f32().collect(), width))
+}
+
+/// Whether the page's text for a value shows `value` to the seven significant digits it prints.
+fn shows(text: &str, value: f64) -> bool {
+    if value == -1.0 {
+        return text == "no receiver";
+    }
+    let Ok(shown) = text.parse::<f64>() else {
+        return false;
+    };
+    let digit = if value == 0.0 {
+        1e-7
+    } else {
+        10f64.powf(value.abs().log10().floor() - 6.0)
+    };
+    (shown - value).abs() <= 0.5 * digit * (1.0 + 1e-9)
+}
+
+/// Every problem the page at `dir`/index.html shows in the browser (none: it passes).
+pub fn problems(browser: &Path, dir: &Path) -> Vec<String> {
+    let report = match self_test(browser, &dir.join("index.html")) {
+        Ok(r) => r,
+        Err(e) => return vec![e],
+    };
+    let mut out = Vec::new();
+    for e in report["errors"].as_array().into_iter().flatten() {
+        out.push(format!("console error: {e}"));
+    }
+    for e in report["console"].as_array().into_iter().flatten() {
+        out.push(format!("console error (browser log): {e}"));
+    }
+    for img in report["images"].as_array().into_iter().flatten() {
+        if img["ok"] != Value::Bool(true) {
+            out.push(format!("image does not decode: {}", img["src"]));
+        }
+    }
+    let readouts = report["readouts"].as_array().cloned().unwrap_or_default();
+    let mut files = std::collections::BTreeMap::new();
+    let mut read = |name: &str| -> Result<(Vec<f32>, usize), String> {
+        if !files.contains_key(name) {
+            files.insert(name.to_string(), exr(&dir.join(name))?);
+        }
+        Ok(files[name].clone())
+    };
+    for r in &readouts {
+        let (a, b) = (r["a"].as_str().unwrap_or(""), r["b"].as_str().unwrap_or(""));
+        let (x, y) = (
+            r["x"].as_u64().unwrap_or(0) as usize,
+            r["y"].as_u64().unwrap_or(0) as usize,
+        );
+        let shown = &r["shown"];
+        let (Ok((av, w)), Ok((bv, _))) = (read(a), read(b)) else {
+            out.push(format!("readout names an unreadable EXR: {a} or {b}"));
+            continue;
+        };
+        if shown["x"] != Value::String(x.to_string()) || shown["y"] != Value::String(y.to_string()) {
+            out.push(format!(
+                "{a}: hovering pixel ({x}, {y}) reads out pixel ({}, {})",
+                shown["x"], shown["y"]
+            ));
+            continue;
+        }
+        let (va, vb) = (av[y * w + x] as f64, bv[y * w + x] as f64);
+        let text = |k: &str| shown[k].as_str().unwrap_or("").to_string();
+        if !shows(&text("a"), va) {
+            out.push(format!(
+                "{a} ({x}, {y}): the page reads {} where the EXR holds {va}",
+                text("a")
+            ));
+        }
+        if !shows(&text("b"), vb) {
+            out.push(format!(
+                "{b} ({x}, {y}): the page reads {} where the EXR holds {vb}",
+                text("b")
+            ));
+        }
+        if va != -1.0 && vb != -1.0 && !shows(&text("e"), va - vb) {
+            out.push(format!(
+                "{a} - {b} ({x}, {y}): the error view reads {} where the EXRs differ by {}",
+                text("e"),
+                va - vb
+            ));
+        }
+    }
+    // Every image of the page (an EXR under images/ is one) is read out.
+    let exrs: Vec<String> = std::fs::read_dir(dir.join("images"))
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".exr"))
+        .map(|n| format!("images/{n}"))
+        .collect();
+    for e in &exrs {
+        if !readouts.iter().any(|r| r["a"] == Value::String(e.clone())) {
+            out.push(format!("{e} is not on the page (no readout of it)"));
+        }
+    }
+    // Two different images of one size: the slider and the flip must change what is shown.
+    let differing = exrs.iter().enumerate().any(|(i, p)| {
+        exrs[i + 1..].iter().any(|q| match (read(p), read(q)) {
+            (Ok(a), Ok(b)) => a.1 == b.1 && a.0.len() == b.0.len() && a.0 != b.0,
+            _ => false,
+        })
+    });
+    if differing {
+        for control in ["slider", "flip"] {
+            if report[control]["changed"] != Value::Bool(true) {
+                out.push(format!(
+                    "the {control} does not change what is shown: {}",
+                    report[control]
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Asserts the page in `dir` passes in the browser (when one is installed).
+pub fn check_page(dir: &Path) {
+    if let Some(browser) = chromium() {
+        let p = problems(&browser, dir);
+        assert!(
+            p.is_empty(),
+            "{}/index.html in {}:\n{}",
+            dir.display(),
+            browser.display(),
+            p.join("\n")
+        );
+    }
+}
