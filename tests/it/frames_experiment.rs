@@ -72,7 +72,9 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
         "summary.csv",
         "manifest.toml",
         "plots/frame_time_opengl.png",
+        "plots/frame_time_opengl.svg",
         "plots/frame_time_whitted.png",
+        "plots/frame_time_whitted.svg",
         "images/strip_opengl.png",
         "images/strip_whitted.png",
     ] {
@@ -106,7 +108,14 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 2 * 2 * 4, "sizes x viewpoints x frames x structures");
     assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
-    for file in ["plots/scaling_opengl.png", "plots/memory.png", "plots/build_time.png"] {
+    for file in [
+        "plots/scaling_opengl.png",
+        "plots/scaling_opengl.svg",
+        "plots/memory.png",
+        "plots/memory.svg",
+        "plots/build_time.png",
+        "plots/build_time.svg",
+    ] {
         assert!(dir.path().join("out").join(file).exists(), "{file} missing");
     }
     assert!(report.contains("median frame time grows as kdtree N^"), "{report}");

@@ -10,7 +10,8 @@ use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::tonemap;
-use crate::output::plots::{image_grid, line_plot, Axes, Series};
+use crate::output::numbers::thousands;
+use crate::output::plots::{image_grid, line_plot, Axes, Series, Tile};
 use crate::output::table::{float, write_rows};
 use crate::scene::procedural::random;
 use serde::Serialize;
@@ -127,17 +128,18 @@ pub fn write_frames(
                 .collect()
         };
         let title = format!(
-            "{} shading, {}x{}, {}K triangles, viewpoint {}, CPU f64",
+            "{} shading, {}x{}, {} triangles, viewpoint {}, CPU f64",
             shading.name(),
             spec.width,
             spec.height,
-            largest as f64 / 1e3,
+            thousands(largest),
             spec.viewpoints[0]
         );
+        let frame_times = series(&|r| r.seconds);
         line_plot(
             &out.join(format!("plots/frame_time_{}.png", shading.name())),
-            &Axes::new(&title, "frame", "render seconds", false, false),
-            &series(&|r| r.seconds),
+            &Axes::new(&title, "frame", "render seconds", false, spread(&frame_times) > 30.0),
+            &frame_times,
             &[],
         )?;
         if spec.motion.is_some() {
@@ -237,7 +239,7 @@ pub fn write_frames(
                 )
             })
             .collect();
-        let tiles: Vec<(String, &_)> = pictures.iter().map(|(c, img)| (c.clone(), img)).collect();
+        let tiles: Vec<Tile> = pictures.iter().map(|(c, img)| Tile::new(c.clone(), img)).collect();
         image_grid(
             &out.join(format!("images/strip_{}.png", shading.name())),
             &tiles,
@@ -248,6 +250,18 @@ pub fn write_frames(
         &out.join("report.md"),
         report(spec, outcome, threads, seconds).as_bytes(),
     )
+}
+
+/// The largest positive y of `series` over the smallest: where it is large, one structure's
+/// times would flatten the others' on a linear axis.
+fn spread(series: &[(usize, Series)]) -> f64 {
+    let ys = || {
+        series
+            .iter()
+            .flat_map(|(_, s)| s.points.iter().map(|p| p.1))
+            .filter(|y| *y > 0.0)
+    };
+    ys().fold(0.0, f64::max) / ys().fold(f64::INFINITY, f64::min)
 }
 
 /// One structure (and way of following motion) at one scene size and shading, over its path:

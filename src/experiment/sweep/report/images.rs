@@ -6,8 +6,13 @@ use super::pictures::{shown, write_fig2_picture};
 use super::results::Results;
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::output::images::{diverging, grey, write_exr, Rgb};
-use crate::output::plots::image_grid;
+use crate::output::plots::{image_grid, ColourBar, Tile};
 use std::path::Path;
+
+/// The difference a run's error map shows at full colour.
+const RUN_ERROR: f64 = 0.5;
+/// The difference the ground truth's error map (against the exact image) shows at full colour.
+const TRUTH_ERROR: f64 = 0.005;
 
 /// Writes the images into `dir`.
 pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
@@ -25,7 +30,7 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
         let gt = &reference.ground_truth;
         write_exr(&dir.join("ground_truth.exr"), gt, w, h)?;
         let mut tiles: Vec<(String, Rgb)> = Vec::new();
-        let mut errors: Vec<(String, Rgb)> = Vec::new();
+        let mut errors: Vec<(String, Rgb, f64)> = Vec::new();
         for (scheme, pattern) in shown(spec) {
             // The first swept structure's image (every structure's answers are exact, so the
             // images differ only where a structure is wrong, which the tests catch).
@@ -46,7 +51,8 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
                 tiles.push((format!("{scheme} ({pattern}), {n} rays"), grey(img, w, h)));
                 errors.push((
                     format!("{scheme} ({pattern}) - ground truth"),
-                    diverging(img, gt, 0.5, w, h),
+                    diverging(img, gt, RUN_ERROR, w, h),
+                    RUN_ERROR,
                 ));
             }
         }
@@ -57,10 +63,24 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<()> {
         if let Some(exact) = &reference.exact {
             write_exr(&dir.join("exact.exr"), exact, w, h)?;
             tiles.push(("exact".into(), grey(exact, w, h)));
-            errors.push(("ground truth - exact (x100)".into(), diverging(gt, exact, 0.005, w, h)));
+            errors.push((
+                "ground truth - exact".into(),
+                diverging(gt, exact, TRUTH_ERROR, w, h),
+                TRUTH_ERROR,
+            ));
         }
         let columns = tiles.len().max(errors.len());
-        let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
+        let all: Vec<Tile> = tiles
+            .iter()
+            .map(|(l, i)| Tile::new(l.clone(), i))
+            .chain(errors.iter().map(|(l, i, scale)| Tile {
+                bar: Some(ColourBar {
+                    scale: *scale,
+                    what: "visibility difference".into(),
+                }),
+                ..Tile::new(l.clone(), i)
+            }))
+            .collect();
         image_grid(&dir.join("fig2_measure.png"), &all, columns)?;
     }
     if let Some(p) = r.pictures {
