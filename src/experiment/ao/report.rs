@@ -9,7 +9,8 @@ use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{grey, write_png};
-use crate::output::plots::{line_plot, Axes, Series};
+use crate::output::numbers::thousands;
+use crate::output::plots::{grouped_bars, Bar, Group};
 use crate::output::table::{float, write_rows};
 use serde::Serialize;
 
@@ -221,40 +222,48 @@ pub fn write_ao(
             )?;
         }
     }
-    let series: Vec<(usize, Series)> = spec
+    let groups: Vec<Group> = spec
+        .meshes
+        .iter()
+        .filter_map(|m| {
+            let of_mesh: Vec<&AoRow> = rows.iter().filter(|r| r.mesh == m.name).collect();
+            let first = of_mesh.first()?;
+            let bars = spec
+                .structures
+                .iter()
+                .enumerate()
+                .filter_map(|(i, (s, _))| {
+                    let r = of_mesh.iter().find(|r| r.structure == *s)?;
+                    Some(Bar {
+                        series: i,
+                        value: r.frame.median,
+                        lo: r.frame.lo,
+                        hi: r.frame.hi,
+                    })
+                })
+                .collect();
+            Some(Group {
+                name: m.name.clone(),
+                note: format!("{} triangles", thousands(first.triangles)),
+                bars,
+            })
+        })
+        .collect();
+    let names: Vec<(usize, String)> = spec
         .structures
         .iter()
         .enumerate()
-        .map(|(i, (s, _))| {
-            let points = rows
-                .iter()
-                .filter(|r| r.structure == *s)
-                .map(|r| (r.triangles as f64, r.frame.median, f64::NAN))
-                .collect();
-            (
-                i,
-                Series {
-                    name: s.to_string(),
-                    points,
-                    dashed: false,
-                },
-            )
-        })
+        .map(|(i, (s, _))| (i, s.to_string()))
         .collect();
-    line_plot(
+    grouped_bars(
         &out("plots/frame_time.png")?,
-        &Axes::new(
-            &format!(
-                "AO, {} rays per hit, {}x{}, CPU f64",
-                spec.ao.rays, spec.width, spec.height
-            ),
-            "triangles",
-            "frame seconds (median)",
-            true,
-            true,
+        &format!(
+            "AO frame time per mesh: {} rays per hit, {}x{}, CPU f64",
+            spec.ao.rays, spec.width, spec.height
         ),
-        &series,
-        &[],
+        "frame time, median (s)",
+        &names,
+        &groups,
     )?;
     write_atomic(&out("report.md")?, report(spec, rows, threads, seconds).as_bytes())
 }
