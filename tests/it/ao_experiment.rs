@@ -50,10 +50,21 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         .filter_map(|n| n.text())
         .map(str::trim)
         .collect();
-    for name in ["cow", "mech-holes-shark", "kdtree", "vlf", "bvh", "brute", "95 % interval"] {
+    for name in [
+        "cow",
+        "mech-holes-shark",
+        "kdtree",
+        "vlf",
+        "bvh",
+        "brute",
+        "95 % interval",
+    ] {
         assert!(texts.contains(&name), "frame_time.svg lacks {name}: {texts:?}");
     }
     assert!(texts.iter().any(|t| t.ends_with("triangles")), "{texts:?}");
+    let tables = common::assert_tidy_tables(&out);
+    assert_eq!(tables.len(), 2, "ao.csv and tuning.csv: {tables:?}");
+    assert!(header.iter().any(|h| h == "vlf_depth") && header.iter().any(|h| h == "kdtree_max_depth"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
     assert!(

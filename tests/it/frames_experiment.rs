@@ -32,6 +32,13 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let (header, rows, report) = run(dir.path(), &ci());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
+    let tables = common::assert_tidy_tables(&dir.path().join("out"));
+    assert_eq!(tables.len(), 3, "frames.csv, builds.csv and summary.csv: {tables:?}");
+    let builds = std::fs::read_to_string(dir.path().join("out/builds.csv")).unwrap();
+    assert!(
+        builds.starts_with("triangles,structure,bvh_preset,") && builds.contains("\n51224,vlf,,3,32,4,uniform,32,,,"),
+        "the field's parameters one per column: {builds}"
+    );
     for r in &rows {
         let same_frame: Vec<&csv::StringRecord> = rows
             .iter()

@@ -6,6 +6,7 @@
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{FramesSpec, Generator};
 use super::verdict::{label, labels, median_at, verdict};
+use crate::accel::settings::ParameterColumns;
 use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
@@ -47,11 +48,20 @@ struct FrameCsv<'a> {
     differing_pixels: usize,
 }
 
+/// A row of builds.csv: the scene size and structure, its parameters one column each, then its
+/// build's time and memory.
+type BuildCsv<'a> = (Built<'a>, ParameterColumns, BuildCost);
+
+/// The columns before the parameters in builds.csv.
 #[derive(Serialize)]
-struct BuildCsv<'a> {
+struct Built<'a> {
     triangles: usize,
     structure: &'a str,
-    parameters: String,
+}
+
+/// The columns after the parameters in builds.csv.
+#[derive(Serialize)]
+struct BuildCost {
     #[serde(with = "float")]
     build_s: f64,
     memory_bytes: u64,
@@ -94,12 +104,18 @@ pub fn write_frames(
     )?;
     write_rows(
         &out.join("builds.csv"),
-        outcome.builds.iter().map(|b: &BuildRow| BuildCsv {
-            triangles: b.triangles,
-            structure: b.structure,
-            parameters: b.settings.describe(),
-            build_s: b.build_seconds,
-            memory_bytes: b.memory_bytes,
+        outcome.builds.iter().map(|b: &BuildRow| -> BuildCsv {
+            (
+                Built {
+                    triangles: b.triangles,
+                    structure: b.structure,
+                },
+                ParameterColumns::of(&b.settings),
+                BuildCost {
+                    build_s: b.build_seconds,
+                    memory_bytes: b.memory_bytes,
+                },
+            )
         }),
     )?;
     write_rows(&out.join("summary.csv"), summarise(spec, outcome))?;
@@ -285,9 +301,9 @@ struct Summary {
     #[serde(with = "float")]
     rays: f64,
     #[serde(with = "float")]
-    nodes: f64,
+    nodes_visited: f64,
     #[serde(with = "float")]
-    tests: f64,
+    primitive_tests: f64,
     frames: usize,
 }
 
@@ -337,8 +353,8 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     update,
                     update_s: update.median,
                     rays: of(|r| r.rays.total()),
-                    nodes: of(|r| r.work.nodes),
-                    tests: of(|r| r.work.primitives),
+                    nodes_visited: of(|r| r.work.nodes),
+                    primitive_tests: of(|r| r.work.primitives),
                     frames: sel.len(),
                 });
             }
@@ -391,8 +407,8 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
                 r.update.show(4)
             },
             r.rays,
-            r.nodes,
-            r.tests,
+            r.nodes_visited,
+            r.primitive_tests,
             r.frames
         );
     }
