@@ -125,11 +125,14 @@ impl<'a> LinePlot<'a> {
             if !lo.is_finite() {
                 return (1.0, 2.0);
             }
-            if log {
-                (lo / 1.3, hi * 1.3)
-            } else {
-                let d = (hi - lo).max(1e-12 * hi.abs().max(1e-300));
-                (lo - 0.06 * d, hi + 0.06 * d)
+            let single = hi - lo <= 1e-9 * hi.abs().max(lo.abs());
+            match (log, single) {
+                // One value: a range around it, so that the axis still has labels.
+                (true, true) => (lo / 2.0, hi * 2.0),
+                (false, true) if lo == 0.0 => (-1.0, 1.0),
+                (false, true) => (lo - 0.2 * lo.abs(), hi + 0.2 * hi.abs()),
+                (true, false) => (lo / 1.3, hi * 1.3),
+                (false, false) => (lo - 0.06 * (hi - lo), hi + 0.06 * (hi - lo)),
             }
         };
         let x = axes
@@ -265,12 +268,16 @@ impl<'a> LinePlot<'a> {
             }
         }
         for (i, r) in self.references.iter().enumerate() {
-            let line: Vec<(i32, i32)> = r
+            let mut line: Vec<(i32, i32)> = r
                 .points
                 .iter()
                 .filter(|p| valid(p.0, p.1))
                 .map(|p| px(p.0, p.1))
                 .collect();
+            if let [(x, y)] = line[..] {
+                // A reference at one x: a level mark across it.
+                line = vec![(x - 24, y), (x + 24, y)];
+            }
             let c = r.colour.map_or(REFERENCE_GREY, colour);
             draw_line(root, &line, rect, c, Some(reference_dash(i)))?;
         }

@@ -230,3 +230,27 @@ fn an_error_map_gets_a_colour_bar_from_blue_to_red() {
     );
     assert!(right - left > img.width() / 2);
 }
+
+#[test]
+fn an_axis_over_one_value_is_still_labelled() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("one.png");
+    let series = [(
+        0,
+        Series {
+            name: "one radius".into(),
+            points: vec![(20.0, 14.0, 0.5)],
+            dashed: false,
+        },
+    )];
+    line_plot(
+        &path,
+        &Axes::new("t", "light radius (mm)", "width (mm)", false, false),
+        &series,
+        &[],
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(path.with_extension("svg")).unwrap();
+    let doc = Document::parse(&text).unwrap();
+    assert!(text_at(&doc, "20").is_some(), "the one x value is labelled");
+}

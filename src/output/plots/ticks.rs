@@ -173,18 +173,18 @@ fn round_sig(v: f64) -> f64 {
 }
 
 /// A tick label: at most four significant digits, no trailing zeros; exponent form (`1e6`,
-/// `2.5e-5`) from 100 000 up and below 0.001, so that labels stay short.
+/// `2.5e-5`) from a million up and below 0.0001, so that labels stay short.
 pub fn label(v: f64) -> String {
     label_in(v, wants_exponent(v))
 }
 
 /// Whether `v` reads better in exponent form.
 fn wants_exponent(v: f64) -> bool {
-    v != 0.0 && v.is_finite() && !(1e-3..1e5).contains(&v.abs())
+    v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs())
 }
 
-/// How the labels of one axis read: all in exponent form if any wants it (`5e-4`, `1e-3`, never
-/// `5e-4` beside `0.001`).
+/// How the labels of one axis read: all in exponent form if any wants it (`5e-5`, `1e-4`, never
+/// `5e-5` beside `0.0001`).
 pub fn axis_labels(values: &[f64]) -> impl Fn(&f64) -> String {
     let exponent = values.iter().any(|v| wants_exponent(*v));
     move |v| label_in(*v, exponent)
@@ -220,7 +220,7 @@ mod tests {
         for (v, s) in [
             (0.7000000000000001, "0.7"),
             (1000000.0, "1e6"),
-            (25000.0, "25000"),
+            (250000.0, "250000"),
             (0.00001, "1e-5"),
             (0.000025, "2.5e-5"),
             (0.002, "0.002"),
@@ -244,8 +244,10 @@ mod tests {
 
     #[test]
     fn an_axis_reads_in_one_form() {
-        let f = axis_labels(&[5e-4, 1e-3, 2e-3]);
-        assert_eq!([f(&5e-4), f(&1e-3), f(&2e-3)], ["5e-4", "1e-3", "2e-3"]);
+        let f = axis_labels(&[5e-5, 1e-4, 2e-4]);
+        assert_eq!([f(&5e-5), f(&1e-4), f(&2e-4)], ["5e-5", "1e-4", "2e-4"]);
+        let f = axis_labels(&[5e-4, 1e-3, 0.5]);
+        assert_eq!([f(&5e-4), f(&1e-3), f(&0.5)], ["0.0005", "0.001", "0.5"]);
         let f = axis_labels(&[0.0, 0.5, 1.0]);
         assert_eq!([f(&0.0), f(&0.5), f(&1.0)], ["0", "0.5", "1"]);
     }
