@@ -6,12 +6,18 @@
 //! In an experiment that tunes, a key may hold a list: every combination is a candidate
 //! ([`candidates`]); where the file gives no list, the structure's own grid is tried
 //! ([`Params::tuning`]).
+//!
+//! In tables the parameters are spread one value per column ([`ParameterColumns`]): a column
+//! per parameter of every registered structure, `STRUCTURE_KEY` (`vlf_depth`,
+//! `kdtree_max_depth`, `bvh_preset`), empty where a row's structure is another.
 
 use super::{registered, Registered};
 use crate::config::{ConfigError, Seg, Source};
-use serde::de::DeserializeOwned;
-use serde::Serialize;
+use serde::de::{DeserializeOwned, SeqAccess, Visitor};
+use serde::ser::SerializeStruct;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
 /// A structure's typed parameters: serde with defaults for absent keys and unknown keys
 /// refused, plus the checks serde cannot make.
@@ -68,17 +74,22 @@ impl AccelSettings {
             .expect("settings hold validated parameters")
     }
 
+    /// The text of parameter `key`'s value (a string without quotes), if it has that key.
+    pub fn value(&self, key: &str) -> Option<String> {
+        self.params.get(key).map(|v| match v {
+            toml::Value::String(s) => s.clone(),
+            v => v.to_string(),
+        })
+    }
+
     /// `key=value` pairs, in key order: the parameters in a few words.
     pub fn describe(&self) -> String {
         if self.params.is_empty() {
             return "defaults".into();
         }
         self.params
-            .iter()
-            .map(|(k, v)| match v {
-                toml::Value::String(s) => format!("{k}={s}"),
-                v => format!("{k}={v}"),
-            })
+            .keys()
+            .map(|k| format!("{k}={}", self.value(k).unwrap_or_default()))
             .collect::<Vec<_>>()
             .join(" ")
     }
@@ -87,6 +98,109 @@ impl AccelSettings {
 impl Default for AccelSettings {
     fn default() -> Self {
         AccelSettings::default_for(&super::REGISTRY[0])
+    }
+}
+
+/// A parameter of a registered structure, as a table column.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParameterColumn {
+    /// The structure's registry name.
+    pub structure: &'static str,
+    /// The parameter's key in `[accel.STRUCTURE]`.
+    pub key: String,
+    /// The column's name, `STRUCTURE_KEY`.
+    pub name: String,
+}
+
+/// One column per parameter of every registered structure, in registry and then key order.
+pub fn parameter_columns() -> &'static [ParameterColumn] {
+    static COLUMNS: OnceLock<Vec<ParameterColumn>> = OnceLock::new();
+    COLUMNS.get_or_init(|| {
+        super::REGISTRY
+            .iter()
+            .flat_map(|r| {
+                AccelSettings::default_for(r)
+                    .params
+                    .into_iter()
+                    .map(|(key, _)| ParameterColumn {
+                        structure: r.name,
+                        name: format!("{}_{key}", r.name),
+                        key,
+                    })
+            })
+            .collect()
+    })
+}
+
+/// A row's structure parameters as table columns, one value per column
+/// ([`parameter_columns`]): its own structure's columns hold its values, every other column is
+/// empty, so that a table can be filtered on any one parameter.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParameterColumns(Vec<String>);
+
+impl ParameterColumns {
+    /// No structure: every column empty.
+    pub fn none() -> ParameterColumns {
+        ParameterColumns(vec![String::new(); parameter_columns().len()])
+    }
+
+    /// The columns of `settings`.
+    pub fn of(settings: &AccelSettings) -> ParameterColumns {
+        ParameterColumns(
+            parameter_columns()
+                .iter()
+                .map(|c| {
+                    (c.structure == settings.name)
+                        .then(|| settings.value(&c.key))
+                        .flatten()
+                        .unwrap_or_default()
+                })
+                .collect(),
+        )
+    }
+
+    /// The value in column `name` (empty where the row's structure has no such parameter).
+    pub fn get(&self, name: &str) -> Option<&str> {
+        let i = parameter_columns().iter().position(|c| c.name == name)?;
+        self.0.get(i).map(String::as_str)
+    }
+}
+
+impl Serialize for ParameterColumns {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let columns = parameter_columns();
+        let mut row = s.serialize_struct("ParameterColumns", columns.len())?;
+        for (c, v) in columns.iter().zip(&self.0) {
+            row.serialize_field(c.name.as_str(), v)?;
+        }
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for ParameterColumns {
+    /// Reads the columns by position, as many as [`parameter_columns`] names.
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<ParameterColumns, D::Error> {
+        struct Columns;
+        impl<'de> Visitor<'de> for Columns {
+            type Value = ParameterColumns;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "{} parameter columns", parameter_columns().len())
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<ParameterColumns, A::Error> {
+                let n = parameter_columns().len();
+                let mut values = Vec::with_capacity(n);
+                for i in 0..n {
+                    values.push(
+                        seq.next_element::<String>()?
+                            .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?,
+                    );
+                }
+                Ok(ParameterColumns(values))
+            }
+        }
+        d.deserialize_tuple(parameter_columns().len(), Columns)
     }
 }
 
@@ -191,4 +305,71 @@ pub fn candidates(r: &Registered, table: &toml::Table) -> Result<Vec<AccelSettin
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::table::{read_rows, write_rows};
+
+    #[test]
+    fn every_parameter_of_every_structure_has_its_own_column() {
+        let names: Vec<&str> = parameter_columns().iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "bvh_preset",
+                "vlf_depth",
+                "vlf_leaf_size",
+                "vlf_level",
+                "vlf_split",
+                "vlf_tiles",
+                "kdtree_leaf_size",
+                "kdtree_max_depth"
+            ]
+        );
+        let kd = AccelSettings::with("kdtree", &toml::toml! { max_depth = 7 }).unwrap();
+        let columns = ParameterColumns::of(&kd);
+        assert_eq!(columns.get("kdtree_max_depth"), Some("7"));
+        assert_eq!(columns.get("kdtree_leaf_size"), Some("8"));
+        assert_eq!(columns.get("vlf_leaf_size"), Some(""));
+        assert_eq!(columns.get("parameters"), None);
+        let bvh = ParameterColumns::of(&AccelSettings::named("bvh").unwrap());
+        assert_eq!(bvh.get("bvh_preset"), Some("medium"));
+        assert_eq!(bvh.get("kdtree_max_depth"), Some(""));
+    }
+
+    #[derive(Serialize, Deserialize, Debug, PartialEq)]
+    struct Key {
+        structure: String,
+    }
+
+    #[test]
+    fn parameter_columns_read_back_as_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        let rows: Vec<(Key, ParameterColumns, Key)> = ["vlf", "brute", "kdtree"]
+            .iter()
+            .map(|name| {
+                let key = || Key {
+                    structure: name.to_string(),
+                };
+                (key(), ParameterColumns::of(&AccelSettings::named(name).unwrap()), key())
+            })
+            .chain([(
+                Key {
+                    structure: "none".into(),
+                },
+                ParameterColumns::none(),
+                Key {
+                    structure: "none".into(),
+                },
+            )])
+            .collect();
+        write_rows(&path, &rows).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("structure,bvh_preset,vlf_depth,"), "{text}");
+        assert!(text.contains("\nbrute,,,,,,,,,brute\n"), "{text}");
+        assert_eq!(read_rows::<(Key, ParameterColumns, Key)>(&path), rows);
+    }
 }

@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 use std::path::{Component, Path, PathBuf};
 
 /// Version of the manifest and of the tables beside it; raised when a column or key changes
-/// meaning.
-pub const SCHEMA: u32 = 2;
+/// name or meaning. 3: structure parameters one column each (`vlf_depth`, ...) instead of a
+/// `parameters` text; fps.csv's rates `frames_per_s` and `paper_frames_per_s`; frames'
+/// summary.csv names its work `nodes_visited` and `primitive_tests`.
+pub const SCHEMA: u32 = 3;
 
 /// A results folder's provenance.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

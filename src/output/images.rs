@@ -74,15 +74,21 @@ pub fn diverging(a: &[f32], b: &[f32], scale: f64, width: u32, height: u32) -> R
             if x == NO_RECEIVER || y == NO_RECEIVER {
                 return NO_RECEIVER_RGB;
             }
-            let t = ((x - y) as f64 / scale).clamp(-1.0, 1.0);
-            if t >= 0.0 {
-                [255, to_byte(1.0 - t), to_byte(1.0 - t)]
-            } else {
-                [to_byte(1.0 + t), to_byte(1.0 + t), 255]
-            }
+            diverging_colour((x - y) as f64 / scale)
         })
         .collect();
     Rgb { width, height, data }
+}
+
+/// The colour [`diverging`] gives a difference of `t` times its scale: white at 0, full red at
+/// +1 and beyond, full blue at -1 and below (also what a colour bar beside the map shows).
+pub fn diverging_colour(t: f64) -> [u8; 3] {
+    let t = t.clamp(-1.0, 1.0);
+    if t >= 0.0 {
+        [255, to_byte(1.0 - t), to_byte(1.0 - t)]
+    } else {
+        [to_byte(1.0 + t), to_byte(1.0 + t), 255]
+    }
 }
 
 /// Writes a PNG atomically.

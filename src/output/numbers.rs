@@ -44,6 +44,19 @@ pub fn bias2(split: &BiasVariance) -> String {
     }
 }
 
+/// A count with thin spaces between its thousands (`12 345`), for titles and axis notes.
+pub fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push('\u{2009}');
+        }
+        out.push(c);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -64,6 +77,13 @@ mod tests {
         assert_eq!(with_ci(f64::NAN, 0.001, mm), "n/a");
         assert_eq!(with_ci(0.014, 0.0004, mm), "14.00 mm ± 0.40 mm");
         assert_eq!(or_na(f64::INFINITY, |x| x.to_string()), "n/a");
+    }
+
+    #[test]
+    fn thousands_are_set_apart() {
+        assert_eq!(thousands(7), "7");
+        assert_eq!(thousands(5804), "5\u{2009}804");
+        assert_eq!(thousands(1_234_567), "1\u{2009}234\u{2009}567");
     }
 
     #[test]

@@ -37,11 +37,37 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         "images/cow_vlf.png",
         "images/mech-holes-shark_kdtree.exr",
         "plots/frame_time.png",
+        "plots/frame_time.svg",
         "index.html",
     ] {
         assert!(out.join(file).exists(), "{file} missing");
     }
+    // Frame time is drawn as bars grouped by mesh, each mesh named under its group and each
+    // structure in the legend.
+    let svg = std::fs::read_to_string(out.join("plots/frame_time.svg")).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let texts: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .filter_map(|n| n.text())
+        .map(str::trim)
+        .collect();
+    for name in [
+        "cow",
+        "mech-holes-shark",
+        "kdtree",
+        "vlf",
+        "bvh",
+        "brute",
+        "95 % interval",
+    ] {
+        assert!(texts.contains(&name), "frame_time.svg lacks {name}: {texts:?}");
+    }
+    assert!(texts.iter().any(|t| t.ends_with("triangles")), "{texts:?}");
     common::browser::check_page(&out);
+    let tables = common::assert_tidy_tables(&out);
+    assert_eq!(tables.len(), 2, "ao.csv and tuning.csv: {tables:?}");
+    assert!(header.iter().any(|h| h == "vlf_depth") && header.iter().any(|h| h == "kdtree_max_depth"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
     assert!(

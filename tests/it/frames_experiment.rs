@@ -32,6 +32,13 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let (header, rows, report) = run(dir.path(), &ci());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
+    let tables = common::assert_tidy_tables(&dir.path().join("out"));
+    assert_eq!(tables.len(), 3, "frames.csv, builds.csv and summary.csv: {tables:?}");
+    let builds = std::fs::read_to_string(dir.path().join("out/builds.csv")).unwrap();
+    assert!(
+        builds.starts_with("triangles,structure,bvh_preset,") && builds.contains("\n51224,vlf,,3,32,4,uniform,32,,,"),
+        "the field's parameters one per column: {builds}"
+    );
     for r in &rows {
         let same_frame: Vec<&csv::StringRecord> = rows
             .iter()
@@ -72,7 +79,9 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
         "summary.csv",
         "manifest.toml",
         "plots/frame_time_opengl.png",
+        "plots/frame_time_opengl.svg",
         "plots/frame_time_whitted.png",
+        "plots/frame_time_whitted.svg",
         "images/strip_opengl.png",
         "images/strip_whitted.png",
         "images/strip_whitted_0.exr",
@@ -109,7 +118,14 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 2 * 2 * 4, "sizes x viewpoints x frames x structures");
     assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
-    for file in ["plots/scaling_opengl.png", "plots/memory.png", "plots/build_time.png"] {
+    for file in [
+        "plots/scaling_opengl.png",
+        "plots/scaling_opengl.svg",
+        "plots/memory.png",
+        "plots/memory.svg",
+        "plots/build_time.png",
+        "plots/build_time.svg",
+    ] {
         assert!(dir.path().join("out").join(file).exists(), "{file} missing");
     }
     assert!(report.contains("median frame time grows as kdtree N^"), "{report}");

@@ -262,6 +262,7 @@ fn three_shards_merged_give_the_unsharded_tables_and_figures() {
             "images/fig2_measure.png",
             "images/ground_truth.exr",
             "plots/profiles.png",
+            "plots/profiles.svg",
             "plots/rmse_vs_samples.png",
         ],
     );

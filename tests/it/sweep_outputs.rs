@@ -67,7 +67,7 @@ fn identical_inputs_give_identical_runs_csv_and_resume_reproduces_it() {
     assert!(log.contains("0 groups resumed"), "{log}");
     let manifest = std::fs::read_to_string(c.join("manifest.toml")).unwrap();
     for key in [
-        "schema = 2",
+        "schema = 3",
         "kind = \"sweep\"",
         "[build]",
         "commit = ",

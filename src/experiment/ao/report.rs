@@ -4,22 +4,32 @@
 
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
+use crate::accel::settings::ParameterColumns;
 use crate::experiment::outputs::Outputs;
 use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
+use crate::output::numbers::thousands;
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
-use crate::output::plots::{line_plot, Axes, Series};
+use crate::output::plots::{grouped_bars, Bar, Group};
 use crate::output::table::{float, write_rows};
 use serde::Serialize;
 
-/// A row of ao.csv.
+/// A row of ao.csv: what was measured ([`Measured`]) after the mesh, the structure and its
+/// parameters, one column each ([`ParameterColumns`]).
+type CsvRow<'a> = (Named<'a>, ParameterColumns, Measured);
+
+/// The columns before the parameters in ao.csv.
 #[derive(Serialize)]
-struct CsvRow<'a> {
+struct Named<'a> {
     mesh: &'a str,
     triangles: usize,
     structure: &'a str,
-    parameters: String,
+}
+
+/// The columns after the parameters in ao.csv.
+#[derive(Serialize)]
+struct Measured {
     #[serde(with = "float")]
     build_s: f64,
     memory_bytes: u64,
@@ -43,12 +53,20 @@ struct CsvRow<'a> {
     same_image_as_first: bool,
 }
 
-/// A row of tuning.csv.
+/// A row of tuning.csv: a candidate's mesh and structure, its parameters one column each, then
+/// its time and work.
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, Candidate);
+
+/// The columns before the parameters in tuning.csv.
 #[derive(Serialize)]
-struct TuningCsv<'a> {
+struct Tuned<'a> {
     mesh: &'a str,
     structure: &'a str,
-    parameters: String,
+}
+
+/// The columns after the parameters in tuning.csv.
+#[derive(Serialize)]
+struct Candidate {
     #[serde(with = "float")]
     frame_s: f64,
     #[serde(with = "float")]
@@ -179,38 +197,50 @@ pub fn write_ao(
     let out = |name: &str| outputs.path(name);
     write_rows(
         &out("tuning.csv")?,
-        tuning.iter().map(|t| TuningCsv {
-            mesh: &t.mesh,
-            structure: t.structure,
-            parameters: t.settings.describe(),
-            frame_s: t.frame.median,
-            frame_s_lo: t.frame.lo,
-            frame_s_hi: t.frame.hi,
-            nodes_visited: t.work.nodes,
-            primitive_tests: t.work.primitives,
-            chosen: t.chosen,
+        tuning.iter().map(|t| -> TuningCsv {
+            (
+                Tuned {
+                    mesh: &t.mesh,
+                    structure: t.structure,
+                },
+                ParameterColumns::of(&t.settings),
+                Candidate {
+                    frame_s: t.frame.median,
+                    frame_s_lo: t.frame.lo,
+                    frame_s_hi: t.frame.hi,
+                    nodes_visited: t.work.nodes,
+                    primitive_tests: t.work.primitives,
+                    chosen: t.chosen,
+                },
+            )
         }),
     )?;
-    let csv = rows.iter().map(|r| CsvRow {
-        mesh: &r.mesh,
-        triangles: r.triangles,
-        structure: r.structure,
-        parameters: r.settings.describe(),
-        build_s: r.build_seconds,
-        memory_bytes: r.memory_bytes,
-        timed_frames: r.frame_seconds.len(),
-        frame_s: r.frame.median,
-        frame_s_lo: r.frame.lo,
-        frame_s_hi: r.frame.hi,
-        primary_rays: r.rays.0,
-        ao_rays: r.rays.1,
-        queries: r.work.queries,
-        nodes_visited: r.work.nodes,
-        primitive_tests: r.work.primitives,
-        rays_per_s: r.mrays_per_s() * 1e6,
-        receivers: r.receivers,
-        mean_ao: r.mean_ao,
-        same_image_as_first: r.same_image,
+    let csv = rows.iter().map(|r| -> CsvRow {
+        (
+            Named {
+                mesh: &r.mesh,
+                triangles: r.triangles,
+                structure: r.structure,
+            },
+            ParameterColumns::of(&r.settings),
+            Measured {
+                build_s: r.build_seconds,
+                memory_bytes: r.memory_bytes,
+                timed_frames: r.frame_seconds.len(),
+                frame_s: r.frame.median,
+                frame_s_lo: r.frame.lo,
+                frame_s_hi: r.frame.hi,
+                primary_rays: r.rays.0,
+                ao_rays: r.rays.1,
+                queries: r.work.queries,
+                nodes_visited: r.work.nodes,
+                primitive_tests: r.work.primitives,
+                rays_per_s: r.rays_per_s(),
+                receivers: r.receivers,
+                mean_ao: r.mean_ao,
+                same_image_as_first: r.same_image,
+            },
+        )
     });
     write_rows(&out("ao.csv")?, csv)?;
     let galleries = galleries(spec, rows);
@@ -221,40 +251,48 @@ pub fn write_ao(
         }
         write_shots(outputs.dir(), g)?;
     }
-    let series: Vec<(usize, Series)> = spec
+    let groups: Vec<Group> = spec
+        .meshes
+        .iter()
+        .filter_map(|m| {
+            let of_mesh: Vec<&AoRow> = rows.iter().filter(|r| r.mesh == m.name).collect();
+            let first = of_mesh.first()?;
+            let bars = spec
+                .structures
+                .iter()
+                .enumerate()
+                .filter_map(|(i, (s, _))| {
+                    let r = of_mesh.iter().find(|r| r.structure == *s)?;
+                    Some(Bar {
+                        series: i,
+                        value: r.frame.median,
+                        lo: r.frame.lo,
+                        hi: r.frame.hi,
+                    })
+                })
+                .collect();
+            Some(Group {
+                name: m.name.clone(),
+                note: format!("{} triangles", thousands(first.triangles)),
+                bars,
+            })
+        })
+        .collect();
+    let names: Vec<(usize, String)> = spec
         .structures
         .iter()
         .enumerate()
-        .map(|(i, (s, _))| {
-            let points = rows
-                .iter()
-                .filter(|r| r.structure == *s)
-                .map(|r| (r.triangles as f64, r.frame.median, f64::NAN))
-                .collect();
-            (
-                i,
-                Series {
-                    name: s.to_string(),
-                    points,
-                    dashed: false,
-                },
-            )
-        })
+        .map(|(i, (s, _))| (i, s.to_string()))
         .collect();
-    line_plot(
+    grouped_bars(
         &out("plots/frame_time.png")?,
-        &Axes::new(
-            &format!(
-                "AO, {} rays per hit, {}x{}, CPU f64",
-                spec.ao.rays, spec.width, spec.height
-            ),
-            "triangles",
-            "frame seconds (median)",
-            true,
-            true,
+        &format!(
+            "AO frame time per mesh: {} rays per hit, {}x{}, CPU f64",
+            spec.ao.rays, spec.width, spec.height
         ),
-        &series,
-        &[],
+        "frame time, median (s)",
+        &names,
+        &groups,
     )?;
     let report = report(spec, rows, threads, seconds);
     write_atomic(&out("report.md")?, report.as_bytes())?;
@@ -352,7 +390,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             r.build_seconds,
             r.memory_bytes as f64 / 1e6,
             r.frame.show(3),
-            r.mrays_per_s(),
+            r.rays_per_s() / 1e6,
             r.work.nodes as f64,
             r.work.primitives as f64,
             if r.same_image { "yes" } else { "NO" }

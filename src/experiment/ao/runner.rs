@@ -51,9 +51,9 @@ pub struct AoRow {
 }
 
 impl AoRow {
-    /// Rays (camera and AO) per second at the median frame time, millions.
-    pub fn mrays_per_s(&self) -> f64 {
-        (self.rays.0 + self.rays.1) as f64 / self.frame.median / 1e6
+    /// Rays (camera and AO) per second at the median frame time.
+    pub fn rays_per_s(&self) -> f64 {
+        (self.rays.0 + self.rays.1) as f64 / self.frame.median
     }
 }
 

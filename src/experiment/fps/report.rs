@@ -129,9 +129,9 @@ struct CsvRow<'a> {
     #[serde(with = "float")]
     frame_s_hi: f64,
     #[serde(with = "float")]
-    fps: f64,
+    frames_per_s: f64,
     #[serde(with = "float")]
-    paper_fps: f64,
+    paper_frames_per_s: f64,
     primary_rays: u64,
     shadow_rays: u64,
     queries: Option<u64>,
@@ -157,8 +157,8 @@ impl<'a> CsvRow<'a> {
             frame_s: r.frame.median,
             frame_s_lo: r.frame.lo,
             frame_s_hi: r.frame.hi,
-            fps: r.fps().median,
-            paper_fps: r.paper_fps,
+            frames_per_s: r.fps().median,
+            paper_frames_per_s: r.paper_fps,
             primary_rays: r.primary_rays,
             shadow_rays: r.shadow_rays,
             queries: r.work.map(|w| w.queries),

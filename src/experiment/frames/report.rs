@@ -6,12 +6,14 @@
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{FramesSpec, Generator};
 use super::verdict::{label, labels, median_at, verdict};
+use crate::accel::settings::ParameterColumns;
 use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
+use crate::output::numbers::thousands;
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
-use crate::output::plots::{image_grid, line_plot, Axes, Series};
+use crate::output::plots::{image_grid, line_plot, Axes, Series, Tile};
 use crate::output::table::{float, write_rows};
 use crate::scene::procedural::random;
 use serde::Serialize;
@@ -47,11 +49,20 @@ struct FrameCsv<'a> {
     differing_pixels: usize,
 }
 
+/// A row of builds.csv: the scene size and structure, its parameters one column each, then its
+/// build's time and memory.
+type BuildCsv<'a> = (Built<'a>, ParameterColumns, BuildCost);
+
+/// The columns before the parameters in builds.csv.
 #[derive(Serialize)]
-struct BuildCsv<'a> {
+struct Built<'a> {
     triangles: usize,
     structure: &'a str,
-    parameters: String,
+}
+
+/// The columns after the parameters in builds.csv.
+#[derive(Serialize)]
+struct BuildCost {
     #[serde(with = "float")]
     build_s: f64,
     memory_bytes: u64,
@@ -94,12 +105,18 @@ pub fn write_frames(
     )?;
     write_rows(
         &out.join("builds.csv"),
-        outcome.builds.iter().map(|b: &BuildRow| BuildCsv {
-            triangles: b.triangles,
-            structure: b.structure,
-            parameters: b.settings.describe(),
-            build_s: b.build_seconds,
-            memory_bytes: b.memory_bytes,
+        outcome.builds.iter().map(|b: &BuildRow| -> BuildCsv {
+            (
+                Built {
+                    triangles: b.triangles,
+                    structure: b.structure,
+                },
+                ParameterColumns::of(&b.settings),
+                BuildCost {
+                    build_s: b.build_seconds,
+                    memory_bytes: b.memory_bytes,
+                },
+            )
         }),
     )?;
     write_rows(&out.join("summary.csv"), summarise(spec, outcome))?;
@@ -128,17 +145,18 @@ pub fn write_frames(
                 .collect()
         };
         let title = format!(
-            "{} shading, {}x{}, {}K triangles, viewpoint {}, CPU f64",
+            "{} shading, {}x{}, {} triangles, viewpoint {}, CPU f64",
             shading.name(),
             spec.width,
             spec.height,
-            largest as f64 / 1e3,
+            thousands(largest),
             spec.viewpoints[0]
         );
+        let frame_times = series(&|r| r.seconds);
         line_plot(
             &out.join(format!("plots/frame_time_{}.png", shading.name())),
-            &Axes::new(&title, "frame", "render seconds", false, false),
-            &series(&|r| r.seconds),
+            &Axes::new(&title, "frame", "render seconds", false, spread(&frame_times) > 30.0),
+            &frame_times,
             &[],
         )?;
         if spec.motion.is_some() {
@@ -238,7 +256,7 @@ pub fn write_frames(
                 )
             })
             .collect();
-        let tiles: Vec<(String, &_)> = pictures.iter().map(|(c, img)| (c.clone(), img)).collect();
+        let tiles: Vec<Tile> = pictures.iter().map(|(c, img)| Tile::new(c.clone(), img)).collect();
         image_grid(
             &out.join(format!("images/strip_{}.png", shading.name())),
             &tiles,
@@ -295,6 +313,18 @@ fn strips(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Gallery> {
         .collect()
 }
 
+/// The largest positive y of `series` over the smallest: where it is large, one structure's
+/// times would flatten the others' on a linear axis.
+fn spread(series: &[(usize, Series)]) -> f64 {
+    let ys = || {
+        series
+            .iter()
+            .flat_map(|(_, s)| s.points.iter().map(|p| p.1))
+            .filter(|y| *y > 0.0)
+    };
+    ys().fold(0.0, f64::max) / ys().fold(f64::INFINITY, f64::min)
+}
+
 /// One structure (and way of following motion) at one scene size and shading, over its path:
 /// a row of summary.csv and of the report's medians.
 #[derive(Serialize)]
@@ -316,9 +346,9 @@ struct Summary {
     #[serde(with = "float")]
     rays: f64,
     #[serde(with = "float")]
-    nodes: f64,
+    nodes_visited: f64,
     #[serde(with = "float")]
-    tests: f64,
+    primitive_tests: f64,
     frames: usize,
 }
 
@@ -368,8 +398,8 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     update,
                     update_s: update.median,
                     rays: of(|r| r.rays.total()),
-                    nodes: of(|r| r.work.nodes),
-                    tests: of(|r| r.work.primitives),
+                    nodes_visited: of(|r| r.work.nodes),
+                    primitive_tests: of(|r| r.work.primitives),
                     frames: sel.len(),
                 });
             }
@@ -422,8 +452,8 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
                 r.update.show(4)
             },
             r.rays,
-            r.nodes,
-            r.tests,
+            r.nodes_visited,
+            r.primitive_tests,
             r.frames
         );
     }

@@ -120,10 +120,10 @@ struct FrameRow {
     frames: usize,
     frame: usize,
     #[serde(with = "float")]
-    frame_seconds: f64,
+    frame_s: f64,
     /// NaN where the clock does not split passes.
     #[serde(with = "float")]
-    primary_seconds: f64,
+    primary_s: f64,
     clock: String,
 }
 
@@ -168,9 +168,9 @@ impl Journal {
                 *frames = usize::MAX;
                 continue;
             }
-            t.frame_seconds.push(f.frame_seconds);
-            if !f.primary_seconds.is_nan() {
-                t.primary_seconds.push(f.primary_seconds);
+            t.frame_seconds.push(f.frame_s);
+            if !f.primary_s.is_nan() {
+                t.primary_seconds.push(f.primary_s);
             }
             t.clock = f.clock;
         }
@@ -200,8 +200,8 @@ impl Journal {
                 settings: settings.to_string(),
                 frames: t.frame_seconds.len(),
                 frame: i,
-                frame_seconds: s,
-                primary_seconds: t.primary_seconds.get(i).copied().unwrap_or(f64::NAN),
+                frame_s: s,
+                primary_s: t.primary_seconds.get(i).copied().unwrap_or(f64::NAN),
                 clock: t.clock.clone(),
             })
         });

@@ -5,6 +5,7 @@ use super::record::{Device, FrameTime, Metrics, Radial, RayCounts, Record, Spect
 use super::reference::{shadow_image, Reference};
 use super::run::Run;
 use super::spec::Spec;
+use crate::accel::settings::ParameterColumns;
 use crate::metrics::spectrum::{blurred_rmse, error_spectrum};
 use crate::metrics::{penumbra_coverage, ErrorMetrics, RadialProfile};
 use crate::render::{Backend, Sampling, View};
@@ -22,6 +23,7 @@ fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, stat
         rays: RayCounts::default(),
         time: FrameTime::UNTIMED,
         structure: StructureColumns::NONE,
+        parameters: ParameterColumns::none(),
         device: Device::of(backend.adapter()),
         image_fnv1a: String::new(),
         error: error.to_string(),
@@ -80,8 +82,8 @@ pub fn measure_run(
     };
     if let Some(a) = &scene.accel {
         let stats = a.stats();
+        r.parameters = ParameterColumns::of(&scene.accel_settings);
         r.structure = StructureColumns {
-            parameters: Some(scene.accel_settings.describe()),
             build_s: stats.build_time.as_secs_f64(),
             gpu_bytes_per_triangle: stats.gpu_bytes as f64 / stats.triangles as f64,
         };

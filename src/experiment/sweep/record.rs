@@ -3,6 +3,7 @@
 //! rows byte for byte); each metric is defined in `metrics` or README.md.
 
 use super::axes::Run;
+use crate::accel::settings::ParameterColumns;
 use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::table::{float, Float};
 use crate::render::AdapterInfo;
@@ -43,6 +44,8 @@ pub struct Record {
     pub time: FrameTime,
     /// The scene's acceleration structure, on mesh scenes.
     pub structure: StructureColumns,
+    /// Its parameters, one column each (empty without meshes).
+    pub parameters: ParameterColumns,
     /// The device that rendered it.
     pub device: Device,
     /// FNV-1a of the shadow image's f32 bits: runs that differ only in the acceleration
@@ -75,6 +78,7 @@ type Parts = (
     RayCounts,
     FrameTime,
     StructureColumns,
+    ParameterColumns,
     Device,
     Tail,
 );
@@ -98,6 +102,7 @@ impl Serialize for Record {
             &self.rays,
             &self.time,
             &self.structure,
+            &self.parameters,
             &self.device,
             tail,
         )
@@ -107,7 +112,8 @@ impl Serialize for Record {
 
 impl<'de> Deserialize<'de> for Record {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Record, D::Error> {
-        let (head, run, radial, metrics, spectrum, rays, time, structure, device, tail) = Parts::deserialize(d)?;
+        let (head, run, radial, metrics, spectrum, rays, time, structure, parameters, device, tail) =
+            Parts::deserialize(d)?;
         Ok(Record {
             run_key: head.run_key,
             status: head.status,
@@ -118,6 +124,7 @@ impl<'de> Deserialize<'de> for Record {
             rays,
             time,
             structure,
+            parameters,
             device,
             image_fnv1a: tail.image_fnv1a,
             error: tail.error,
@@ -347,11 +354,10 @@ impl FrameTime {
     };
 }
 
-/// The scene's acceleration structure: its parameters, build time and GPU memory per triangle.
+/// The scene's acceleration structure: its build time and GPU memory per triangle (its
+/// parameters follow, [`ParameterColumns`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StructureColumns {
-    /// Its parameters (`key=value` pairs).
-    pub parameters: Option<String>,
     /// Build time (s).
     #[serde(with = "float")]
     pub build_s: f64,
@@ -363,7 +369,6 @@ pub struct StructureColumns {
 impl StructureColumns {
     /// No structure (no meshes).
     pub const NONE: StructureColumns = StructureColumns {
-        parameters: None,
         build_s: f64::NAN,
         gpu_bytes_per_triangle: f64::NAN,
     };

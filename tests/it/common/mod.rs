@@ -51,6 +51,46 @@ pub fn earlier_results(out: &std::path::Path, kind: &str, name: &str) {
     .unwrap();
 }
 
+/// Checks every CSV file under `dir` (hidden journals included) against the tables' one unit
+/// convention and tidy shape: times in seconds (`_s`, `_s_lo`, `_s_hi`), rates per second
+/// (`_per_s`), one value per column (no `parameters` column packing several), each column named
+/// once. Returns the files checked.
+pub fn assert_tidy_tables(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut files = vec![];
+    let mut pending = vec![dir.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                pending.push(p);
+            } else if p.extension().is_some_and(|x| x == "csv") {
+                files.push(p);
+            }
+        }
+    }
+    for f in &files {
+        let header = csv::Reader::from_path(f).unwrap().headers().unwrap().clone();
+        let names: Vec<&str> = header.iter().collect();
+        for name in &names {
+            let words: Vec<&str> = name.split('_').collect();
+            assert!(
+                !["ms", "seconds", "mrays", "fps", "mb", "parameters"]
+                    .iter()
+                    .any(|w| words.contains(w)),
+                "{}: column {name} breaks the unit convention or packs several values: {names:?}",
+                f.display()
+            );
+            assert_eq!(
+                names.iter().filter(|n| *n == name).count(),
+                1,
+                "{}: {name} twice",
+                f.display()
+            );
+        }
+    }
+    files
+}
+
 /// Path of a file in the repository.
 pub fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)

@@ -8,9 +8,14 @@ use super::results::Results;
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::output::images::{diverging, exposure, grey, Rgb};
 use crate::output::page::{write_shots, Gallery, Shot, Tone};
-use crate::output::plots::image_grid;
+use crate::output::plots::{image_grid, ColourBar, Tile};
 use crate::output::table::cells;
 use std::path::Path;
+
+/// The difference a run's error map shows at full colour.
+const RUN_ERROR: f64 = 0.5;
+/// The difference the ground truth's error map (against the exact image) shows at full colour.
+const TRUTH_ERROR: f64 = 0.005;
 
 /// A file name part for a scheme (`points:NAME` has a colon no file system likes).
 fn file_part(scheme: &impl ToString) -> String {
@@ -101,20 +106,21 @@ fn measuring_view(r: &Results) -> anyhow::Result<Option<Gallery>> {
 }
 
 /// fig2_measure.png: the schemes [`shown`] beside the ground truth and the exact image, with
-/// their signed errors underneath on a +-0.5 scale (ground truth - exact on +-0.005).
+/// their signed errors underneath, each with its colour bar.
 fn write_measure_grid(r: &Results, g: &Gallery, path: &Path) -> anyhow::Result<()> {
     let (w, h) = (g.width, g.height);
     let n = figure_samples(r.spec);
     let gt = &g.shots[g.reference.expect("the measuring view has a reference")];
     let mut tiles: Vec<(String, Rgb)> = Vec::new();
-    let mut errors: Vec<(String, Rgb)> = Vec::new();
+    let mut errors: Vec<(String, Rgb, f64)> = Vec::new();
     for (scheme, pattern) in shown(r.spec) {
         let label = format!("{scheme} ({pattern}), {n} rays");
         if let Some(s) = g.shots.iter().find(|s| s.label == label) {
             tiles.push((label, grey(&s.values, w, h)));
             errors.push((
-                format!("{scheme} ({pattern}) - ground truth, +-0.5"),
-                diverging(&s.values, &gt.values, 0.5, w, h),
+                format!("{scheme} ({pattern}) - ground truth"),
+                diverging(&s.values, &gt.values, RUN_ERROR, w, h),
+                RUN_ERROR,
             ));
         }
     }
@@ -122,12 +128,23 @@ fn write_measure_grid(r: &Results, g: &Gallery, path: &Path) -> anyhow::Result<(
     if let Some(exact) = g.shots.iter().find(|s| s.label == "exact") {
         tiles.push(("exact".into(), grey(&exact.values, w, h)));
         errors.push((
-            "ground truth - exact, +-0.005".into(),
-            diverging(&gt.values, &exact.values, 0.005, w, h),
+            "ground truth - exact".into(),
+            diverging(&gt.values, &exact.values, TRUTH_ERROR, w, h),
+            TRUTH_ERROR,
         ));
     }
     let columns = tiles.len().max(errors.len());
-    let all: Vec<(String, &Rgb)> = tiles.iter().chain(&errors).map(|(l, i)| (l.clone(), i)).collect();
+    let all: Vec<Tile> = tiles
+        .iter()
+        .map(|(l, i)| Tile::new(l.clone(), i))
+        .chain(errors.iter().map(|(l, i, scale)| Tile {
+            bar: Some(ColourBar {
+                scale: *scale,
+                what: "visibility difference".into(),
+            }),
+            ..Tile::new(l.clone(), i)
+        }))
+        .collect();
     image_grid(path, &all, columns)
 }
 

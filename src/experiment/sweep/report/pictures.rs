@@ -7,7 +7,7 @@ use crate::experiment::sweep::pictures::{Picture, Pictures};
 use crate::experiment::sweep::Spec;
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::output::images::{exposure, tonemap_with, Rgb};
-use crate::output::plots::image_grid;
+use crate::output::plots::{image_grid, Tile};
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
@@ -80,6 +80,6 @@ pub fn write_fig2_picture(spec: &Spec, pictures: &Pictures, seed: u32, path: &Pa
         format!("jittered (ground truth), {} rays", gt.samples),
         display(gt, p99),
     ));
-    let refs: Vec<(String, &Rgb)> = tiles.iter().map(|(l, i)| (l.clone(), i)).collect();
+    let refs: Vec<Tile> = tiles.iter().map(|(l, i)| Tile::new(l.clone(), i)).collect();
     image_grid(path, &refs, 2)
 }

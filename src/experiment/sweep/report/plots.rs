@@ -75,7 +75,6 @@ pub fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Re
 }
 
 fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suffix: &str) -> anyhow::Result<()> {
-    use plotters::chart::SeriesLabelPosition::{LowerLeft, LowerRight};
     let spec = r.spec;
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
@@ -90,31 +89,25 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
     let title = |what: &str| format!("{what}, light radius {radius} m, {lights} light(s)");
     line_plot(
         &file("rmse_vs_samples"),
-        &Axes {
-            legend: LowerLeft,
-            ..Axes::new(
-                &title("RMSE vs ground truth over the penumbra"),
-                "shadow rays per pixel",
-                "RMSE",
-                true,
-                true,
-            )
-        },
+        &Axes::new(
+            &title("RMSE vs ground truth over the penumbra"),
+            "shadow rays per pixel",
+            "RMSE",
+            true,
+            true,
+        ),
         &series(summaries, at_radius, samples, |m| m.rmse, 1.0),
         &[],
     )?;
     line_plot(
         &file("rmse_vs_time"),
-        &Axes {
-            legend: LowerLeft,
-            ..Axes::new(
-                &title("What accuracy costs: RMSE vs frame time"),
-                "median frame time (ms)",
-                "RMSE",
-                true,
-                true,
-            )
-        },
+        &Axes::new(
+            &title("What accuracy costs: RMSE vs frame time"),
+            "median frame time (ms)",
+            "RMSE",
+            true,
+            true,
+        ),
         &series(summaries, at_radius, |s| s.frame.median * 1e3, |m| m.rmse, 1.0),
         &[],
     )?;
@@ -264,7 +257,6 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         &file("profiles"),
         &Axes {
             x_range,
-            legend: LowerRight,
             ..Axes::new(
                 &title(&format!("Radial profile at {n} rays (mean over seeds)")),
                 "distance from shadow centre (mm)",
