@@ -432,7 +432,14 @@ fn tune_kdtree() {
         let mut best = (0.0, 0, 0);
         for max_depth in [16, 18, 20, 22, 24, 26, 28, 30] {
             for leaf_size in [2, 4, 8, 16, 32] {
-                m.kd = KdTree::build(&m.tris, KdSettings { max_depth, leaf_size });
+                m.kd = KdTree::build(
+                    &m.tris,
+                    KdSettings {
+                        max_depth,
+                        leaf_size,
+                        ..KdSettings::default()
+                    },
+                );
                 let times: Vec<f64> = (0..5)
                     .map(|_| {
                         let t = Instant::now();

@@ -371,6 +371,10 @@ fn kd_tree_parameters_are_checked() {
         ("max_depth = 61", "accel.kdtree.max_depth"),
         ("leaf_size = 70000", "accel.kdtree.leaf_size"),
         ("depth = 3", "depth"),
+        ("split = \"mean\"", "accel.kdtree.split"),
+        ("traversal_cost = 0.0\nsplit = \"sah\"", "accel.kdtree.traversal_cost"),
+        ("intersection_cost = -1.0", "accel.kdtree.intersection_cost"),
+        ("empty_factor = 1.5\nsplit = \"sah\"", "accel.kdtree.empty_factor"),
     ] {
         let e = load(kd).unwrap_err().to_string();
         assert!(e.contains("scene.toml:3") && e.contains(key), "{kd}: {e}");
@@ -378,6 +382,10 @@ fn kd_tree_parameters_are_checked() {
     let s = load("max_depth = 7\nleaf_size = 1").unwrap();
     let stats = s.accel.as_ref().unwrap().stats();
     assert_eq!(stats.parameters, "depth 7 leaf 1");
+    let s = load("split = \"sah\"\nmax_depth = 7\nleaf_size = 1\ntraversal_cost = 5.0").unwrap();
+    let stats = s.accel.as_ref().unwrap().stats();
+    assert_eq!(stats.parameters, "sah depth 7 leaf 1 K_T 5 K_I 20 empty 0.8");
+    assert!(stats.description.contains("SAH"), "{}", stats.description);
 }
 
 /// The work counters are exact and deterministic: with brute force and no light, each pixel asks

@@ -20,6 +20,7 @@ mod gpu_resources;
 mod hard_cases;
 mod hostile_input;
 mod kdtree;
+mod kdtree_sah;
 mod mesh_scene;
 mod points_file;
 mod receiver_masks;
