@@ -11,6 +11,7 @@ mod blue_noise;
 mod cache_keys;
 mod command_line;
 mod common;
+mod cwbvh;
 mod dynamic_updates;
 mod frames_experiment;
 mod fuzz_config;
