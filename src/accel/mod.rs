@@ -16,7 +16,9 @@
 //! use the shared triangle struct `AccelTri` and ray-triangle test `triangle_t`
 //! ([`TRIANGLE_WGSL`], prepended to it). The GPU
 //! backend compiles each structure's module into its own pipelines, chosen by name. Adding a
-//! structure is its module, its WGSL and one line in [`REGISTRY`].
+//! structure is its module, its WGSL and one line in [`REGISTRY`]. A structure may be CPU only
+//! ([`Registered::gpu`] false, as obvhs' CWBVH is): its [`Accelerator::gpu`] then refuses by
+//! name, and the GPU backend reports that error rather than render with another structure.
 
 pub mod brute;
 pub mod bvh;

@@ -165,7 +165,7 @@ fn frames_do_not_depend_on_the_structure() {
         for r in &REGISTRY[1..] {
             if name == "gpu" && !r.gpu {
                 let e = b.render(&scene(r.name), view(&cam), sampling()).unwrap_err();
-                assert!(e.to_string().contains(&format!("`{}`", r.name)), "{e:#}");
+                assert!(format!("{e:#}").contains(&format!("`{}`", r.name)), "{e:#}");
                 continue;
             }
             let got = render(b, &scene(r.name), &cam);

@@ -29,25 +29,28 @@ const OBVHS_TMIN: f64 = 1e-4;
 /// root box `(lo, hi)` in world coordinates whose tree lies in coordinates relative to `centre`,
 /// and its parameter shift `s` (walk distance = t - s); `None` where the segment misses the box.
 ///
-/// The ray starts a margin before the box's entry point, wherever the true origin is: its f32
-/// origin is then rounded by ulps of the scene's size (which the tree's widened boxes cover) and
-/// not of its distance, and every point of the true segment inside the box lies more than twice
-/// obvhs' floor on entry distances along the walk. A ray whose origin is inside the box starts
-/// behind it; hits there are before t = 0 and refused by the caller's f64 test.
+/// An origin well outside the box moves to a margin before the box's entry point, so that its
+/// f32 rounding is by ulps of the scene's size (which the tree's widened boxes cover) and not of
+/// its distance. Any other origin moves back a little along the ray: obvhs floors entry distances
+/// at 1e-4, and every point of the true segment must lie beyond twice that along the walk (and
+/// beyond the f32 rounding of a point of the scene). Hits before t = 0 that the walk then meets
+/// are refused by the caller's f64 test.
 pub fn shifted(lo: DVec3, hi: DVec3, centre: DVec3, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(Ray, f64)> {
     let (a, b) = ((lo - origin) / dir, (hi - origin) / dir);
     let enter = a.min(b).max_element();
     let exit = a.max(b).min_element();
-    let margin = (hi - lo).max_element() * 1e-3 + 2.0 * OBVHS_TMIN;
-    // An origin on a slab plane of a ray parallel to it gives NaN: start a margin back.
+    let size = (hi - lo).max_element();
+    let lead = 2.0 * OBVHS_TMIN + size * 1e-6;
+    let margin = size * 1e-3 + lead;
+    // An origin on a slab plane of a ray parallel to it gives NaN: walk from behind the origin.
     let defined = !(enter.is_nan() || exit.is_nan());
     if defined && (exit < 0.0 || enter > exit + margin || enter > tmax + margin) {
         return None;
     }
-    let s = if defined && enter.is_finite() {
+    let s = if defined && enter.is_finite() && enter > margin {
         enter - margin
     } else {
-        -margin
+        -lead
     };
     let far = ((tmax - s) * (1.0 + 1e-6) + margin) as f32;
     let ray = Ray::new(
@@ -74,15 +77,18 @@ mod tests {
     }
 
     #[test]
-    fn the_walk_starts_before_the_box_and_before_the_origin() {
+    fn the_walk_starts_before_the_box_or_just_behind_the_origin() {
         let (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
         // From outside: starts just before the entry at t = 4.
         let (ray, s) = shifted(lo, hi, DVec3::ZERO, DVec3::new(0.0, 0.0, -5.0), DVec3::Z, 100.0).unwrap();
         assert!(s < 4.0 && s > 3.99, "{s}");
         assert!((ray.origin.z as f64 - (-5.0 + s)).abs() < 1e-6);
-        // From inside: starts behind the origin by more than obvhs' floor.
-        let (_, s) = shifted(lo, hi, DVec3::ZERO, DVec3::ZERO, DVec3::Z, 100.0).unwrap();
-        assert!(s < -1.0 - 2.0 * OBVHS_TMIN, "{s}");
+        // From inside, or just outside: starts behind the origin by more than twice obvhs'
+        // floor, not further.
+        for z in [0.0, -1.0005] {
+            let (_, s) = shifted(lo, hi, DVec3::ZERO, DVec3::new(0.0, 0.0, z), DVec3::Z, 100.0).unwrap();
+            assert!(s < -2.0 * OBVHS_TMIN && s > -3.0 * OBVHS_TMIN, "{s}");
+        }
         // Pointing away, or ending before the box: no walk.
         assert!(shifted(lo, hi, DVec3::ZERO, DVec3::new(0.0, 0.0, -5.0), -DVec3::Z, 100.0).is_none());
         assert!(shifted(lo, hi, DVec3::ZERO, DVec3::new(0.0, 0.0, -5.0), DVec3::Z, 3.0).is_none());
