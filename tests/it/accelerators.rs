@@ -397,8 +397,8 @@ fn kd_tree_parameters_are_checked() {
     assert_eq!(stats.parameters, "depth 7 leaf 1");
     let s = load("split = \"sah\"\nmax_depth = 7\nleaf_size = 1\ntraversal_cost = 5.0").unwrap();
     let stats = s.accel.as_ref().unwrap().stats();
-    assert_eq!(stats.parameters, "sah depth 7 leaf 1 K_T 5 K_I 20 empty 0.8");
-    assert!(stats.description.contains("SAH"), "{}", stats.description);
+    assert_eq!(stats.parameters, "sah depth 7 leaf 1 K_T 5 K_I 20 lambda 0.8");
+    assert!(stats.description.contains("SAH planes"), "{}", stats.description);
 }
 
 /// The work counters are exact and deterministic: with brute force and no light, each pixel asks

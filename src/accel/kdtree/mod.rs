@@ -235,13 +235,12 @@ impl Accelerator for KdTree {
             memory_bytes: self.bytes() as u64,
             triangles: n,
             description: format!(
-                "kd-tree ({}, {}): {} nodes, {leaves} leaves, depth {}, {:.2} triangle \
+                "kd-tree ({}): {} nodes, {leaves} leaves, depth {}, {:.2} triangle \
                  references per triangle, {:.1} MB, built in {:.0} ms",
                 match self.settings.split {
-                    Split::Median => "spatial median",
-                    Split::Sah => "SAH",
+                    Split::Median => format!("spatial median, {}", self.settings.describe()),
+                    Split::Sah => format!("SAH planes, {}", self.settings.describe()),
                 },
-                self.settings.describe(),
                 self.nodes.len(),
                 self.depth,
                 self.items.len() as f64 / n.max(1) as f64,

@@ -128,16 +128,19 @@ impl crate::accel::settings::Params for KdSettings {
         }
     }
 
-    /// Both plane choices over the paper's CRT depths (16-23) and deeper up to 30, and leaf
-    /// sizes around both optima (the SAH prefers small leaves, the median 8), with Wald &
-    /// Havran's K_T = 15 beside a cheaper and a dearer traversal (K_I = 20). `cargo bench --bench
-    /// vlf_compare -- --tune-kdtree` times a wider grid and shows the optima inside this one.
+    /// Both plane choices over the paper's CRT depths (16-23) and deeper to 30, at leaf sizes
+    /// around the median's optimum (8), with traversal costs K_T from 1 to 60 around Wald &
+    /// Havran's 15 (K_I = 20). `cargo bench --bench vlf_compare -- --tune-kdtree [--split sah]`
+    /// times a wider grid on grid-direction AO rays: the median peaks at depths 22-28 and leaf 8,
+    /// the SAH at depths 20-30 with leaf size and K_T in 1-15 within timing noise of each other
+    /// (K_T 60 and depth 16 clearly slower; K_T 1, traversal nearly free, is the stated lower
+    /// limit: below it the termination rule hardly stops a split and the depth limit decides).
     fn tuning() -> toml::Table {
         toml::toml! {
             split = ["median", "sah"]
             max_depth = [16, 18, 22, 26, 30]
-            leaf_size = [1, 2, 4, 8, 16]
-            traversal_cost = [5.0, 15.0, 45.0]
+            leaf_size = [2, 4, 8, 16]
+            traversal_cost = [1.0, 5.0, 15.0, 60.0]
         }
     }
 }
@@ -160,7 +163,7 @@ impl KdSettings {
             Split::Sah => {
                 let c = self.costs();
                 format!(
-                    "sah depth {} leaf {} K_T {} K_I {} empty {}",
+                    "sah depth {} leaf {} K_T {} K_I {} lambda {}",
                     self.max_depth, self.leaf_size, c.traversal, c.intersection, c.empty_factor
                 )
             }
