@@ -1,5 +1,5 @@
-//! A triangle clipped to a box, for the SAH's "perfect splits" (Wald & Havran 2006, Section
-//! 4.3): the bounds of the part of a triangle inside a node, whose faces are the planes worth
+//! A triangle clipped to a box, for the SAH's "perfect splits" (Wald & Havran 2006): the
+//! bounds of the part of a triangle inside a node, whose faces are the planes worth
 //! trying. Sutherland-Hodgman against the six faces, in f64.
 
 use glam::DVec3;

@@ -1,5 +1,5 @@
-//! Spatial-median planes, the visibility-field paper's CRT baseline (Section 7: "BSP with spatial
-//! median splits"): each node is cut in the middle of its longest side until it holds at most
+//! Spatial-median planes, the visibility-field paper's CRT baseline (a BSP with spatial-median
+//! splits, Section 7): each node is cut in the middle of its longest side until it holds at most
 //! `leaf_size` triangles or reaches `max_depth`. A triangle goes to each side its bounding box
 //! meets (closed half-spaces: one touching the plane goes to both).
 

@@ -3,17 +3,17 @@
 //! node sorts its own events.
 //!
 //! A ray through a node's box `V` meets a child box `V_i` with probability `P_i = SA(V_i) / SA(V)`
-//! (surface areas), so a split at `p` costs (their Eq. 2, with their empty-space factor)
+//! (surface areas), so a split at `p` costs (their SAH cost, with their empty-space factor)
 //!
 //! ```text
 //! C(p) = lambda(p) * (K_T + K_I * (P_L N_L + P_R N_R)),   lambda = 0.8 where N_L or N_R is 0
 //! ```
 //!
 //! against `K_I * N` for a leaf. The candidate planes are the faces of each triangle clipped to
-//! `V` ("perfect splits", Section 4.3: a triangle's part outside the node does not count). One
-//! sweep per axis over the sorted start, end and planar events (Section 4.2, Algorithm 2) gives
+//! `V` ("perfect splits": a triangle's part outside the node does not count). One sweep per
+//! axis over the sorted start, end and planar events (their incremental sweep) gives
 //! `N_L`, `N_R` and the triangles lying in the plane (`N_P`), which go to whichever side is
-//! cheaper. A node becomes a leaf where no plane costs less than the leaf (Section 4.1's
+//! cheaper. A node becomes a leaf where no plane costs less than the leaf (their
 //! termination), or at `max_depth`, or with at most `leaf_size` triangles.
 
 use super::clip::clipped_bounds;
@@ -26,7 +26,7 @@ use glam::DVec3;
 const PAD: f64 = 1e-12;
 
 /// Event kinds in the order a sweep meets them at one position: ends, planar, starts (their
-/// Section 4.2: `- < | < +`).
+/// order `- < | < +`).
 const END: u8 = 0;
 const PLANAR: u8 = 1;
 const START: u8 = 2;
@@ -191,7 +191,7 @@ impl Builder<'_> {
     }
 
     /// A split's cost with hit probabilities `pl`, `pr` and `nl`, `nr` triangles on each side
-    /// (Eq. 2 with the empty-space factor).
+    /// (the SAH cost with the empty-space factor).
     fn cost(&self, pl: f64, pr: f64, nl: usize, nr: usize) -> f64 {
         let k = self.settings.costs();
         let lambda = if nl == 0 || nr == 0 { k.empty_factor } else { 1.0 };
@@ -206,7 +206,7 @@ impl Builder<'_> {
 
 impl KdTree {
     /// The tree's expected cost for a ray through its root box under the SAH's model (Wald &
-    /// Havran 2006, Eq. 2 unrolled over the tree): `traversal_cost` per inner node and
+    /// Havran 2006, unrolled over the tree): `traversal_cost` per inner node and
     /// `intersection_cost` per triangle of each leaf, weighted by the node's surface area over the
     /// root's. A leaf holding everything costs `intersection_cost * N`. With `empty_factor` 1 a
     /// tree the SAH built with these constants costs no more, at its root or any node (each split

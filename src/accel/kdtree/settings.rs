@@ -15,7 +15,7 @@ pub enum Split {
     Median,
     /// The plane of least expected cost under the surface area heuristic, among the faces of
     /// every triangle clipped to the node ("perfect splits"), found by one sorted sweep per axis:
-    /// Wald & Havran 2006, Sections 3-4 (the O(N log^2 N) sort-per-node form).
+    /// Wald & Havran 2006 (the O(N log^2 N) sort-per-node form).
     Sah,
 }
 
@@ -41,7 +41,7 @@ pub struct KdSettings {
     pub max_depth: u32,
     /// Nodes with at most this many triangles become leaves.
     pub leaf_size: u32,
-    /// SAH: cost of one traversal step, K_T (Wald & Havran 2006, Eq. 2; their value 15).
+    /// SAH: cost of one traversal step, K_T (Wald & Havran 2006; their value 15).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub traversal_cost: Option<f64>,
     /// SAH: cost of one triangle test, K_I (their value 20). Only the ratio K_T / K_I shapes the
@@ -54,7 +54,7 @@ pub struct KdSettings {
     pub empty_factor: Option<f64>,
 }
 
-/// The SAH's cost model (Wald & Havran 2006, Eq. 2 with the empty-space factor of Section 4.4).
+/// The SAH's cost model (Wald & Havran 2006, with their empty-space factor).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SahCosts {
     /// K_T.
