@@ -6,12 +6,17 @@
 //! - `bvh`: the project's `accel::Bvh` (obvhs BVH2, `very-slow` preset, its best tree), its f64
 //!   exact-test queries;
 //! - `bvh2-obvhs`: the same BVH2 traversed by obvhs itself with its f32 triangle test;
-//! - `cwbvh-obvhs`: obvhs' CWBVH (`very_slow_build`) traversed by obvhs with its f32 test (the
-//!   known-facts figure: about 5.2 Mrays/s single-thread on the cow for 513-direction AO);
+//! - `cwbvh-obvhs`: obvhs' CWBVH (`very_slow_build`) traversed by obvhs with its f32 test, its
+//!   rays' -0.0 direction components made +0.0 (`accel::cwbvh::ray::direction`: obvhs 0.4.0's
+//!   node test misses every child box along a -0.0 component);
 //! - `kdtree`: the paper's baseline, a CRT-like kd-tree (`accel::kdtree`: spatial-median
 //!   splits, explicit-stack front-to-back walk, f64 exact tests) at its default depth and leaf
 //!   size; `-- --tune-kdtree` times it on `ao-grid` over a grid of depths and leaf sizes, as the
-//!   paper tuned its CRT.
+//!   paper tuned its CRT;
+//! - `kdtree-sah`: the same nodes and walk with SAH planes (Wald & Havran 2006) at the best of
+//!   `-- --tune-kdtree --split sah` ([`SAH`]);
+//! - `cwbvh`: `accel::cwbvh`, the registry's CWBVH: obvhs' very-slow CWBVH over widened boxes,
+//!   obvhs' traversal, f64 exact tests.
 //!
 //! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
 //! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
@@ -22,17 +27,18 @@
 //! closest-hit. Single thread (`1t`) and
 //! rayon over all cores (`mt`).
 //!
-//! The obvhs columns are not exact: f32 tests, and on `ao-grid` obvhs' CWBVH reports fewer hits
-//! (cow 19.8 % against 22.4 % for every other structure): about a quarter of the 513 stored
-//! directions have an exactly zero component (the octahedron's edges lie in coordinate planes)
-//! and its quantised child-box test most likely drops hits for such rays (not yet isolated; on
-//! `ao-random` all four agree), so it also stops early less often
-//! than it should. Its BVH2 traversal agrees with the f64 structures.
+//! The obvhs columns are not exact (f32 tests), but agree with the f64 structures to a few hits
+//! in 10^5. Without the -0.0 workaround obvhs' CWBVH reported fewer hits on `ao-grid` (cow 19.8 %
+//! against 22.4 %): about a quarter of the 513 stored directions lie in coordinate planes, and
+//! orienting one into a hemisphere by negation gives a -0.0 component.
 //!
 //! `cargo bench --bench vlf_compare`: criterion, small samples (about 5 minutes on 2 cores).
-//! `cargo bench --bench vlf_compare -- --table`: one table of medians (Mrays/s), build times
-//! and memory (structure bytes: the VLF's arrays, the BVHs' nodes and index lists; not the
-//! triangles every structure keeps). `-- --counters`: the VLF's work per any-hit ray (tiles,
+//! `cargo bench --bench vlf_compare -- --table`: one table of medians (Mrays/s, with the 95 %
+//! interval of the median of 7 runs single-threaded), build times, memory (structure bytes: the
+//! VLF's arrays, the BVHs' nodes and index lists; not the triangles every structure keeps) and
+//! the work counters per ray (`accel::work`: nodes visited, primitives tested; `-` for obvhs'
+//! own walks, which count nothing). `--meshes cow,man` and `--structures kdtree,kdtree-sah`
+//! narrow it. `-- --counters`: the VLF's work per any-hit ray (tiles,
 //! leaves, entries scanned, exact tests) beside the CWBVH's triangle tests.
 //! `VLF_PROFILE_SECS=20 perf record ... vlf_compare-*`: loops the VLF's single-thread any-hit on
 //! the cow's grid-direction AO rays, for a profile.
@@ -43,9 +49,12 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::BvhBuildParams;
-use penumbra::accel::kdtree::{KdSettings, KdTree};
+use penumbra::accel::cwbvh::{ray as cw_ray, Cwbvh};
+use penumbra::accel::kdtree::{KdSettings, KdTree, Split};
 use penumbra::accel::vlf::{VisibilityField, VlfSettings};
+use penumbra::accel::work;
 use penumbra::accel::{Bvh, Preset};
+use penumbra::experiment::timing::median_interval;
 use penumbra::mesh::Triangles;
 use penumbra::sampling::rng::pcg;
 use rayon::prelude::*;
@@ -56,7 +65,28 @@ use std::time::{Duration, Instant};
 type Q = (DVec3, DVec3, f64, u32);
 
 const KINDS: [&str; 5] = ["ao-grid", "ao-grid-by-direction", "ao-random", "shadow", "camera"];
-const STRUCTURES: [&str; 5] = ["vlf", "bvh", "bvh2-obvhs", "cwbvh-obvhs", "kdtree"];
+const STRUCTURES: [&str; 7] = [
+    "vlf",
+    "bvh",
+    "bvh2-obvhs",
+    "cwbvh-obvhs",
+    "kdtree",
+    "kdtree-sah",
+    "cwbvh",
+];
+
+/// The SAH kd-tree the table times: the best of `-- --tune-kdtree --split sah` summed over the
+/// cow, the man and the body (depth 24, leaf 2, Wald & Havran's constants; depths 20-30 and K_T
+/// 1-15 lie within the timing noise of it on a loaded two-core machine, depth 16 and below or
+/// K_T 60 clearly slower).
+const SAH: KdSettings = KdSettings {
+    split: Split::Sah,
+    max_depth: 24,
+    leaf_size: 2,
+    traversal_cost: None,
+    intersection_cost: None,
+    empty_factor: None,
+};
 const POINTS: u32 = 64;
 
 struct Mesh {
@@ -66,6 +96,8 @@ struct Mesh {
     cw: CwBvh,
     cw_time: Duration,
     kd: KdTree,
+    kd_sah: KdTree,
+    cwbvh: Cwbvh,
 }
 
 fn repo(p: &str) -> std::path::PathBuf {
@@ -95,6 +127,8 @@ fn build(name: &'static str) -> Mesh {
     let cw = build_cwbvh_from_tris(&bvh.local, BvhBuildParams::very_slow_build(), &mut core);
     let cw_time = start.elapsed();
     let kd = KdTree::build(&tris, KdSettings::default());
+    let kd_sah = KdTree::build(&tris, SAH);
+    let cwbvh = Cwbvh::build(&tris, Preset::VerySlow);
     Mesh {
         tris,
         vlf,
@@ -102,6 +136,8 @@ fn build(name: &'static str) -> Mesh {
         cw,
         cw_time,
         kd,
+        kd_sah,
+        cwbvh,
     }
 }
 
@@ -196,10 +232,14 @@ fn trace(m: &Mesh, s: usize, closest: bool, &(o, d, tmax, skip): &Q) -> bool {
         1 => m.bvh.any_hit(o, d, tmax, skip),
         4 if closest => penumbra::accel::Accelerator::closest(&m.kd, o, d, tmax, skip).is_some(),
         4 => penumbra::accel::Accelerator::any_hit(&m.kd, o, d, tmax, skip),
+        5 if closest => penumbra::accel::Accelerator::closest(&m.kd_sah, o, d, tmax, skip).is_some(),
+        5 => penumbra::accel::Accelerator::any_hit(&m.kd_sah, o, d, tmax, skip),
+        6 if closest => m.cwbvh.closest(o, d, tmax, skip).is_some(),
+        6 => m.cwbvh.any_hit(o, d, tmax, skip),
         _ => {
             let ray = Ray::new(
                 Vec3A::from((o - m.bvh.centre).as_vec3()),
-                Vec3A::from(d.as_vec3()),
+                cw_ray::direction(d),
                 0.0,
                 tmax as f32,
             );
@@ -240,10 +280,18 @@ fn run(m: &Mesh, s: usize, closest: bool, rays: &[Q], parallel: bool) -> usize {
 }
 
 /// Structure bytes (no triangles) of each structure.
-fn bytes(m: &Mesh) -> [usize; 5] {
+fn bytes(m: &Mesh) -> [usize; 7] {
     let bvh2 = std::mem::size_of_val(m.bvh.tree.nodes.as_slice()) + 4 * m.bvh.tree.primitive_indices.len();
     let cw = std::mem::size_of_val(m.cw.nodes.as_slice()) + 4 * m.cw.primitive_indices.len();
-    [m.vlf.bytes(), bvh2, bvh2, cw, m.kd.bytes()]
+    [
+        m.vlf.bytes(),
+        bvh2,
+        bvh2,
+        cw,
+        m.kd.bytes(),
+        m.kd_sah.bytes(),
+        m.cwbvh.bytes(),
+    ]
 }
 
 const MESHES: [&str; 4] = ["cow", "bull", "man", "body"];
@@ -253,17 +301,31 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// The values of `--flag a,b,c`, or `all` where the flag is absent.
+fn listed<'a>(flag: &str, all: &[&'a str]) -> Vec<&'a str> {
+    let args: Vec<String> = std::env::args().collect();
+    let Some(i) = args.iter().position(|a| a == flag) else {
+        return all.to_vec();
+    };
+    let wanted: Vec<&str> = args.get(i + 1).map_or(vec![], |v| v.split(',').collect());
+    let out: Vec<&str> = all.iter().copied().filter(|a| wanted.contains(a)).collect();
+    assert!(!out.is_empty(), "{flag} names none of {all:?}");
+    out
+}
+
 fn table() {
     let threads = rayon::current_num_threads();
     println!(
-        "vlf_compare: {} logical CPUs, rayon {threads} threads; Mrays/s, median of 7 runs of {} rays",
+        "vlf_compare: {} logical CPUs, rayon {threads} threads; Mrays/s, median of 7 runs of {} rays \
+         (1t: with its 95 % interval, the runs' range); work per ray from one single-threaded run",
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         POINTS * 513
     );
     println!();
-    println!("| mesh | tris | structure | build s | MB | B/tri | kind | 1t Mrays/s | mt Mrays/s | hit % |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
-    for name in MESHES {
+    println!("| mesh | tris | structure | build s | MB | B/tri | kind | nodes/ray | prims/ray | 1t Mrays/s | mt Mrays/s | hit % |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let structures = listed("--structures", &STRUCTURES);
+    for name in listed("--meshes", &MESHES) {
         let t0 = Instant::now();
         let m = build(name);
         eprintln!("{name}: built in {:.1} s", t0.elapsed().as_secs_f64());
@@ -274,38 +336,53 @@ fn table() {
             m.bvh.total_time.as_secs_f64(),
             m.cw_time.as_secs_f64(),
             penumbra::accel::Accelerator::stats(&m.kd).build_time.as_secs_f64(),
+            penumbra::accel::Accelerator::stats(&m.kd_sah).build_time.as_secs_f64(),
+            m.cwbvh.build_time.as_secs_f64(),
         ];
         let n = m.tris.positions.len();
         for kind in KINDS {
             let rays = rays(&m, kind);
             let closest = kind == "camera";
-            for s in 0..STRUCTURES.len() {
-                let mut rates = [0.0; 2];
-                let mut hits = 0;
-                for (p, rate) in rates.iter_mut().enumerate() {
-                    hits = run(&m, s, closest, &rays, p == 1);
-                    let times: Vec<f64> = (0..7)
+            for (s, label) in STRUCTURES.iter().enumerate() {
+                if !structures.contains(label) {
+                    continue;
+                }
+                let (hits, w) = work::counted(|| run(&m, s, closest, &rays, false));
+                let per_ray = |x: u64| {
+                    if w.nodes + w.primitives == 0 {
+                        "-".to_string()
+                    } else {
+                        format!("{:.1}", x as f64 / rays.len() as f64)
+                    }
+                };
+                let mut rates = Vec::new();
+                for p in [false, true] {
+                    let rate: Vec<f64> = (0..7)
                         .map(|_| {
                             let t = Instant::now();
-                            std::hint::black_box(run(&m, s, closest, &rays, p == 1));
-                            t.elapsed().as_secs_f64()
+                            std::hint::black_box(run(&m, s, closest, &rays, p));
+                            rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
                         })
                         .collect();
-                    *rate = rays.len() as f64 / median(times) / 1e6;
+                    rates.push(median_interval(&rate));
                 }
                 println!(
-                    "| {name} | {n} | {} | {:.2} | {:.1} | {:.0} | {kind} | {:.2} | {:.2} | {:.2} |",
-                    STRUCTURES[s],
+                    "| {name} | {n} | {label} | {:.3} | {:.1} | {:.0} | {kind} | {} | {} | {} | {:.2} | {:.2} |",
                     builds[s],
                     b[s] as f64 / 1e6,
                     b[s] as f64 / n as f64,
-                    rates[0],
-                    rates[1],
+                    per_ray(w.nodes),
+                    per_ray(w.primitives),
+                    rates[0].show(2),
+                    rates[1].median,
                     100.0 * hits as f64 / rays.len() as f64
                 );
             }
         }
         eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.vlf).description);
+        eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.kd).description);
+        eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.kd_sah).description);
+        eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.cwbvh).description);
     }
 }
 
@@ -363,7 +440,7 @@ fn counters(m: &Mesh, rays: &[Q]) -> [f64; 5] {
         assert_eq!(hit, f.any_hit(o, d, tmax, skip));
         let ray = Ray::new(
             Vec3A::from((o - m.bvh.centre).as_vec3()),
-            Vec3A::from(d.as_vec3()),
+            cw_ray::direction(d),
             0.0,
             tmax as f32,
         );
@@ -417,42 +494,86 @@ fn criterion_benches(c: &mut Criterion) {
 }
 
 /// The kd-tree on `ao-grid` rays over depths and leaf sizes (`--tune-kdtree`), one thread, as the
-/// paper tuned its CRT baseline: median of 5 runs each, with memory and build time.
+/// paper tuned its CRT baseline: median of 5 runs each, with memory, build time and the work per
+/// ray. With `--split sah`, the SAH tree over depths, leaf sizes and traversal costs K_T
+/// (K_I = 20, Wald & Havran's 15 among them).
 fn tune_kdtree() {
+    let sah = std::env::args().any(|a| a == "sah");
     println!(
-        "kd-tree on ao-grid any-hit rays, one thread, median of 5 runs of {} rays",
+        "{} kd-tree on ao-grid any-hit rays, one thread, median of 5 runs of {} rays",
+        if sah { "SAH" } else { "Spatial-median" },
         POINTS * 513
     );
     println!();
-    println!("| mesh | depth | leaf | build ms | MB | Mrays/s |");
-    println!("|---|---|---|---|---|---|");
-    for name in MESHES {
-        let mut m = build(name);
-        let rays = rays(&m, "ao-grid");
-        let mut best = (0.0, 0, 0);
-        for max_depth in [16, 18, 20, 22, 24, 26, 28, 30] {
-            for leaf_size in [2, 4, 8, 16, 32] {
-                m.kd = KdTree::build(&m.tris, KdSettings { max_depth, leaf_size });
-                let times: Vec<f64> = (0..5)
-                    .map(|_| {
-                        let t = Instant::now();
-                        std::hint::black_box(run(&m, 4, false, &rays, false));
-                        t.elapsed().as_secs_f64()
-                    })
-                    .collect();
-                let rate = rays.len() as f64 / median(times) / 1e6;
-                let stats = penumbra::accel::Accelerator::stats(&m.kd);
-                println!(
-                    "| {name} | {max_depth} | {leaf_size} | {:.0} | {:.1} | {rate:.2} |",
-                    stats.build_time.as_secs_f64() * 1e3,
-                    m.kd.bytes() as f64 / 1e6
-                );
-                if rate > best.0 {
-                    best = (rate, max_depth, leaf_size);
+    println!("| mesh | depth | leaf | K_T | build ms | MB | nodes/ray | prims/ray | Mrays/s |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let grid: Vec<(u32, u32, Option<f64>)> = if sah {
+        let mut g = Vec::new();
+        for d in [12, 16, 20, 24, 30] {
+            for l in [1, 2, 4, 8] {
+                for k in [1.0, 2.5, 5.0, 10.0, 15.0, 30.0, 60.0] {
+                    g.push((d, l, Some(k)));
                 }
             }
         }
-        eprintln!("{name}: best depth {} leaf {} at {:.2} Mrays/s", best.1, best.2, best.0);
+        g
+    } else {
+        let mut g = Vec::new();
+        for d in [16, 18, 20, 22, 24, 26, 28, 30] {
+            for l in [2, 4, 8, 16, 32] {
+                g.push((d, l, None));
+            }
+        }
+        g
+    };
+    let (slot, split) = if sah { (5, Split::Sah) } else { (4, Split::Median) };
+    for name in listed("--meshes", &MESHES) {
+        let mut m = build(name);
+        let rays = rays(&m, "ao-grid");
+        let mut best = (0.0, 0, 0, None);
+        for &(max_depth, leaf_size, traversal_cost) in &grid {
+            let tree = KdTree::build(
+                &m.tris,
+                KdSettings {
+                    split,
+                    max_depth,
+                    leaf_size,
+                    traversal_cost,
+                    ..KdSettings::default()
+                },
+            );
+            if sah {
+                m.kd_sah = tree;
+            } else {
+                m.kd = tree;
+            }
+            let (_, w) = work::counted(|| run(&m, slot, false, &rays, false));
+            let times: Vec<f64> = (0..5)
+                .map(|_| {
+                    let t = Instant::now();
+                    std::hint::black_box(run(&m, slot, false, &rays, false));
+                    t.elapsed().as_secs_f64()
+                })
+                .collect();
+            let rate = rays.len() as f64 / median(times) / 1e6;
+            let tree = if sah { &m.kd_sah } else { &m.kd };
+            let stats = penumbra::accel::Accelerator::stats(tree);
+            println!(
+                "| {name} | {max_depth} | {leaf_size} | {} | {:.0} | {:.1} | {:.1} | {:.1} | {rate:.2} |",
+                traversal_cost.map_or("-".into(), |k| k.to_string()),
+                stats.build_time.as_secs_f64() * 1e3,
+                tree.bytes() as f64 / 1e6,
+                w.nodes as f64 / rays.len() as f64,
+                w.primitives as f64 / rays.len() as f64,
+            );
+            if rate > best.0 {
+                best = (rate, max_depth, leaf_size, traversal_cost);
+            }
+        }
+        eprintln!(
+            "{name}: best depth {} leaf {} K_T {:?} at {:.2} Mrays/s",
+            best.1, best.2, best.3, best.0
+        );
     }
 }
 

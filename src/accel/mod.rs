@@ -16,10 +16,13 @@
 //! use the shared triangle struct `AccelTri` and ray-triangle test `triangle_t`
 //! ([`TRIANGLE_WGSL`], prepended to it). The GPU
 //! backend compiles each structure's module into its own pipelines, chosen by name. Adding a
-//! structure is its module, its WGSL and one line in [`REGISTRY`].
+//! structure is its module, its WGSL and one line in [`REGISTRY`]. A structure may be CPU only
+//! ([`Registered::gpu`] false, as obvhs' CWBVH is): its [`Accelerator::gpu`] then refuses by
+//! name, and the GPU backend reports that error rather than render with another structure.
 
 pub mod brute;
 pub mod bvh;
+pub mod cwbvh;
 pub mod kdtree;
 pub mod memory;
 pub mod settings;
@@ -212,8 +215,12 @@ pub struct GpuStructure {
 pub struct Registered {
     /// Name in scene files and sweeps.
     pub name: &'static str,
-    /// Its WGSL module (see the module doc for the interface).
+    /// Its WGSL module (see the module doc for the interface); empty where it has none.
     pub wgsl: &'static str,
+    /// Whether it has a GPU form. A structure without one (`wgsl` empty) is refused by its
+    /// [`Accelerator::gpu`] with an error naming it, which the GPU backend meets before compiling
+    /// anything: it never falls back to another structure.
+    pub gpu: bool,
     /// Storage buffers its WGSL declares at `@group(2)`.
     pub gpu_buffers: u32,
     /// Its parameters from its table, validated and completed with defaults, or the key that
@@ -239,6 +246,7 @@ pub const REGISTRY: &[Registered] = &[
     Registered {
         name: "bvh",
         wgsl: bvh::WGSL,
+        gpu: true,
         gpu_buffers: 2,
         params: settings::validate::<bvh::BvhSettings>,
         tuning: <bvh::BvhSettings as settings::Params>::tuning,
@@ -250,6 +258,7 @@ pub const REGISTRY: &[Registered] = &[
     Registered {
         name: "brute",
         wgsl: brute::WGSL,
+        gpu: true,
         gpu_buffers: 1,
         params: settings::validate::<brute::BruteSettings>,
         tuning: <brute::BruteSettings as settings::Params>::tuning,
@@ -260,6 +269,7 @@ pub const REGISTRY: &[Registered] = &[
     Registered {
         name: "vlf",
         wgsl: vlf::WGSL,
+        gpu: true,
         gpu_buffers: vlf::GPU_BUFFERS,
         params: settings::validate::<vlf::VlfSettings>,
         tuning: <vlf::VlfSettings as settings::Params>::tuning,
@@ -270,11 +280,29 @@ pub const REGISTRY: &[Registered] = &[
     Registered {
         name: "kdtree",
         wgsl: kdtree::WGSL,
+        gpu: true,
         gpu_buffers: kdtree::GPU_BUFFERS,
         params: settings::validate::<kdtree::KdSettings>,
         tuning: <kdtree::KdSettings as settings::Params>::tuning,
         build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()))),
         // A leaf entry per triangle at least, and the f64 copy.
+        memory: |n, _| n as u64 * (4 + 72),
+        follows_within: None,
+    },
+    Registered {
+        name: "cwbvh",
+        wgsl: "",
+        gpu: false,
+        gpu_buffers: 0,
+        params: settings::validate::<cwbvh::CwbvhSettings>,
+        tuning: <cwbvh::CwbvhSettings as settings::Params>::tuning,
+        build: |t, s| {
+            Ok(Arc::new(cwbvh::Cwbvh::build(
+                t,
+                s.typed::<cwbvh::CwbvhSettings>().preset,
+            )))
+        },
+        // A primitive slot per triangle at least, and the f64 copy.
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
     },

@@ -25,6 +25,13 @@ pub trait Params: Serialize + DeserializeOwned + Default {
     /// The first key out of range and why.
     fn check(&self) -> Result<(), (&'static str, String)>;
 
+    /// The same structure's parameters with the keys it ignores set to their defaults (a
+    /// kd-tree's SAH constants under a median split), so that candidates building the same
+    /// structure compare equal and a tuning grid times each once.
+    fn canonical(self) -> Self {
+        self
+    }
+
     /// The candidates an experiment tunes over when its file lists none: each key's values
     /// (the paper's among them), as a table of lists.
     fn tuning() -> toml::Table {
@@ -218,7 +225,7 @@ pub fn validate<P: Params>(table: &toml::Table) -> Result<toml::Table, (String, 
         .try_into()
         .map_err(|e: toml::de::Error| (String::new(), e.to_string()))?;
     p.check().map_err(|(k, m)| (k.to_string(), m))?;
-    toml::Table::try_from(&p).map_err(|e| (String::new(), e.to_string()))
+    toml::Table::try_from(p.canonical()).map_err(|e| (String::new(), e.to_string()))
 }
 
 /// The `[accel.*]` tables of a file at `at` (e.g. `["accel"]`): each name a registered

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 /// Brute force's closest hit with the walk's rules: 0 < t < tmax, not `skip`, ties to the lower
 /// index.
-fn brute(t: &Triangles, (o, d, tmax, skip): Ray) -> Option<TriHit> {
+pub(crate) fn brute(t: &Triangles, (o, d, tmax, skip): Ray) -> Option<TriHit> {
     let mut best: Option<TriHit> = None;
     for (i, tri) in t.positions.iter().enumerate() {
         let i = i as u32;
@@ -32,7 +32,7 @@ fn brute(t: &Triangles, (o, d, tmax, skip): Ray) -> Option<TriHit> {
 }
 
 /// Rays the tree answers differently from brute force (closest or any-hit), with a few named.
-fn wrong(tree: &KdTree, t: &Triangles, rays: &[Ray]) -> (usize, Vec<String>) {
+pub(crate) fn wrong(tree: &KdTree, t: &Triangles, rays: &[Ray]) -> (usize, Vec<String>) {
     let bad: Vec<String> = rays
         .par_iter()
         .filter_map(|&ray| {
@@ -59,6 +59,7 @@ fn every_ray_kind_on_every_mesh_matches_brute_force() {
             KdSettings {
                 max_depth: 8,
                 leaf_size: 16,
+                ..KdSettings::default()
             },
         ] {
             let tree = KdTree::build(t, settings);
@@ -80,7 +81,7 @@ fn every_ray_kind_on_every_mesh_matches_brute_force() {
 
 /// An axis-aligned box of side 2 at `c`, its faces as 12 triangles, every face in a plane a
 /// spatial-median split can choose; plus a second, coincident copy of one face.
-fn boxes(c: DVec3) -> Triangles {
+pub(crate) fn boxes(c: DVec3) -> Triangles {
     let mut out = Vec::new();
     for axis in 0..3 {
         for side in [-1.0, 1.0] {
@@ -105,7 +106,7 @@ fn boxes(c: DVec3) -> Triangles {
 
 /// Rays along the axes and diagonals from points on the box's faces and median planes, from
 /// inside and outside, with and without `tmax` and `skip`.
-fn plane_rays(c: DVec3, r: &mut Rng) -> Vec<Ray> {
+pub(crate) fn plane_rays(c: DVec3, r: &mut Rng) -> Vec<Ray> {
     let mut dirs: Vec<DVec3> = Vec::new();
     for a in 0..3 {
         for s in [-1.0, 1.0] {
@@ -143,10 +144,12 @@ fn rays_and_triangles_in_split_planes_match_brute_force() {
             KdSettings {
                 max_depth: 0,
                 leaf_size: 4,
+                ..KdSettings::default()
             },
             KdSettings {
                 max_depth: MAX_DEPTH,
                 leaf_size: 0,
+                ..KdSettings::default()
             },
         ] {
             let tree = KdTree::build(&t, settings);

@@ -41,7 +41,8 @@ pub enum Preset {
 }
 
 impl Preset {
-    fn params(self) -> BvhBuildParams {
+    /// obvhs' build parameters for this preset.
+    pub(crate) fn params(self) -> BvhBuildParams {
         match self {
             Preset::Fastest => BvhBuildParams::fastest_build(),
             Preset::VeryFast => BvhBuildParams::very_fast_build(),
@@ -131,8 +132,23 @@ fn depth(tree: &Bvh2) -> usize {
     deepest
 }
 
+/// The centre of `positions`' bounding box (the origin of the trees' f32 coordinates), or zero
+/// for none.
+pub(crate) fn centre(positions: &[[DVec3; 3]]) -> DVec3 {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for t in positions.iter().flatten() {
+        lo = lo.min(*t);
+        hi = hi.max(*t);
+    }
+    if lo.is_finite() {
+        0.5 * (lo + hi)
+    } else {
+        DVec3::ZERO
+    }
+}
+
 /// `positions` in f32 relative to `centre`, as obvhs builds and walks them.
-fn relative(positions: &[[DVec3; 3]], centre: DVec3) -> Vec<Triangle> {
+pub(crate) fn relative(positions: &[[DVec3; 3]], centre: DVec3) -> Vec<Triangle> {
     let f = |p: DVec3| Vec3A::from((p - centre).as_vec3());
     positions
         .iter()
@@ -145,7 +161,7 @@ fn relative(positions: &[[DVec3; 3]], centre: DVec3) -> Vec<Triangle> {
 }
 
 /// `tree` with every box widened by a few f32 ulps of its root's size (see `Bvh::cpu_tree`).
-fn widened(tree: &Bvh2) -> Bvh2 {
+pub(crate) fn widened(tree: &Bvh2) -> Bvh2 {
     let mut cpu_tree = tree.clone();
     if let Some(root) = tree.nodes.first() {
         let size = root.aabb.min.abs().max(root.aabb.max.abs()).max_element();
@@ -193,12 +209,7 @@ impl Bvh {
     /// Builds the tree over `triangles` with `preset`.
     pub fn build(triangles: &Triangles, preset: Preset) -> Bvh {
         let start = Instant::now();
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for t in triangles.positions.iter().flatten() {
-            lo = lo.min(*t);
-            hi = hi.max(*t);
-        }
-        let centre = if lo.is_finite() { 0.5 * (lo + hi) } else { DVec3::ZERO };
+        let centre = centre(&triangles.positions);
         let local = relative(&triangles.positions, centre);
         let mut build_time = Duration::default();
         let tree = build_bvh2_from_tris(&local, preset.params(), &mut build_time);

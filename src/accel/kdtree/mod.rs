@@ -1,7 +1,9 @@
 //! A kd-tree as the visibility-field paper's baseline built it: single-ray Coherent Ray Tracing
 //! (Wald, Slusallek, Benthin, Wagner 2001), a BSP over axis-aligned planes with spatial-median
-//! splits (no SAH), 8-byte nodes, and an explicit-stack front-to-back traversal. Tuned, as the
-//! paper tuned it, on maximum depth and leaf size ([`KdSettings`]).
+//! splits ([`median`]), 8-byte nodes, and an explicit-stack front-to-back traversal. Tuned, as the
+//! paper tuned it, on maximum depth and leaf size ([`KdSettings`]). Beside it, the split the
+//! paper's authors name as the missing improvement: planes chosen by the surface area heuristic
+//! (Wald & Havran 2006, [`sah`]), over the same nodes and the same walk.
 //!
 //! # Nodes
 //! Two u32 words ([`KdNode`]). Inner: the split plane's coordinate, measured from the root box's
@@ -10,15 +12,23 @@
 //! `left + 1`). Leaf: the first entry of its triangle list in `items`, then `count << 2 | 3`.
 //!
 //! # Exactness
-//! A node's triangles are those whose bounding box meets its closed half-space, so a triangle
-//! touching a plane sits on both sides. The walk treats each plane as a slab `delta` thick
-//! ([`walk`]), visiting both children wherever rounding could decide the side, and leaves test
-//! triangles with [`crate::accel::intersect`] over the whole segment: answers equal brute
+//! Every triangle meeting a node's closed box is in one of its children at least: the median
+//! puts a triangle whose bounding box meets a closed half-space on that side (touching a plane: on
+//! both sides); the SAH clips triangles to the node (conservatively) and may put one that only
+//! touches the plane, or lies in it, on one side. The walk treats each plane as a slab `delta`
+//! thick ([`walk`]), visiting both children wherever rounding could decide the side, and leaves
+//! test triangles with [`crate::accel::intersect`] over the whole segment: answers equal brute
 //! force's bit for bit, ties going to the lower index. A popped subtree is skipped only when its
 //! entry distance lies beyond the best hit, and entry distances are lower bounds.
 
+mod clip;
 mod gpu;
+pub mod median;
+pub mod sah;
+mod settings;
 pub mod walk;
+
+pub use settings::{KdSettings, SahCosts, Split, PAPER_COSTS};
 
 use super::{Accelerator, BuildStats, GpuStructure, TriHit};
 use crate::geometry::LocalFrame;
@@ -35,61 +45,6 @@ pub const GPU_BUFFERS: u32 = 4;
 
 /// Deepest tree the walk's stack (64 entries on the CPU and the GPU) allows.
 pub const MAX_DEPTH: u32 = 60;
-
-/// The paper's tuning knobs for its CRT baseline (`[accel.kdtree]`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct KdSettings {
-    /// Deepest split level (the paper's best: 16-23 for AO, 23 for the walkthrough).
-    pub max_depth: u32,
-    /// Nodes with at most this many triangles become leaves.
-    pub leaf_size: u32,
-}
-
-impl Default for KdSettings {
-    /// The best of `cargo bench --bench vlf_compare -- --tune-kdtree` (depths 16-30, leaves
-    /// 2-32, AO rays along the 513 grid directions, one thread): depth 22 and leaf 8 on the cow
-    /// (1.56 Mrays/s) and bull (1.25); the man and the body peak deeper (26-28) within 10 %.
-    fn default() -> Self {
-        KdSettings {
-            max_depth: 22,
-            leaf_size: 8,
-        }
-    }
-}
-
-impl crate::accel::settings::Params for KdSettings {
-    fn check(&self) -> Result<(), (&'static str, String)> {
-        if self.max_depth > MAX_DEPTH {
-            return Err((
-                "max_depth",
-                format!("must lie in 0..={MAX_DEPTH} (the walk's stack), got {}", self.max_depth),
-            ));
-        }
-        if self.leaf_size > 1 << 16 {
-            return Err((
-                "leaf_size",
-                format!("must lie in 0..={}, got {}", 1 << 16, self.leaf_size),
-            ));
-        }
-        Ok(())
-    }
-
-    /// The paper's CRT depths (16-23) and deeper, at three leaf sizes.
-    fn tuning() -> toml::Table {
-        toml::toml! {
-            max_depth = [16, 18, 22, 26, 30]
-            leaf_size = [4, 8, 16]
-        }
-    }
-}
-
-impl KdSettings {
-    /// The parameters in a few words.
-    pub fn describe(&self) -> String {
-        format!("depth {} leaf {}", self.max_depth, self.leaf_size)
-    }
-}
 
 /// One node, 8 bytes (see the module doc).
 #[repr(C)]
@@ -151,28 +106,43 @@ fn bounds_of(t: &[DVec3; 3]) -> (DVec3, DVec3) {
     (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]))
 }
 
-struct Builder<'a> {
-    boxes: &'a [(DVec3, DVec3)],
+/// The node array as a build fills it: each builder allocates children in pairs and stores planes
+/// from the root box's low corner, rounded to the f32 the node holds.
+struct Layout {
     /// The root box's low corner, from which splits are stored.
     origin: DVec3,
-    settings: KdSettings,
     nodes: Vec<KdNode>,
     items: Vec<u32>,
     depth: u32,
 }
 
-impl Builder<'_> {
-    /// Fills node `at` (already allocated) for `tris` inside `bounds` at `depth`.
-    fn node(&mut self, at: usize, tris: Vec<u32>, bounds: (DVec3, DVec3), depth: u32) {
+impl Layout {
+    fn new(origin: DVec3) -> Layout {
+        Layout {
+            origin,
+            nodes: vec![KdNode::zeroed()],
+            items: Vec::new(),
+            depth: 0,
+        }
+    }
+
+    /// The plane `s` on `axis` as the node will store it (f32 from the root box's corner), in
+    /// world coordinates.
+    fn stored(&self, axis: usize, s: f64) -> f64 {
+        let o = self.origin[axis];
+        o + (s - o) as f32 as f64
+    }
+
+    /// Makes node `at` a leaf holding `tris`.
+    fn leaf(&mut self, at: usize, tris: &[u32], depth: u32) {
         self.depth = self.depth.max(depth);
-        let split = (tris.len() > self.settings.leaf_size as usize && depth < self.settings.max_depth)
-            .then(|| self.split(&tris, bounds))
-            .flatten();
-        let Some((axis, s, left, right)) = split else {
-            self.nodes[at] = KdNode::leaf(self.items.len(), tris.len());
-            self.items.extend(tris);
-            return;
-        };
+        self.nodes[at] = KdNode::leaf(self.items.len(), tris.len());
+        self.items.extend_from_slice(tris);
+    }
+
+    /// Makes node `at` an inner node splitting `axis` at `s` (a value [`Layout::stored`]
+    /// returned); returns its left child (the right one follows it).
+    fn inner(&mut self, at: usize, axis: usize, s: f64) -> usize {
         let first = self.nodes.len();
         self.nodes.push(KdNode::zeroed());
         self.nodes.push(KdNode::zeroed());
@@ -180,41 +150,22 @@ impl Builder<'_> {
             word: ((s - self.origin[axis]) as f32).to_bits(),
             data: (first as u32) << 2 | axis as u32,
         };
-        let (mut lo_box, mut hi_box) = (bounds, bounds);
-        lo_box.1[axis] = s;
-        hi_box.0[axis] = s;
-        self.node(first, left, lo_box, depth + 1);
-        self.node(first + 1, right, hi_box, depth + 1);
-    }
-
-    /// The spatial median of the longest side (rounded to the f32 the node stores, from the root
-    /// box's low corner) and each side's triangles; `None` where the plane would not divide
-    /// anything.
-    #[allow(clippy::type_complexity)]
-    fn split(&self, tris: &[u32], (lo, hi): (DVec3, DVec3)) -> Option<(usize, f64, Vec<u32>, Vec<u32>)> {
-        let axis = (hi - lo).max_position();
-        let o = self.origin[axis];
-        let s = o + ((lo[axis] + hi[axis]) * 0.5 - o) as f32 as f64;
-        if !(s > lo[axis] && s < hi[axis]) {
-            return None;
-        }
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        for &t in tris {
-            let (a, b) = self.boxes[t as usize];
-            if a[axis] <= s {
-                left.push(t);
-            }
-            if b[axis] >= s {
-                right.push(t);
-            }
-        }
-        (left.len() < tris.len() || right.len() < tris.len()).then_some((axis, s, left, right))
+        first
     }
 }
 
+/// `bounds` cut at `s` on `axis`: the low and high halves.
+fn halves(bounds: (DVec3, DVec3), axis: usize, s: f64) -> ((DVec3, DVec3), (DVec3, DVec3)) {
+    let (mut lo, mut hi) = (bounds, bounds);
+    lo.1[axis] = s;
+    hi.0[axis] = s;
+    (lo, hi)
+}
+
 impl KdTree {
-    /// Builds the tree over `triangles` (all of them: degenerate ones are simply never hit), no
-    /// deeper than [`MAX_DEPTH`] whatever `settings` ask (the walks' stacks hold that much).
+    /// Builds the tree over `triangles` (all of them: degenerate ones are simply never hit) with
+    /// the planes `settings.split` chooses, no deeper than [`MAX_DEPTH`] whatever `settings` ask
+    /// (the walks' stacks hold that much).
     pub fn build(triangles: &Triangles, settings: KdSettings) -> KdTree {
         let started = Instant::now();
         let settings = KdSettings {
@@ -227,20 +178,16 @@ impl KdTree {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| {
                 (lo.min(*a), hi.max(*b))
             });
-        let mut b = Builder {
-            boxes: &boxes,
-            origin: bounds.0,
-            settings,
-            nodes: vec![KdNode::zeroed()],
-            items: Vec::new(),
-            depth: 0,
-        };
-        b.node(0, (0..boxes.len() as u32).collect(), bounds, 0);
+        let mut layout = Layout::new(bounds.0);
+        match settings.split {
+            Split::Median => median::build(&mut layout, &boxes, bounds, &settings),
+            Split::Sah => sah::build(&mut layout, &triangles.positions, &boxes, bounds, &settings),
+        }
         KdTree {
-            nodes: b.nodes,
-            items: b.items,
+            nodes: layout.nodes,
+            items: layout.items,
             bounds,
-            depth: b.depth,
+            depth: layout.depth,
             triangles: triangles.clone(),
             settings,
             build_time: started.elapsed(),
@@ -288,9 +235,12 @@ impl Accelerator for KdTree {
             memory_bytes: self.bytes() as u64,
             triangles: n,
             description: format!(
-                "kd-tree (spatial median, {}): {} nodes, {leaves} leaves, depth {}, {:.2} triangle \
+                "kd-tree ({}): {} nodes, {leaves} leaves, depth {}, {:.2} triangle \
                  references per triangle, {:.1} MB, built in {:.0} ms",
-                self.settings.describe(),
+                match self.settings.split {
+                    Split::Median => format!("spatial median, {}", self.settings.describe()),
+                    Split::Sah => format!("SAH planes, {}", self.settings.describe()),
+                },
                 self.nodes.len(),
                 self.depth,
                 self.items.len() as f64 / n.max(1) as f64,
