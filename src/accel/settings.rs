@@ -126,17 +126,32 @@ pub fn parameter_columns() -> &'static [ParameterColumn] {
         super::REGISTRY
             .iter()
             .flat_map(|r| {
-                AccelSettings::default_for(r)
-                    .params
-                    .into_iter()
-                    .map(|(key, _)| ParameterColumn {
-                        structure: r.name,
-                        name: format!("{}_{key}", r.name),
-                        key,
-                    })
+                keys(r).into_iter().map(|key| ParameterColumn {
+                    structure: r.name,
+                    name: format!("{}_{key}", r.name),
+                    key,
+                })
             })
             .collect()
     })
+}
+
+/// Every key a structure's parameters can hold: its defaults' and, since a choice can bring
+/// keys of its own (the kd-tree's SAH costs come with `split = "sah"`), those of each value of
+/// its tuning grid taken alone; in the order first met.
+fn keys(r: &super::Registered) -> Vec<String> {
+    let mut keys: Vec<String> = AccelSettings::default_for(r).params.keys().cloned().collect();
+    for (key, values) in (r.tuning)() {
+        for v in values.as_array().into_iter().flatten() {
+            let one = toml::Table::from_iter([(key.clone(), v.clone())]);
+            for (k, _) in (r.params)(&one).into_iter().flatten() {
+                if !keys.contains(&k) {
+                    keys.push(k);
+                }
+            }
+        }
+    }
+    keys
 }
 
 /// A row's structure parameters as table columns, one value per column
@@ -332,9 +347,17 @@ mod tests {
                 "vlf_split",
                 "vlf_tiles",
                 "kdtree_leaf_size",
-                "kdtree_max_depth"
+                "kdtree_max_depth",
+                "kdtree_split",
+                "kdtree_empty_factor",
+                "kdtree_intersection_cost",
+                "kdtree_traversal_cost",
+                "cwbvh_preset"
             ]
         );
+        // The SAH's costs, which only a SAH tree has, have their columns too.
+        let sah = AccelSettings::with("kdtree", &toml::toml! { split = "sah" traversal_cost = 5.0 }).unwrap();
+        assert_eq!(ParameterColumns::of(&sah).get("kdtree_traversal_cost"), Some("5.0"));
         let kd = AccelSettings::with("kdtree", &toml::toml! { max_depth = 7 }).unwrap();
         let columns = ParameterColumns::of(&kd);
         assert_eq!(columns.get("kdtree_max_depth"), Some("7"));
@@ -376,7 +399,7 @@ mod tests {
         write_rows(&path, &rows).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.starts_with("structure,bvh_preset,vlf_depth,"), "{text}");
-        assert!(text.contains("\nbrute,,,,,,,,,brute\n"), "{text}");
+        assert!(text.contains("\nbrute,,,,,,,,,,,,,,brute\n"), "{text}");
         assert_eq!(read_rows::<(Key, ParameterColumns, Key)>(&path), rows);
     }
 }
