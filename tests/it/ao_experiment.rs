@@ -24,7 +24,7 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     let header = rows.headers().unwrap().clone();
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let rows: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
-    assert_eq!(rows.len(), 2 * 4, "{csv}");
+    assert_eq!(rows.len(), 2 * 5, "{csv}");
     for r in &rows {
         assert_eq!(&r[col("same_image_as_first")], "true", "{csv}");
         assert!(r[col("receivers")].parse::<usize>().unwrap() > 50, "{csv}");
@@ -59,6 +59,7 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         "vlf",
         "bvh",
         "brute",
+        "cwbvh",
         "95 % interval",
     ] {
         assert!(texts.contains(&name), "frame_time.svg lacks {name}: {texts:?}");

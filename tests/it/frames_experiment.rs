@@ -31,7 +31,7 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let dir = tempfile::tempdir().unwrap();
     let (header, rows, report) = run(dir.path(), &ci());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    assert_eq!(rows.len(), 2 * 3 * 4, "2 shadings x 3 frames x 4 structures");
+    assert_eq!(rows.len(), 2 * 3 * 5, "2 shadings x 3 frames x 5 structures");
     let tables = common::assert_tidy_tables(&dir.path().join("out"));
     assert_eq!(tables.len(), 3, "frames.csv, builds.csv and summary.csv: {tables:?}");
     let builds = std::fs::read_to_string(dir.path().join("out/builds.csv")).unwrap();
@@ -116,7 +116,7 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
         .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]");
     let (header, rows, report) = run(dir.path(), &text);
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    assert_eq!(rows.len(), 2 * 2 * 2 * 4, "sizes x viewpoints x frames x structures");
+    assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
     assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
     for file in [
         "plots/scaling_opengl.png",
@@ -153,11 +153,12 @@ fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
         "bvh rebuild",
         "bvh rebuild-fastest",
         "bvh refit",
+        "cwbvh rebuild",
         "brute rebuild",
     ] {
         assert!(methods.iter().any(|x| x == m), "{m} missing: {methods:?}");
     }
-    assert_eq!(rows.len(), 2 * 3 * 6);
+    assert_eq!(rows.len(), 2 * 3 * 7);
     for r in &rows {
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
         assert!(r[col("update_s")].parse::<f64>().unwrap() > 0.0, "{r:?}");
@@ -189,8 +190,8 @@ fn bad_input_is_located_and_writes_nothing() {
             "scene.generator",
         ),
         (
-            text.replace("\"bvh\", \"brute\"", "\"bvh\", \"octree\""),
-            "structures[3]",
+            text.replace("\"cwbvh\", \"brute\"", "\"cwbvh\", \"octree\""),
+            "structures[4]",
         ),
         (
             text.replace("\"opengl\", \"whitted\"", "\"opengl\", \"opengl\""),
