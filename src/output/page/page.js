@@ -486,9 +486,33 @@
     state.panY = c.height / 2 - (y + 0.5) * state.zoom;
     render();
     const r = c.getBoundingClientRect();
-    c.dispatchEvent(new MouseEvent('mousemove', { clientX: r.left + r.width / 2, clientY: r.top + r.height / 2, bubbles: true }));
+    const [clientX, clientY] = [r.left + r.width / 2, r.top + r.height / 2];
+    c.dispatchEvent(new MouseEvent('mousemove', { clientX, clientY, bubbles: true }));
     const text = (id) => ($(id) ? $(id).textContent : null);
-    return { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
+    const out = { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
+    // What is drawn under the cursor: A and B each shown whole (flip), at 0 EV (the PNG's
+    // picture) and at +1 EV.
+    const saved = { mode: state.mode, showB: state.showB, ev: state.ev };
+    const colour = (showB, ev) => {
+      Object.assign(state, { mode: 'flip', showB, ev });
+      render();
+      return shownAt(c, ((clientX - r.left) * c.width) / r.width, ((clientY - r.top) * c.height) / r.height);
+    };
+    Object.assign(out, { rgb_a: colour(false, 0), rgb_b: colour(true, 0), rgb_a_ev1: colour(false, 1) });
+    Object.assign(state, saved);
+    render();
+    return out;
+  }
+
+  // The colour a canvas shows at canvas position (x, y), read from a copy (reading the shown
+  // canvas itself makes the browser warn about repeated readbacks).
+  function shownAt(canvas, x, y) {
+    const copy = document.createElement('canvas');
+    copy.width = 1;
+    copy.height = 1;
+    const ctx = copy.getContext('2d', { willReadFrequently: true });
+    ctx.drawImage(canvas, Math.floor(x), Math.floor(y), 1, 1, 0, 0, 1, 1);
+    return Array.from(ctx.getImageData(0, 0, 1, 1).data.slice(0, 3));
   }
 
   function differs(i, j) {
@@ -497,7 +521,7 @@
   }
 
   async function selftest() {
-    const report = { errors, images: [], readouts: [], slider: null, flip: null, shots: shots.length };
+    const report = { errors, images: [], readouts: [], slider: null, flip: null, exposure: null, shots: shots.length };
     if (document.readyState !== 'complete') await new Promise((done) => window.addEventListener('load', done));
     // A broken image has no natural size, and drawing it throws.
     const scratch = document.createElement('canvas').getContext('2d');
@@ -523,7 +547,7 @@
         });
         const pixels = [[0, 0], [s.width - 1, s.height - 1], [worst % s.width, Math.floor(worst / s.width)]];
         for (const [x, y] of pixels) {
-          report.readouts.push({ a: s.exr, b: shots[state.b].exr, x, y, shown: hover(x, y) });
+          report.readouts.push({ a: s.exr, b: shots[state.b].exr, png_a: s.png, png_b: shots[state.b].png, tone: s.tone, x, y, shown: hover(x, y) });
         }
       });
       let pair = null;
@@ -546,6 +570,12 @@
         const once = shownHash();
         $('flip').click();
         report.flip = { changed: before !== once && once !== shownHash() };
+        const expose = (ev) => {
+          $('exposure').value = String(ev);
+          $('exposure').dispatchEvent(new Event('input'));
+          return shownHash();
+        };
+        report.exposure = { changed: expose(-1) !== expose(0) };
       }
     }
     const out = $('selftest');
