@@ -253,7 +253,10 @@
   }
 
   // ---- pixel readout -----------------------------------------------------------------------
+  // A pixel's value; an error view's value (NaN where either pixel has no receiver: an error of
+  // exactly -1, black against white, is a value), FLIP to the three decimals its map keeps.
   const show = (v) => (v === NO_RECEIVER ? 'no receiver' : Number.isFinite(v) ? v.toPrecision(7) : '—');
+  const showError = (v) => (!Number.isFinite(v) ? '—' : state.view === 'flip' ? v.toFixed(3) : v.toPrecision(7));
 
   function pixelAt(canvas, clientX, clientY) {
     const r = canvas.getBoundingClientRect();
@@ -283,7 +286,7 @@
     part(', ', 'read-y', String(y));
     part('A ', 'read-a', show(a.values[i]));
     part('B ', 'read-b', show(b.values[i]));
-    part(`${VIEWS[state.view].name} `, 'read-e', show(e));
+    part(`${VIEWS[state.view].name} `, 'read-e', showError(e));
   }
 
   // ---- controls ----------------------------------------------------------------------------

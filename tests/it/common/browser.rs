@@ -108,11 +108,16 @@ fn exr(path: &Path) -> Result<(Vec<f32>, usize), String> {
     Ok((ch.sample_data.values_as_f32().collect(), width))
 }
 
-/// Whether the page's text for a value shows `value` to the seven significant digits it prints.
+/// Whether the page's text for a pixel shows `value` (`no receiver` for -1).
 fn shows(text: &str, value: f64) -> bool {
     if value == -1.0 {
         return text == "no receiver";
     }
+    shows_number(text, value)
+}
+
+/// Whether the page's text shows `value` to the seven significant digits it prints.
+fn shows_number(text: &str, value: f64) -> bool {
     let Ok(shown) = text.parse::<f64>() else {
         return false;
     };
@@ -221,7 +226,16 @@ pub fn problems(browser: &Path, dir: &Path) -> Vec<String> {
                 text("b")
             ));
         }
-        if va != -1.0 && vb != -1.0 && !shows(&text("e"), va - vb) {
+        // An error view has no value where either pixel has no receiver; elsewhere every
+        // difference is a number, -1 (black against white) too.
+        if va == -1.0 || vb == -1.0 {
+            if text("e") != "—" {
+                out.push(format!(
+                    "{a} - {b} ({x}, {y}): the error view reads {} where a pixel has no receiver",
+                    text("e")
+                ));
+            }
+        } else if !shows_number(&text("e"), va - vb) {
             out.push(format!(
                 "{a} - {b} ({x}, {y}): the error view reads {} where the EXRs differ by {}",
                 text("e"),
