@@ -18,6 +18,10 @@
   const NO_RECEIVER = -1;
   const NO_RECEIVER_RGB = [20, 24, 60];
   const $ = (id) => document.getElementById(id);
+  // A link to a file of the results folder by its relative path: each part percent-encoded and
+  // the whole led by ./, so that no file name (`javascript:x.csv`, `a#b.csv`) reads as a scheme
+  // or a fragment.
+  const fileUrl = (path) => './' + path.split('/').map(encodeURIComponent).join('/');
 
   // ---- decoding ----------------------------------------------------------------------------
   async function inflate(b64) {
@@ -222,7 +226,7 @@
     for (const s of [a, b]) {
       for (const f of [s.exr, s.png]) {
         const link = document.createElement('a');
-        link.href = f;
+        link.href = fileUrl(f);
         link.textContent = f;
         $('files').append(link, ' ');
       }
@@ -406,7 +410,7 @@
       details.open = t.file === (DATA.tables.some((u) => u.file === 'summary.csv') ? 'summary.csv' : DATA.tables[0].file);
       const summary = document.createElement('summary');
       const link = document.createElement('a');
-      link.href = t.file;
+      link.href = fileUrl(t.file);
       link.textContent = t.file;
       if (!t.shown) {
         const p = document.createElement('p');
