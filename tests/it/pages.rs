@@ -1,9 +1,9 @@
 //! Results pages in a real browser: the CI sweep's fresh page and every committed results
-//! folder's page pass their self-test (no console error, every image decodes, the slider and the
-//! flip and the exposure change what is shown, every readout equals the EXR, what is drawn under
-//! the cursor is the PNG's pixel); and the check fails on a page broken in each of those ways.
-//! The ao and frames kinds' pages are checked where their CI experiments
-//! run (ao_experiment.rs, frames_experiment.rs).
+//! folder's page pass their self-test (no console error, every image decodes, the slider, the flip
+//! and the exposure change what is shown, every readout equals the EXR, what is drawn under the
+//! cursor is the PNG's pixel and the error view's colour of A - B); and the check fails on a page
+//! broken in each of those ways. The ao and frames kinds' pages are checked where their CI
+//! experiments run (ao_experiment.rs, frames_experiment.rs).
 
 use crate::common::{self, browser};
 use std::ffi::OsStr;
@@ -95,7 +95,7 @@ fn the_browser_check_fails_on_a_broken_page() {
         return;
     };
     type Edit = Box<dyn FnOnce(&Path)>;
-    let cases: [(&str, Edit); 8] = [
+    let cases: [(&str, Edit); 9] = [
         (
             "console error",
             Box::new(|d| {
@@ -166,6 +166,17 @@ fn the_browser_check_fails_on_a_broken_page() {
                     &d.join("index.html"),
                     "const gain = Math.pow(2, state.ev);",
                     "const gain = Math.pow(2, state.ev / 2);",
+                )
+            }),
+        ),
+        (
+            "the error view draws",
+            Box::new(|d| {
+                // Positive differences drawn blue: the readout still reads the right number.
+                replace_in(
+                    &d.join("index.html"),
+                    "colour: (v, s) => diverging(v / s)",
+                    "colour: (v, s) => diverging(-v / s)",
                 )
             }),
         ),

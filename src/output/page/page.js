@@ -497,13 +497,15 @@
     c.dispatchEvent(new MouseEvent('mousemove', { clientX, clientY, bubbles: true }));
     const text = (id) => ($(id) ? $(id).textContent : null);
     const out = { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
-    // What is drawn under the cursor: A and B each shown whole (flip), at 0 EV (the PNG's
-    // picture) and at +1 EV.
+    // What is drawn under the cursor: the error view there, and A and B each shown whole (flip),
+    // at 0 EV (the PNG's picture) and at +1 EV.
+    const [cx, cy] = [((clientX - r.left) * c.width) / r.width, ((clientY - r.top) * c.height) / r.height];
+    out.rgb_e = shownAt($('view-error'), cx, cy);
     const saved = { mode: state.mode, showB: state.showB, ev: state.ev };
     const colour = (showB, ev) => {
       Object.assign(state, { mode: 'flip', showB, ev });
       render();
-      return shownAt(c, ((clientX - r.left) * c.width) / r.width, ((clientY - r.top) * c.height) / r.height);
+      return shownAt(c, cx, cy);
     };
     Object.assign(out, { rgb_a: colour(false, 0), rgb_b: colour(true, 0), rgb_a_ev1: colour(false, 1) });
     Object.assign(state, saved);

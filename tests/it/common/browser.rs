@@ -153,6 +153,26 @@ fn close(shown: &Value, want: &[u8; 3]) -> bool {
         .all(|(s, &w)| s.as_u64().is_some_and(|s| s.abs_diff(w as u64) <= 1))
 }
 
+/// The scale of the signed-difference view of `a` against `b`: the 99th percentile of |a - b|
+/// over the pixels where both have a receiver (1 where that is 0).
+fn difference_scale(a: &[f32], b: &[f32]) -> f64 {
+    let mut m: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| **x != -1.0 && **y != -1.0)
+        .map(|(&x, &y)| (x as f64 - y as f64).abs())
+        .collect();
+    m.sort_by(f64::total_cmp);
+    // The page's index, floor(0.99 n), computed as it computes it.
+    let k = ((0.99 * m.len() as f64).floor() as usize).min(m.len().saturating_sub(1));
+    let s = m.get(k).copied().unwrap_or(0.0);
+    if s > 0.0 {
+        s
+    } else {
+        1.0
+    }
+}
+
 /// The colour the page should draw for `value` at +1 EV under the gallery's tone mapping (JSON
 /// as the page has it), computed with the crate's own mapping: the value doubled, except a pixel
 /// with no receiver, which keeps its colour.
@@ -262,6 +282,20 @@ pub fn problems(browser: &Path, dir: &Path) -> Vec<String> {
                 }
                 Err(e) => out.push(e),
             }
+        }
+        // The signed-difference view (the one the self-test reads) draws A - B on the diverging
+        // scale at the 99th percentile of |A - B|, grey where a pixel has no receiver.
+        let want = if va == -1.0 || vb == -1.0 {
+            [96, 96, 96]
+        } else {
+            penumbra::output::images::diverging_colour((va - vb) / difference_scale(&av, &bv))
+        };
+        if !close(&shown["rgb_e"], &want) {
+            out.push(format!(
+                "{a} - {b} ({x}, {y}): the error view draws {} under the cursor where A - B = {} is {want:?}",
+                shown["rgb_e"],
+                va - vb
+            ));
         }
         match brighter(&r["tone"], va as f32) {
             Some(want) if !close(&shown["rgb_a_ev1"], &want) => out.push(format!(
