@@ -401,6 +401,8 @@
     });
   }
   let drag = null;
+  // The shots some table row opens.
+  const linked = new Set();
 
   // ---- tables ------------------------------------------------------------------------------
   function tables() {
@@ -444,6 +446,7 @@
           return c >= 0 && r[c] === v;
         }));
         if (shot >= 0) {
+          linked.add(shot);
           tr.className = 'linked';
           tr.title = `compare ${shots[shot].label}`;
           tr.addEventListener('click', () => {
@@ -531,6 +534,8 @@
 
   async function selftest() {
     const report = { errors, images: [], readouts: [], slider: null, flip: null, exposure: null, shots: shots.length };
+    // A shot that names its table rows (its key) and that no row opens.
+    report.unlinked = shots.filter((s, i) => Object.keys(s.key).length && !linked.has(i)).map((s) => s.exr);
     if (document.readyState !== 'complete') await new Promise((done) => window.addEventListener('load', done));
     // A broken image has no natural size, and drawing it throws.
     const scratch = document.createElement('canvas').getContext('2d');

@@ -200,6 +200,9 @@ pub fn problems(browser: &Path, dir: &Path) -> Vec<String> {
     for e in report["console"].as_array().into_iter().flatten() {
         out.push(format!("console error (browser log): {e}"));
     }
+    for exr in report["unlinked"].as_array().into_iter().flatten() {
+        out.push(format!("no table row opens {exr}, though it names its rows"));
+    }
     for img in report["images"].as_array().into_iter().flatten() {
         if img["ok"] != Value::Bool(true) {
             out.push(format!("image does not decode: {}", img["src"]));
