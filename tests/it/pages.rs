@@ -42,6 +42,8 @@ fn the_ci_sweeps_page_passes_in_the_browser() {
         assert!(!html.contains(&format!("src=\"{remote}")), "{remote} in the page");
     }
     browser::check_page(dir);
+    // Its tables (journal included) under the one unit convention, one value per column.
+    assert!(common::assert_tidy_tables(dir).len() >= 4);
 }
 
 #[test]
