@@ -602,7 +602,11 @@
       shots = await decode(DATA);
       if (shots.length) {
         wire();
-        choose(0, shots[0].reference === null ? undefined : shots[0].reference);
+        // B opens as A's reference, or where its gallery has none (a strip's frames) as the
+        // gallery's next image, so that the page opens on a comparison.
+        const first = shots[0];
+        const next = shots.findIndex((s, j) => j > 0 && s.gallery === first.gallery);
+        choose(0, first.reference !== null ? first.reference : next >= 0 ? next : undefined);
         fit();
         render();
       }
