@@ -1,8 +1,9 @@
 //! Results pages in a real browser: the CI sweep's fresh page and every committed results
-//! folder's page pass their self-test (no console error, every image decodes, the slider and the
-//! flip change what is shown, every readout equals the EXR); and the check fails on a page broken
-//! in each of those ways. The ao and frames kinds' pages are checked where their CI experiments
-//! run (ao_experiment.rs, frames_experiment.rs).
+//! folder's page pass their self-test (no console error, every image decodes, the slider, the flip
+//! and the exposure change what is shown, every readout equals the EXR, what is drawn under the
+//! cursor is the PNG's pixel and the error view's colour of A - B); and the check fails on a page
+//! broken in each of those ways. The ao and frames kinds' pages are checked where their CI
+//! experiments run (ao_experiment.rs, frames_experiment.rs).
 
 use crate::common::{self, browser};
 use std::ffi::OsStr;
@@ -41,6 +42,8 @@ fn the_ci_sweeps_page_passes_in_the_browser() {
         assert!(!html.contains(&format!("src=\"{remote}")), "{remote} in the page");
     }
     browser::check_page(dir);
+    // Its tables (journal included) under the one unit convention, one value per column.
+    assert!(common::assert_tidy_tables(dir).len() >= 4);
 }
 
 #[test]
@@ -94,7 +97,7 @@ fn the_browser_check_fails_on_a_broken_page() {
         return;
     };
     type Edit = Box<dyn FnOnce(&Path)>;
-    let cases: [(&str, Edit); 5] = [
+    let cases: [(&str, Edit); 10] = [
         (
             "console error",
             Box::new(|d| {
@@ -143,6 +146,60 @@ fn the_browser_check_fails_on_a_broken_page() {
                     &d.join("index.html"),
                     "return [Math.floor((cx - state.panX) / state.zoom),",
                     "return [1 + Math.floor((cx - state.panX) / state.zoom),",
+                )
+            }),
+        ),
+        (
+            "under the cursor where the PNG holds",
+            Box::new(|d| {
+                // The picture drawn upside down: every readout still matches the EXR.
+                replace_in(
+                    &d.join("index.html"),
+                    "px.set([...rgb, 255], 4 * i);",
+                    "px.set([...rgb, 255], 4 * ((shot.height - 1 - Math.floor(i / shot.width)) * shot.width + (i % shot.width)));",
+                )
+            }),
+        ),
+        (
+            "at +1 EV the page draws",
+            Box::new(|d| {
+                // An exposure control that is not in stops.
+                replace_in(
+                    &d.join("index.html"),
+                    "const gain = Math.pow(2, state.ev);",
+                    "const gain = Math.pow(2, state.ev / 2);",
+                )
+            }),
+        ),
+        (
+            "the error view draws",
+            Box::new(|d| {
+                // Positive differences drawn blue: the readout still reads the right number.
+                replace_in(
+                    &d.join("index.html"),
+                    "colour: (v, s) => diverging(v / s)",
+                    "colour: (v, s) => diverging(-v / s)",
+                )
+            }),
+        ),
+        (
+            "no table row opens",
+            Box::new(|d| {
+                // A key the tables do not write the same way (the radius as 0.020).
+                replace_in(
+                    &d.join("page_data.js"),
+                    "\"light_radius\":\"0.02\"",
+                    "\"light_radius\":\"0.020\"",
+                )
+            }),
+        ),
+        (
+            "the exposure does not change",
+            Box::new(|d| {
+                replace_in(
+                    &d.join("index.html"),
+                    "state.ev = Number(e.target.value);",
+                    "state.ev = state.ev;",
                 )
             }),
         ),

@@ -213,8 +213,14 @@ pub fn escape(text: &str) -> String {
 
 fn html(page: &Page, plots: &[String], pictures: &[String]) -> String {
     let title = escape(&page.title);
+    // A page without images (the fps kind) has no comparison to link to.
+    let compare = if page.galleries.is_empty() {
+        ""
+    } else {
+        "<a href=\"#compare\">compare</a> "
+    };
     let mut h = format!(
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n<style>\n{STYLE}</style>\n</head>\n<body>\n<header><h1>{title}</h1><nav><a href=\"#compare\">compare</a> <a href=\"#tables\">tables</a> <a href=\"#plots\">plots</a> <a href=\"#report\">report</a></nav></header>\n"
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n<style>\n{STYLE}</style>\n</head>\n<body>\n<header><h1>{title}</h1><nav>{compare}<a href=\"#tables\">tables</a> <a href=\"#plots\">plots</a> <a href=\"#report\">report</a></nav></header>\n"
     );
     if !page.galleries.is_empty() {
         h += COMPARE;

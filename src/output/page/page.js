@@ -18,6 +18,10 @@
   const NO_RECEIVER = -1;
   const NO_RECEIVER_RGB = [20, 24, 60];
   const $ = (id) => document.getElementById(id);
+  // A link to a file of the results folder by its relative path: each part percent-encoded and
+  // the whole led by ./, so that no file name (`javascript:x.csv`, `a#b.csv`) reads as a scheme
+  // or a fragment.
+  const fileUrl = (path) => './' + path.split('/').map(encodeURIComponent).join('/');
 
   // ---- decoding ----------------------------------------------------------------------------
   async function inflate(b64) {
@@ -222,7 +226,7 @@
     for (const s of [a, b]) {
       for (const f of [s.exr, s.png]) {
         const link = document.createElement('a');
-        link.href = f;
+        link.href = fileUrl(f);
         link.textContent = f;
         $('files').append(link, ' ');
       }
@@ -253,7 +257,10 @@
   }
 
   // ---- pixel readout -----------------------------------------------------------------------
+  // A pixel's value; an error view's value (NaN where either pixel has no receiver: an error of
+  // exactly -1, black against white, is a value), FLIP to the three decimals its map keeps.
   const show = (v) => (v === NO_RECEIVER ? 'no receiver' : Number.isFinite(v) ? v.toPrecision(7) : '—');
+  const showError = (v) => (!Number.isFinite(v) ? '—' : state.view === 'flip' ? v.toFixed(3) : v.toPrecision(7));
 
   function pixelAt(canvas, clientX, clientY) {
     const r = canvas.getBoundingClientRect();
@@ -283,7 +290,7 @@
     part(', ', 'read-y', String(y));
     part('A ', 'read-a', show(a.values[i]));
     part('B ', 'read-b', show(b.values[i]));
-    part(`${VIEWS[state.view].name} `, 'read-e', show(e));
+    part(`${VIEWS[state.view].name} `, 'read-e', showError(e));
   }
 
   // ---- controls ----------------------------------------------------------------------------
@@ -394,6 +401,8 @@
     });
   }
   let drag = null;
+  // The shots some table row opens.
+  const linked = new Set();
 
   // ---- tables ------------------------------------------------------------------------------
   function tables() {
@@ -403,7 +412,7 @@
       details.open = t.file === (DATA.tables.some((u) => u.file === 'summary.csv') ? 'summary.csv' : DATA.tables[0].file);
       const summary = document.createElement('summary');
       const link = document.createElement('a');
-      link.href = t.file;
+      link.href = fileUrl(t.file);
       link.textContent = t.file;
       if (!t.shown) {
         const p = document.createElement('p');
@@ -437,6 +446,7 @@
           return c >= 0 && r[c] === v;
         }));
         if (shot >= 0) {
+          linked.add(shot);
           tr.className = 'linked';
           tr.title = `compare ${shots[shot].label}`;
           tr.addEventListener('click', () => {
@@ -486,9 +496,35 @@
     state.panY = c.height / 2 - (y + 0.5) * state.zoom;
     render();
     const r = c.getBoundingClientRect();
-    c.dispatchEvent(new MouseEvent('mousemove', { clientX: r.left + r.width / 2, clientY: r.top + r.height / 2, bubbles: true }));
+    const [clientX, clientY] = [r.left + r.width / 2, r.top + r.height / 2];
+    c.dispatchEvent(new MouseEvent('mousemove', { clientX, clientY, bubbles: true }));
     const text = (id) => ($(id) ? $(id).textContent : null);
-    return { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
+    const out = { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
+    // What is drawn under the cursor: the error view there, and A and B each shown whole (flip),
+    // at 0 EV (the PNG's picture) and at +1 EV.
+    const [cx, cy] = [((clientX - r.left) * c.width) / r.width, ((clientY - r.top) * c.height) / r.height];
+    out.rgb_e = shownAt($('view-error'), cx, cy);
+    const saved = { mode: state.mode, showB: state.showB, ev: state.ev };
+    const colour = (showB, ev) => {
+      Object.assign(state, { mode: 'flip', showB, ev });
+      render();
+      return shownAt(c, cx, cy);
+    };
+    Object.assign(out, { rgb_a: colour(false, 0), rgb_b: colour(true, 0), rgb_a_ev1: colour(false, 1) });
+    Object.assign(state, saved);
+    render();
+    return out;
+  }
+
+  // The colour a canvas shows at canvas position (x, y), read from a copy (reading the shown
+  // canvas itself makes the browser warn about repeated readbacks).
+  function shownAt(canvas, x, y) {
+    const copy = document.createElement('canvas');
+    copy.width = 1;
+    copy.height = 1;
+    const ctx = copy.getContext('2d', { willReadFrequently: true });
+    ctx.drawImage(canvas, Math.floor(x), Math.floor(y), 1, 1, 0, 0, 1, 1);
+    return Array.from(ctx.getImageData(0, 0, 1, 1).data.slice(0, 3));
   }
 
   function differs(i, j) {
@@ -497,7 +533,9 @@
   }
 
   async function selftest() {
-    const report = { errors, images: [], readouts: [], slider: null, flip: null, shots: shots.length };
+    const report = { errors, images: [], readouts: [], slider: null, flip: null, exposure: null, shots: shots.length };
+    // A shot that names its table rows (its key) and that no row opens.
+    report.unlinked = shots.filter((s, i) => Object.keys(s.key).length && !linked.has(i)).map((s) => s.exr);
     if (document.readyState !== 'complete') await new Promise((done) => window.addEventListener('load', done));
     // A broken image has no natural size, and drawing it throws.
     const scratch = document.createElement('canvas').getContext('2d');
@@ -523,7 +561,7 @@
         });
         const pixels = [[0, 0], [s.width - 1, s.height - 1], [worst % s.width, Math.floor(worst / s.width)]];
         for (const [x, y] of pixels) {
-          report.readouts.push({ a: s.exr, b: shots[state.b].exr, x, y, shown: hover(x, y) });
+          report.readouts.push({ a: s.exr, b: shots[state.b].exr, png_a: s.png, png_b: shots[state.b].png, tone: s.tone, x, y, shown: hover(x, y) });
         }
       });
       let pair = null;
@@ -546,6 +584,12 @@
         const once = shownHash();
         $('flip').click();
         report.flip = { changed: before !== once && once !== shownHash() };
+        const expose = (ev) => {
+          $('exposure').value = String(ev);
+          $('exposure').dispatchEvent(new Event('input'));
+          return shownHash();
+        };
+        report.exposure = { changed: expose(-1) !== expose(0) };
       }
     }
     const out = $('selftest');
@@ -558,7 +602,11 @@
       shots = await decode(DATA);
       if (shots.length) {
         wire();
-        choose(0, shots[0].reference === null ? undefined : shots[0].reference);
+        // B opens as A's reference, or where its gallery has none (a strip's frames) as the
+        // gallery's next image, so that the page opens on a comparison.
+        const first = shots[0];
+        const next = shots.findIndex((s, j) => j > 0 && s.gallery === first.gallery);
+        choose(0, first.reference !== null ? first.reference : next >= 0 ? next : undefined);
         fit();
         render();
       }

@@ -3,7 +3,9 @@
 //! the files do not is named from the files instead: each EXR under images/ is an image labelled
 //! by its file name, grouped with the others of its size; `ground_truth` (or
 //! `picture_ground_truth`) is its group's reference; `picture_*` and `strip_*` hold radiance, the
-//! rest values in [0, 1]. A missing PNG beside an EXR is drawn from it.
+//! rest values in [0, 1]; each strip's frames (`strip_SHADING_FRAME`) are a group of their own,
+//! shown at the exposure of its first frame, as the frames kind drew their PNGs. A missing PNG
+//! beside an EXR is drawn from it.
 
 use super::{files_in, write, Gallery, Page, Shot, Tone};
 use crate::output::images::{exposure, write_png};
@@ -15,10 +17,18 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
     let report = std::fs::read_to_string(dir.join("report.md"))
         .with_context(|| format!("{}: no report.md (is this a results folder?)", dir.display()))?;
     let mut galleries: Vec<Gallery> = Vec::new();
+    // Each gallery's family: a strip's frames (`strip_SHADING_FRAME`) are one gallery per strip,
+    // since each strip's PNGs were drawn at its own exposure; every other image is grouped by
+    // size and kind alone.
+    let mut families: Vec<String> = Vec::new();
     for exr in files_in(dir, "images", ".exr")? {
         let (values, width, height) = read_exr(&dir.join(&exr))?;
         let stem = exr.trim_start_matches("images/").trim_end_matches(".exr").to_string();
         let radiance = stem.starts_with("picture_") || stem.starts_with("strip_");
+        let family = match stem.strip_prefix("strip_").and_then(|s| s.rsplit_once('_')) {
+            Some((strip, _)) => format!("strip {strip}"),
+            None => String::new(),
+        };
         let shot = Shot {
             label: stem.replace('_', " "),
             png: exr.replace(".exr", ".png"),
@@ -26,13 +36,19 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
             values,
             key: vec![],
         };
-        match galleries
-            .iter_mut()
-            .find(|g| g.width == width && g.height == height && matches!(g.tone, Tone::Radiance { .. }) == radiance)
-        {
-            Some(g) => g.shots.push(shot),
+        match galleries.iter_mut().zip(&families).find(|(g, f)| {
+            g.width == width
+                && g.height == height
+                && matches!(g.tone, Tone::Radiance { .. }) == radiance
+                && **f == family
+        }) {
+            Some((g, _)) => g.shots.push(shot),
             None => galleries.push(Gallery {
-                title: format!("{width}x{height} images"),
+                title: if family.is_empty() {
+                    format!("{width}x{height} images")
+                } else {
+                    format!("{family} frames")
+                },
                 width,
                 height,
                 tone: if radiance {
@@ -43,6 +59,9 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
                 reference: None,
                 shots: vec![shot],
             }),
+        }
+        if families.len() < galleries.len() {
+            families.push(family);
         }
     }
     for g in &mut galleries {

@@ -222,7 +222,7 @@ impl Figure for Bars<'_> {
         DB::ErrorType: 'static,
     {
         let height = (HEIGHT - TITLE - 2 * MARGIN - X_LABELS) as f64;
-        let up = |_: f64| TICK_FONT as f64 + 4.0;
+        let up = |_: &str| TICK_FONT as f64 + 4.0;
         let (y0, y1) = self.y;
         let scale = Scale {
             log: self.log,

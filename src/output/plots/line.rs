@@ -3,7 +3,7 @@
 
 use super::legend::{self, Entry, Look};
 use super::style::{colour, draw_line, draw_marker, marker, reference_dash, within, DASH};
-use super::ticks::{label, ticks, Keyed, Scale};
+use super::ticks::{ticks, Keyed, Scale};
 use super::{error, text_width, write_figure, Figure, FONT};
 use plotters::coord::ranged1d::Ranged;
 use plotters::coord::Shift;
@@ -311,8 +311,8 @@ impl Figure for LinePlot<'_> {
     {
         let width = (self.chart_width() - 2 * MARGIN - Y_LABELS) as f64;
         let height = (CHART.1 - TITLE - 2 * MARGIN - X_LABELS) as f64;
-        let across = |v: f64| text_width(&label(v), TICK_FONT) as f64;
-        let up = |_: f64| TICK_FONT as f64 + 4.0;
+        let across = |text: &str| text_width(text, TICK_FONT) as f64;
+        let up = |_: &str| TICK_FONT as f64 + 4.0;
         let (x0, x1) = self.x;
         let (y0, y1) = self.y;
         let x_scale = Scale {

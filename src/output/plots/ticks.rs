@@ -21,12 +21,13 @@ pub struct Scale {
     pub whole: bool,
 }
 
-/// The labelled values of an axis over `lo..hi` drawn `pixels` long, where `room(v)` is the
-/// length along the axis that the label of `v` takes: the densest nice set (on a log axis: every
-/// 1..9 of each decade, then 1, 2, 3 and 5, then 1, 2 and 5, then decades, then every second, third... decade; where
-/// fewer than two of those fall in range, or on a linear axis, multiples of 1, 2 or 5 times a
-/// power of ten) whose neighbouring labels keep [`GAP`] apart.
-pub fn ticks(lo: f64, hi: f64, scale: Scale, pixels: f64, room: &dyn Fn(f64) -> f64) -> Vec<f64> {
+/// The labelled values of an axis over `lo..hi` drawn `pixels` long, where `room(text)` is the
+/// length along the axis that a label reading `text` takes: the densest nice set (on a log axis:
+/// every 1..9 of each decade, then 1, 2, 3 and 5, then 1, 2 and 5, then decades, then every
+/// second, third... decade; where fewer than two of those fall in range, or on a linear axis,
+/// multiples of 1, 2 or 5 times a power of ten) whose neighbouring labels, as [`axis_labels`]
+/// writes them, keep [`GAP`] apart.
+pub fn ticks(lo: f64, hi: f64, scale: Scale, pixels: f64, room: &dyn Fn(&str) -> f64) -> Vec<f64> {
     let Scale { log, whole } = scale;
     if !(lo.is_finite() && hi.is_finite() && hi > lo) || (log && lo <= 0.0) {
         return vec![];
@@ -39,6 +40,8 @@ pub fn ticks(lo: f64, hi: f64, scale: Scale, pixels: f64, room: &dyn Fn(f64) -> 
         }
     };
     let fits = |vs: &[f64]| {
+        let text = axis_labels(vs);
+        let room = |v: f64| room(&text(&v));
         vs.len() <= MOST
             && vs
                 .windows(2)
@@ -184,14 +187,28 @@ fn wants_exponent(v: f64) -> bool {
 }
 
 /// How the labels of one axis read: all in exponent form if any wants it (`5e-5`, `1e-4`, never
-/// `5e-5` beside `0.0001`).
+/// `5e-5` beside `0.0001`), with four significant digits or as many more as it takes for no two
+/// labels to read the same (1.0002 and 1.0004, never 1 and 1).
 pub fn axis_labels(values: &[f64]) -> impl Fn(&f64) -> String {
     let exponent = values.iter().any(|v| wants_exponent(*v));
-    move |v| label_in(*v, exponent)
+    let distinct = |extra: usize| {
+        let mut texts: Vec<String> = values.iter().map(|v| label_with(*v, exponent, extra)).collect();
+        texts.sort();
+        texts.dedup();
+        texts.len() == values.len()
+    };
+    let extra = (0..=8).find(|&e| distinct(e)).unwrap_or(8);
+    move |v| label_with(*v, exponent, extra)
 }
 
 /// `v` with at most four significant digits and no trailing zeros, in exponent form or not.
 fn label_in(v: f64, exponent: bool) -> String {
+    label_with(v, exponent, 0)
+}
+
+/// `v` with at most 4 + `extra` significant digits and no trailing zeros, in exponent form or
+/// not.
+fn label_with(v: f64, exponent: bool, extra: usize) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{}", if v == 0.0 { 0.0 } else { v });
     }
@@ -203,11 +220,11 @@ fn label_in(v: f64, exponent: bool) -> String {
         }
     };
     if exponent {
-        let s = format!("{v:.3e}");
+        let s = format!("{v:.*e}", 3 + extra);
         let (mantissa, power) = s.split_once('e').expect("exponent form");
         return format!("{}e{power}", trim(mantissa));
     }
-    let decimals = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+    let decimals = (3 + extra as i32 - v.abs().log10().floor() as i32).max(0) as usize;
     trim(&format!("{v:.decimals$}"))
 }
 
@@ -250,11 +267,16 @@ mod tests {
         assert_eq!([f(&5e-4), f(&1e-3), f(&0.5)], ["0.0005", "0.001", "0.5"]);
         let f = axis_labels(&[0.0, 0.5, 1.0]);
         assert_eq!([f(&0.0), f(&0.5), f(&1.0)], ["0", "0.5", "1"]);
+        // Close values get the digits that tell them apart.
+        let f = axis_labels(&[1.0, 1.0002, 1.0004]);
+        assert_eq!([f(&1.0), f(&1.0002), f(&1.0004)], ["1", "1.0002", "1.0004"]);
+        let f = axis_labels(&[1234600.0, 1234700.0]);
+        assert_eq!([f(&1234600.0), f(&1234700.0)], ["1.2346e6", "1.2347e6"]);
     }
 
     /// Room for a label: 8 pixels a character, as the 15-pixel axis font roughly takes.
-    fn room(v: f64) -> f64 {
-        8.0 * label(v).len() as f64
+    fn room(text: &str) -> f64 {
+        8.0 * text.len() as f64
     }
 
     #[test]
@@ -284,7 +306,7 @@ mod tests {
     fn no_two_labels_ever_touch() {
         let mut seen = 0;
         for (i, lo) in [1e-7, 3e-4, 0.02, 0.9, 7.0, 60.0, 999.0, 3e4, 2e6].iter().enumerate() {
-            for ratio in [1.05, 1.3, 2.0, 9.0, 31.0, 1e3, 1e6] {
+            for ratio in [1.0008, 1.05, 1.3, 2.0, 9.0, 31.0, 1e3, 1e6] {
                 for log in [false, true] {
                     for pixels in [120.0, 480.0, 780.0] {
                         let hi = lo * ratio;
@@ -297,14 +319,14 @@ mod tests {
                                 (v - lo) / (hi - lo) * pixels
                             }
                         };
+                        let text = axis_labels(&t);
                         for w in t.windows(2) {
                             assert!(w[0] < w[1] && w[0] >= *lo * (1.0 - 1e-9) && w[1] <= hi * (1.0 + 1e-9));
                             let apart = at(w[1]) - at(w[0]);
+                            let (a, b) = (text(&w[0]), text(&w[1]));
                             assert!(
-                                apart >= (room(w[0]) + room(w[1])) / 2.0 + GAP,
-                                "{lo}..{hi} log {log} {pixels} px ({i}): {} and {} touch in {t:?}",
-                                label(w[0]),
-                                label(w[1])
+                                apart >= (room(&a) + room(&b)) / 2.0 + GAP && a != b,
+                                "{lo}..{hi} log {log} {pixels} px ({i}): {a} and {b} touch in {t:?}",
                             );
                             seen += 1;
                         }
