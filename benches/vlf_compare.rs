@@ -21,7 +21,12 @@
 //! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
 //! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
 //! skipped: the paper's Section 7 set-up), `ao-grid-by-direction` (the same rays ordered one
-//! stored direction at a time, so consecutive rays share a parallel subfield), `ao-random` (513
+//! stored direction at a time, so consecutive rays share a parallel subfield), `ao-frame` (the AO
+//! experiment's own frame: every camera hit of its 256 x 256 image, origins lifted as the renderer
+//! lifts them, with every 8th stored direction, 65 per receiver, receiver by receiver; and as
+//! `STRUCTURE bundled` rows the same rays direction-major in bundles of 4096 receivers, answered by
+//! `Accelerator::any_hits`: the field's tile-ordered walk, the kd-trees' packets of 8, the
+//! others one ray at a time in bundle order), `ao-random` (513
 //! uniform hemisphere directions per point), `shadow` (to a uniform point of a disk of radius
 //! 0.02 above the scene) any-hit, and `camera` (a 181 x 181 pinhole image framing the ball)
 //! closest-hit. Single thread (`1t`) and
@@ -37,8 +42,11 @@
 //! interval of the median of 7 runs single-threaded), build times, memory (structure bytes: the
 //! VLF's arrays, the BVHs' nodes and index lists; not the triangles every structure keeps) and
 //! the work counters per ray (`accel::work`: nodes visited, primitives tested; `-` for obvhs'
-//! own walks, which count nothing). `--meshes cow,man` and `--structures kdtree,kdtree-sah`
-//! narrow it. `-- --counters`: the VLF's work per any-hit ray (tiles,
+//! own walks, which count nothing; a packet's node is counted once for its rays). `--meshes
+//! cow,man`, `--structures kdtree,kdtree-sah` and `--kinds ao-frame` narrow it.
+//! `-- --resolution`: the `ao-frame` rays at 64, 128, 256 and 512 square, single and bundled, one
+//! thread, with the work per ray beside each rate (does the field's advantage move with the image
+//! size because the work does, or because the memory traffic does?). `-- --counters`: the VLF's work per any-hit ray (tiles,
 //! leaves, entries scanned, exact tests) beside the CWBVH's triangle tests.
 //! `VLF_PROFILE_SECS=20 perf record ... vlf_compare-*`: loops the VLF's single-thread any-hit on
 //! the cow's grid-direction AO rays, for a profile.
@@ -53,7 +61,7 @@ use penumbra::accel::cwbvh::{ray as cw_ray, Cwbvh};
 use penumbra::accel::kdtree::{KdSettings, KdTree, Split};
 use penumbra::accel::vlf::{VisibilityField, VlfSettings};
 use penumbra::accel::work;
-use penumbra::accel::{Bvh, Preset};
+use penumbra::accel::{Accelerator, Bvh, Preset, Query};
 use penumbra::experiment::timing::median_interval;
 use penumbra::mesh::Triangles;
 use penumbra::sampling::rng::pcg;
@@ -64,7 +72,14 @@ use std::time::{Duration, Instant};
 /// A query: origin, unit direction, tmax, skip.
 type Q = (DVec3, DVec3, f64, u32);
 
-const KINDS: [&str; 5] = ["ao-grid", "ao-grid-by-direction", "ao-random", "shadow", "camera"];
+const KINDS: [&str; 6] = [
+    "ao-grid",
+    "ao-grid-by-direction",
+    "ao-frame",
+    "ao-random",
+    "shadow",
+    "camera",
+];
 const STRUCTURES: [&str; 7] = [
     "vlf",
     "bvh",
@@ -88,6 +103,12 @@ const SAH: KdSettings = KdSettings {
     empty_factor: None,
 };
 const POINTS: u32 = 64;
+/// `ao-frame`: the AO experiment's image size ...
+const FRAME: u32 = 256;
+/// ... with every 8th of the 513 stored directions (65 per receiver).
+const STRIDE: usize = 8;
+/// Receivers per bundle, as the renderer's direction-major AO pass takes them.
+const BUNDLE: usize = 4096;
 
 struct Mesh {
     tris: Triangles,
@@ -170,7 +191,103 @@ fn point(t: &Triangles, r: &mut Rng) -> (DVec3, DVec3, u32) {
     (p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b, n, i as u32)
 }
 
+/// A receiver of the AO experiment's frame: lifted origin, normal facing the camera, triangle.
+type Receiver = (DVec3, DVec3, u32);
+
+/// Every camera hit of the AO experiment's frame at `size` x `size` (its camera, closest hits
+/// found exactly), in raster order, lifted off the surface as the renderer lifts them.
+fn receivers(m: &Mesh, size: u32) -> Vec<Receiver> {
+    let camera = penumbra::experiment::ao::runner::camera();
+    let mut out = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            let r = camera.ray(x, y, size, size);
+            let Some(hit) = m.bvh.closest(r.origin, r.direction, f64::INFINITY, u32::MAX) else {
+                continue;
+            };
+            let p = &m.tris.positions[hit.triangle as usize];
+            let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+            let n = if n.dot(r.direction) > 0.0 { -n } else { n };
+            let at = r.origin + r.direction * hit.t;
+            out.push((penumbra::geometry::offset_origin(at, n), n, hit.triangle));
+        }
+    }
+    out
+}
+
+/// Every [`STRIDE`]-th stored direction oriented into receiver `r`'s hemisphere: its AO rays.
+fn ao_rays<'a>(m: &'a Mesh, &(o, n, tri): &Receiver) -> impl Iterator<Item = Q> + 'a {
+    let dirs = &m.vlf.frame.directions;
+    (0..dirs.len() as u32).step_by(STRIDE).map(move |k| {
+        let w = dirs.direction(k);
+        (o, if w.dot(n) < 0.0 { -w } else { w }, 4.0, tri)
+    })
+}
+
+/// The frame's AO rays direction-major, as the renderer bundles them: per [`BUNDLE`]
+/// receivers, one bundle per direction.
+fn bundles(m: &Mesh, receivers: &[Receiver]) -> Vec<Vec<Query>> {
+    let mut out = Vec::new();
+    for chunk in receivers.chunks(BUNDLE) {
+        let per: Vec<Vec<Q>> = chunk.iter().map(|r| ao_rays(m, r).collect()).collect();
+        for k in 0..per[0].len() {
+            out.push(
+                per.iter()
+                    .map(|rays| {
+                        let (origin, dir, tmax, skip) = rays[k];
+                        Query {
+                            origin,
+                            dir,
+                            tmax,
+                            skip,
+                        }
+                    })
+                    .collect(),
+            );
+        }
+    }
+    out
+}
+
+/// The structures behind the `Accelerator` seam, by slot (obvhs' own walks have none).
+fn accelerator(m: &Mesh, s: usize) -> Option<&dyn Accelerator> {
+    match s {
+        0 => Some(&m.vlf),
+        1 => Some(&m.bvh),
+        4 => Some(&m.kd),
+        5 => Some(&m.kd_sah),
+        6 => Some(&m.cwbvh),
+        _ => None,
+    }
+}
+
+/// Any-hit over `bundles`, each answered by the structure's [`Accelerator::any_hits`] (obvhs'
+/// own walks: ray by ray in bundle order); returns the hits.
+fn run_bundled(m: &Mesh, s: usize, bundles: &[Vec<Query>], parallel: bool) -> usize {
+    let one = |b: &Vec<Query>| -> usize {
+        match accelerator(m, s) {
+            Some(a) => {
+                let mut hits = vec![false; b.len()];
+                a.any_hits(b, &mut hits);
+                hits.iter().filter(|&&h| h).count()
+            }
+            None => b
+                .iter()
+                .filter(|q| trace(m, s, false, &(q.origin, q.dir, q.tmax, q.skip)))
+                .count(),
+        }
+    };
+    if parallel {
+        bundles.par_iter().map(one).sum()
+    } else {
+        bundles.iter().map(one).sum()
+    }
+}
+
 fn rays(m: &Mesh, kind: &str) -> Vec<Q> {
+    if kind == "ao-frame" {
+        return receivers(m, FRAME).iter().flat_map(|r| ao_rays(m, r)).collect();
+    }
     if kind == "ao-grid-by-direction" {
         // Direction-major: consecutive rays read the same subfield's arrays.
         let point_major = rays(m, "ao-grid");
@@ -316,8 +433,9 @@ fn listed<'a>(flag: &str, all: &[&'a str]) -> Vec<&'a str> {
 fn table() {
     let threads = rayon::current_num_threads();
     println!(
-        "vlf_compare: {} logical CPUs, rayon {threads} threads; Mrays/s, median of 7 runs of {} rays \
-         (1t: with its 95 % interval, the runs' range); work per ray from one single-threaded run",
+        "vlf_compare: {} logical CPUs, rayon {threads} threads; Mrays/s, median of 7 runs of each kind's \
+         rays ({} per kind; ao-frame: every camera hit of a {FRAME}^2 frame x 65 directions) (1t: with \
+         its 95 % interval, the runs' range); work per ray from one single-threaded run",
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         POINTS * 513
     );
@@ -340,43 +458,53 @@ fn table() {
             m.cwbvh.build_time.as_secs_f64(),
         ];
         let n = m.tris.positions.len();
-        for kind in KINDS {
+        for kind in listed("--kinds", &KINDS) {
             let rays = rays(&m, kind);
             let closest = kind == "camera";
+            // The frame's rays also as the renderer bundles them (`STRUCTURE bundled` rows).
+            let bundled = (kind == "ao-frame").then(|| bundles(&m, &receivers(&m, FRAME)));
             for (s, label) in STRUCTURES.iter().enumerate() {
                 if !structures.contains(label) {
                     continue;
                 }
-                let (hits, w) = work::counted(|| run(&m, s, closest, &rays, false));
-                let per_ray = |x: u64| {
-                    if w.nodes + w.primitives == 0 {
-                        "-".to_string()
-                    } else {
-                        format!("{:.1}", x as f64 / rays.len() as f64)
-                    }
-                };
-                let mut rates = Vec::new();
-                for p in [false, true] {
-                    let rate: Vec<f64> = (0..7)
-                        .map(|_| {
-                            let t = Instant::now();
-                            std::hint::black_box(run(&m, s, closest, &rays, p));
-                            rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
-                        })
-                        .collect();
-                    rates.push(median_interval(&rate));
+                let mut issues: Vec<(String, &dyn Fn(bool) -> usize)> = Vec::new();
+                let single = |p: bool| run(&m, s, closest, &rays, p);
+                issues.push((label.to_string(), &single));
+                let bundle = |p: bool| run_bundled(&m, s, bundled.as_deref().unwrap_or_default(), p);
+                if bundled.is_some() {
+                    issues.push((format!("{label} bundled"), &bundle));
                 }
-                println!(
-                    "| {name} | {n} | {label} | {:.3} | {:.1} | {:.0} | {kind} | {} | {} | {} | {:.2} | {:.2} |",
-                    builds[s],
-                    b[s] as f64 / 1e6,
-                    b[s] as f64 / n as f64,
-                    per_ray(w.nodes),
-                    per_ray(w.primitives),
-                    rates[0].show(2),
-                    rates[1].median,
-                    100.0 * hits as f64 / rays.len() as f64
-                );
+                for (label, go) in issues {
+                    let (hits, w) = work::counted(|| go(false));
+                    let per_ray = |x: u64| {
+                        if w.nodes + w.primitives == 0 {
+                            "-".to_string()
+                        } else {
+                            format!("{:.1}", x as f64 / rays.len() as f64)
+                        }
+                    };
+                    let rates = [false, true].map(|p| {
+                        let rate: Vec<f64> = (0..7)
+                            .map(|_| {
+                                let t = Instant::now();
+                                std::hint::black_box(go(p));
+                                rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
+                            })
+                            .collect();
+                        median_interval(&rate)
+                    });
+                    println!(
+                        "| {name} | {n} | {label} | {:.3} | {:.1} | {:.0} | {kind} | {} | {} | {} | {:.2} | {:.2} |",
+                        builds[s],
+                        b[s] as f64 / 1e6,
+                        b[s] as f64 / n as f64,
+                        per_ray(w.nodes),
+                        per_ray(w.primitives),
+                        rates[0].show(2),
+                        rates[1].median,
+                        100.0 * hits as f64 / rays.len() as f64
+                    );
+                }
             }
         }
         eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.vlf).description);
@@ -577,7 +705,56 @@ fn tune_kdtree() {
     }
 }
 
+/// Each structure on the AO experiment's frame at 64, 128, 256 and 512 square (`--resolution`),
+/// one thread, single and bundled: the rate (median of 5 runs) beside the work per ray, so a
+/// ratio that moves with the image size can be told apart from work that moves with it.
+fn resolution() {
+    println!(
+        "AO frame rays (every {STRIDE}th stored direction per camera hit), one thread, median of 5 runs, Mrays/s [95 % interval]"
+    );
+    println!();
+    println!("| mesh | size | receivers | structure | issue | nodes/ray | prims/ray | Mrays/s |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let structures = listed("--structures", &["kdtree", "kdtree-sah", "vlf", "bvh", "cwbvh"]);
+    for name in listed("--meshes", &["cow", "man", "body"]) {
+        let m = build(name);
+        for size in [64, 128, 256, 512] {
+            let receivers = receivers(&m, size);
+            let rays: Vec<Q> = receivers.iter().flat_map(|r| ao_rays(&m, r)).collect();
+            let bundled = bundles(&m, &receivers);
+            for (s, label) in STRUCTURES.iter().enumerate() {
+                if !structures.contains(label) {
+                    continue;
+                }
+                let single = || run(&m, s, false, &rays, false);
+                let bundle = || run_bundled(&m, s, &bundled, false);
+                for (issue, go) in [("single", &single as &dyn Fn() -> usize), ("bundled", &bundle)] {
+                    let (_, w) = work::counted(go);
+                    let rate: Vec<f64> = (0..5)
+                        .map(|_| {
+                            let t = Instant::now();
+                            std::hint::black_box(go());
+                            rays.len() as f64 / t.elapsed().as_secs_f64() / 1e6
+                        })
+                        .collect();
+                    println!(
+                        "| {name} | {size} | {} | {label} | {issue} | {:.1} | {:.1} | {} |",
+                        receivers.len(),
+                        w.nodes as f64 / rays.len() as f64,
+                        w.primitives as f64 / rays.len() as f64,
+                        median_interval(&rate).show(2)
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--resolution") {
+        resolution();
+        return;
+    }
     if std::env::args().any(|a| a == "--tune-kdtree") {
         tune_kdtree();
         return;

@@ -21,6 +21,7 @@
 //! name, and the GPU backend reports that error rather than render with another structure.
 
 pub mod brute;
+pub mod bundle;
 pub mod bvh;
 pub mod cwbvh;
 pub mod kdtree;
@@ -29,6 +30,7 @@ pub mod settings;
 pub mod vlf;
 pub mod work;
 
+pub use bundle::{Issue, Query};
 pub use bvh::{Bvh, Preset};
 pub use settings::AccelSettings;
 
@@ -89,14 +91,20 @@ pub struct TriHit {
 
 /// Möller-Trumbore ray-triangle intersection in f64; the distance, or None. Both sides hit.
 pub fn intersect(origin: DVec3, dir: DVec3, tri: &[DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (tri[1] - tri[0], tri[2] - tri[0]);
+    intersect_edges(origin, dir, tri[0], (tri[1] - tri[0], tri[2] - tri[0]))
+}
+
+/// [`intersect`] with the triangle's edges from corner 0 already taken (the same operations,
+/// so the same t to the bit): a packet sets a triangle up once for all its rays.
+#[inline]
+pub fn intersect_edges(origin: DVec3, dir: DVec3, v0: DVec3, (e1, e2): (DVec3, DVec3)) -> Option<f64> {
     let p = dir.cross(e2);
     let det = e1.dot(p);
     if det == 0.0 {
         return None;
     }
     let inv = 1.0 / det;
-    let s = origin - tri[0];
+    let s = origin - v0;
     let u = s.dot(p) * inv;
     if !(0.0..=1.0).contains(&u) {
         return None;
@@ -134,6 +142,22 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
 
     /// Whether any triangle other than `skip` is hit with 0 < t < `tmax`; may stop at the first.
     fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool;
+
+    /// [`Accelerator::any_hit`] for each of `queries`, issued as one bundle: `hits[i]` answers
+    /// `queries[i]`. A structure that can share work across coherent rays overrides it (the
+    /// field walks a direction's tiles in tile order, the kd-tree traverses packets); the
+    /// answers are always the single queries'.
+    fn any_hits(&self, queries: &[Query], hits: &mut [bool]) {
+        for (q, h) in queries.iter().zip(hits) {
+            *h = self.any_hit(q.origin, q.dir, q.tmax, q.skip);
+        }
+    }
+
+    /// Whether [`Accelerator::any_hits`] is its own (not the one-at-a-time default): only then
+    /// is timing its bundles a different measurement.
+    fn bundles(&self) -> bool {
+        false
+    }
 
     /// What the structure cost to build and what it occupies.
     fn stats(&self) -> BuildStats;
@@ -286,6 +310,17 @@ pub const REGISTRY: &[Registered] = &[
         tuning: <kdtree::KdSettings as settings::Params>::tuning,
         build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()))),
         // A leaf entry per triangle at least, and the f64 copy.
+        memory: |n, _| n as u64 * (4 + 72),
+        follows_within: None,
+    },
+    Registered {
+        name: "kdtree-sah",
+        wgsl: kdtree::WGSL,
+        gpu: true,
+        gpu_buffers: kdtree::GPU_BUFFERS,
+        params: kdtree::sah_params,
+        tuning: kdtree::sah_tuning,
+        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()).named("kdtree-sah"))),
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
     },

@@ -352,6 +352,12 @@ mod tests {
                 "kdtree_empty_factor",
                 "kdtree_intersection_cost",
                 "kdtree_traversal_cost",
+                "kdtree-sah_empty_factor",
+                "kdtree-sah_intersection_cost",
+                "kdtree-sah_leaf_size",
+                "kdtree-sah_max_depth",
+                "kdtree-sah_split",
+                "kdtree-sah_traversal_cost",
                 "cwbvh_preset"
             ]
         );
@@ -399,7 +405,7 @@ mod tests {
         write_rows(&path, &rows).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.starts_with("structure,bvh_preset,vlf_depth,"), "{text}");
-        assert!(text.contains("\nbrute,,,,,,,,,,,,,,brute\n"), "{text}");
+        assert!(text.contains("\nbrute,,,,,,,,,,,,,,,,,,,,brute\n"), "{text}");
         assert_eq!(read_rows::<(Key, ParameterColumns, Key)>(&path), rows);
     }
 }

@@ -2,7 +2,8 @@
 //! (the scene's [`AoDirections`]), any-hit up to the scene's maximum distance, weighted as the
 //! scene asks ([`Weighting`]).
 
-use super::shading::{blocked, Receiver};
+use super::shading::{blocked, blocked_by_shapes, Receiver};
+use crate::accel::Query;
 use crate::sampling::Site;
 use crate::scene::ambient::{AmbientOcclusion, AoDirections, Weighting};
 use crate::scene::Scene;
@@ -35,8 +36,60 @@ pub fn lift(s: DVec2, weighting: Weighting) -> DVec3 {
     }
 }
 
-/// The receiver's ambient-occlusion value and the rays it traced. `shared` holds the disk points
-/// every receiver uses (shared pattern); otherwise they come from `stream`.
+/// Ray `k` of receiver `r`: its direction and weight. `shared` holds the disk points every
+/// receiver uses (shared pattern); otherwise they come from `site`'s stream.
+fn ray(ao: &AmbientOcclusion, r: &Receiver, k: u32, shared: Option<&[DVec2]>, site: Site) -> (DVec3, f64) {
+    match &ao.directions {
+        AoDirections::Grid { lines, .. } => {
+            // The line oriented into the normal's hemisphere; cosine weights where asked.
+            let w = lines[k as usize];
+            let c = w.dot(r.n);
+            let weight = match ao.weighting {
+                Weighting::Plain => 1.0,
+                Weighting::Cosine => c.abs(),
+            };
+            (if c < 0.0 { -w } else { w }, weight)
+        }
+        AoDirections::Disk(scheme) => {
+            let (t, b) = tangent_basis(r.n);
+            let s = match shared {
+                Some(points) => points[k as usize],
+                None => scheme.point(ao.rays, k, site),
+            };
+            let l = lift(s, ao.weighting);
+            (t * l.x + b * l.y + r.n * l.z, 1.0)
+        }
+    }
+}
+
+/// Weight seen and weight cast, summed ray by ray in ray order (so either way of issuing the
+/// rays gives the same value to the bit).
+#[derive(Clone, Copy, Default)]
+struct Tally {
+    seen: f64,
+    total: f64,
+}
+
+impl Tally {
+    fn add(&mut self, weight: f64, open: bool) {
+        self.total += weight;
+        if open {
+            self.seen += weight;
+        }
+    }
+
+    fn value(self) -> f64 {
+        if self.total > 0.0 {
+            self.seen / self.total
+        } else {
+            1.0
+        }
+    }
+}
+
+/// The receiver's ambient-occlusion value and the rays it traced, one query at a time.
+/// `shared` holds the disk points every receiver uses (shared pattern); otherwise they come from
+/// `site`'s stream.
 pub fn occlusion(
     scene: &Scene,
     r: &Receiver,
@@ -45,41 +98,55 @@ pub fn occlusion(
     site: Site,
 ) -> (f64, u64) {
     let origin = r.origin();
-    let open = |d: DVec3| !blocked(scene, origin, d, ao.max_distance, r);
-    match &ao.directions {
-        AoDirections::Grid { lines, .. } => {
-            // Each line oriented into the normal's hemisphere; cosine weights where asked.
-            let (mut seen, mut total) = (0.0, 0.0);
-            for &w in lines.iter() {
-                let c = w.dot(r.n);
-                let d = if c < 0.0 { -w } else { w };
-                let weight = match ao.weighting {
-                    Weighting::Plain => 1.0,
-                    Weighting::Cosine => c.abs(),
-                };
-                total += weight;
-                if open(d) {
-                    seen += weight;
-                }
+    let mut tally = Tally::default();
+    for k in 0..ao.rays {
+        let (d, weight) = ray(ao, r, k, shared, site);
+        tally.add(weight, !blocked(scene, origin, d, ao.max_distance, r));
+    }
+    (tally.value(), ao.rays as u64)
+}
+
+/// [`occlusion`] of many receivers (each with its site), with the rays issued direction-major:
+/// ray `k` of every receiver as one bundle for the scene's structure
+/// ([`crate::accel::Accelerator::any_hits`]), then ray `k + 1`. Values equal [`occlusion`]'s.
+pub fn occlusion_bundled(
+    scene: &Scene,
+    receivers: &[(&Receiver, Site)],
+    ao: &AmbientOcclusion,
+    shared: Option<&[DVec2]>,
+) -> Vec<(f64, u64)> {
+    let origins: Vec<DVec3> = receivers.iter().map(|(r, _)| r.origin()).collect();
+    let mut tallies = vec![Tally::default(); receivers.len()];
+    let mut bundle: Vec<Query> = Vec::with_capacity(receivers.len());
+    let mut asked: Vec<(usize, f64)> = Vec::with_capacity(receivers.len());
+    let mut hits = vec![false; receivers.len()];
+    for k in 0..ao.rays {
+        bundle.clear();
+        asked.clear();
+        for (i, &(r, site)) in receivers.iter().enumerate() {
+            let (dir, weight) = ray(ao, r, k, shared, site);
+            if blocked_by_shapes(scene, origins[i], dir, ao.max_distance, r) {
+                tallies[i].add(weight, false);
+                continue;
             }
-            (if total > 0.0 { seen / total } else { 1.0 }, lines.len() as u64)
+            bundle.push(Query {
+                origin: origins[i],
+                dir,
+                tmax: ao.max_distance,
+                skip: r.triangle,
+            });
+            asked.push((i, weight));
         }
-        AoDirections::Disk(scheme) => {
-            let (t, b) = tangent_basis(r.n);
-            let mut seen = 0u32;
-            for k in 0..ao.rays {
-                let s = match shared {
-                    Some(points) => points[k as usize],
-                    None => scheme.point(ao.rays, k, site),
-                };
-                let l = lift(s, ao.weighting);
-                if open(t * l.x + b * l.y + r.n * l.z) {
-                    seen += 1;
-                }
-            }
-            (seen as f64 / ao.rays as f64, ao.rays as u64)
+        let hits = &mut hits[..bundle.len()];
+        match &scene.accel {
+            Some(a) => a.any_hits(&bundle, hits),
+            None => hits.fill(false),
+        }
+        for (&(i, weight), &hit) in asked.iter().zip(hits.iter()) {
+            tallies[i].add(weight, !hit);
         }
     }
+    tallies.iter().map(|t| (t.value(), ao.rays as u64)).collect()
 }
 
 #[cfg(test)]

@@ -2,11 +2,12 @@
 //! in tests. It runs the plan's passes in order, each a parallel loop over pixels (rayon), with
 //! the GPU's sample streams, in double precision.
 
-use super::ambient::{occlusion, AMBIENT_STREAM};
+use super::ambient::{occlusion, occlusion_bundled, AMBIENT_STREAM};
 use super::mirror::{mirror_chain, Chain};
 use super::shading::{shade_light, LightSample, Receiver, Targets};
 use super::{AdapterInfo, Backend, Clock, Frame, RayCounts, Sampling, Timing, View, NO_HIT, NO_RECEIVER};
 use crate::accel::work::{self, Work};
+use crate::accel::Issue;
 use crate::render::plan::{Pass, RenderPlan};
 use crate::sampling::{shared_points, Pattern, Site};
 use crate::scene::ambient::{AmbientOcclusion, AoDirections};
@@ -154,6 +155,13 @@ fn light_pass(
     rays
 }
 
+/// A pixel's ambient occlusion and rays, where it has a receiver.
+type Pixel = Option<(f64, u64)>;
+
+/// Receivers per bundle when the ambient pass issues rays direction-major: 16 rows of a 256-wide
+/// image, so a frame still splits into enough bundles to keep every core busy.
+const BUNDLE: usize = 4096;
+
 /// The ambient-occlusion pass over every receiver: the image and the rays traced.
 fn ambient_image(
     scene: &Scene,
@@ -168,15 +176,42 @@ fn ambient_image(
         }
         _ => None,
     };
-    let values: Vec<(Option<(f64, u64)>, Work)> = receivers
-        .par_iter()
-        .enumerate()
-        .map(|(pixel, r)| {
-            let at = site(sampling, AMBIENT_STREAM, pixel, width);
-            work::counted(|| r.as_ref().map(|r| occlusion(scene, r, ao, shared.as_deref(), at)))
-        })
-        .collect();
-    let (values, work) = split_work(values);
+    let at = |pixel: usize| site(sampling, AMBIENT_STREAM, pixel, width);
+    let (values, work) = match ao.issue {
+        Issue::Single => split_work(
+            receivers
+                .par_iter()
+                .enumerate()
+                .map(|(pixel, r)| {
+                    work::counted(|| {
+                        r.as_ref()
+                            .map(|r| occlusion(scene, r, ao, shared.as_deref(), at(pixel)))
+                    })
+                })
+                .collect(),
+        ),
+        Issue::Bundled => {
+            let chunks: Vec<(Vec<Pixel>, Work)> = receivers
+                .par_chunks(BUNDLE)
+                .enumerate()
+                .map(|(c, chunk)| {
+                    let live: Vec<(&Receiver, Site)> = chunk
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(i, r)| r.as_ref().map(|r| (r, at(c * BUNDLE + i))))
+                        .collect();
+                    let (mut values, work) = work::counted(|| occlusion_bundled(scene, &live, ao, shared.as_deref()));
+                    values.reverse();
+                    (
+                        chunk.iter().map(|r| r.as_ref().and_then(|_| values.pop())).collect(),
+                        work,
+                    )
+                })
+                .collect();
+            let work = chunks.iter().map(|c| c.1).sum();
+            (chunks.into_iter().flat_map(|c| c.0).collect(), work)
+        }
+    };
     let rays = values.iter().flatten().map(|v| v.1).sum();
     let image = values.iter().map(|v| v.map_or(NO_RECEIVER, |v| v.0 as f32)).collect();
     (image, rays, work)

@@ -59,6 +59,16 @@ pub fn occluded(scene: &Scene, origin: DVec3, d: DVec3, r: &Receiver) -> bool {
 /// Any-hit test of `origin + t dir`, `0 < t < len` (`len` may be infinite), skipping the
 /// receiver's own sphere or plane or triangle.
 pub fn blocked(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver) -> bool {
+    blocked_by_shapes(scene, origin, dir, len, r)
+        || scene
+            .accel
+            .as_ref()
+            .is_some_and(|a| a.any_hit(origin, dir, len, r.triangle))
+}
+
+/// The query of [`blocked`] counted, and its analytic shapes (not the receiver's own) tested:
+/// whether one of them blocks. The triangles are the structure's to answer.
+pub fn blocked_by_shapes(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver) -> bool {
     work::query();
     let mut tests = 0;
     let analytic = scene.shapes.iter().enumerate().any(|(id, s)| {
@@ -68,10 +78,6 @@ pub fn blocked(scene: &Scene, origin: DVec3, dir: DVec3, len: f64, r: &Receiver)
     });
     work::add(0, tests);
     analytic
-        || scene
-            .accel
-            .as_ref()
-            .is_some_and(|a| a.any_hit(origin, dir, len, r.triangle))
 }
 
 /// Whether no part of the disk can be above the horizon of (p, n), or p is behind the emitter:

@@ -331,5 +331,6 @@ fn ambient(a: &AmbientDesc, v: &Validator) -> Result<AmbientOcclusion, ConfigErr
         rays: a.rays,
         weighting: a.weighting,
         max_distance,
+        issue: Default::default(),
     })
 }

@@ -417,6 +417,7 @@ fn the_grids_error_depends_on_position_and_normal() {
             rays,
             weighting,
             max_distance: f64::INFINITY,
+            issue: Default::default(),
         };
         let (mut lo, mut hi) = (0.0f64, 0.0f64);
         for (k, &n) in normals.iter().enumerate() {

@@ -24,7 +24,14 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     let header = rows.headers().unwrap().clone();
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let rows: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
-    assert_eq!(rows.len(), 2 * 5, "{csv}");
+    // Per mesh: six structures with single rays, and bundled the three with bundles of their own.
+    assert_eq!(rows.len(), 2 * (6 + 3), "{csv}");
+    let bundled: Vec<&str> = rows
+        .iter()
+        .filter(|r| &r[col("issue")] == "bundled")
+        .map(|r| &r[col("structure")])
+        .collect();
+    assert_eq!(bundled, ["kdtree", "kdtree-sah", "vlf"].repeat(2), "{csv}");
     for r in &rows {
         assert_eq!(&r[col("same_image_as_first")], "true", "{csv}");
         assert!(r[col("receivers")].parse::<usize>().unwrap() > 50, "{csv}");
@@ -56,7 +63,10 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         "cow",
         "mech-holes-shark",
         "kdtree",
+        "kdtree-sah",
         "vlf",
+        "vlf bundled",
+        "kdtree bundled",
         "bvh",
         "brute",
         "cwbvh",
@@ -71,6 +81,13 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     assert!(header.iter().any(|h| h == "vlf_depth") && header.iter().any(|h| h == "kdtree_max_depth"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("equals the first structure's, bit for bit"), "{report}");
+    for row in [
+        "| `kdtree-sah` bundled / `vlf` bundled |",
+        "| `vlf` single / bundled |",
+        "| `cwbvh` single / `vlf` bundled |",
+    ] {
+        assert!(report.contains(row), "the open question's table lacks {row}: {report}");
+    }
     assert!(
         report.contains("the paper: 1.80-2.51x") && report.contains("Cow (5.8K)"),
         "{report}"
@@ -84,7 +101,26 @@ fn bad_input_is_located_and_writes_nothing() {
         .unwrap()
         .replace("../assets/", &format!("{}/", common::repo("assets").display()));
     for (edit, key) in [
-        (text.replace("\"vlf\", \"bvh\"", "\"vlf\", \"octree\""), "structures[2]"),
+        (text.replace("\"vlf\", \"bvh\"", "\"vlf\", \"octree\""), "structures[3]"),
+        (
+            text.replace(
+                "issue = [\"single\", \"bundled\"]",
+                "issue = [\"bundled\", \"bundled\"]",
+            ),
+            "issue[1]",
+        ),
+        (text.replace("issue = [\"single\", \"bundled\"]", "issue = []"), "issue"),
+        (
+            text.replace("issue = [\"single\", \"bundled\"]", "issue = [\"sideways\"]"),
+            "issue",
+        ),
+        (
+            text.replace(
+                "max_depth = [8, 22]\nleaf_size = 2",
+                "max_depth = [8, 22]\nleaf_size = 2\nsplit = \"median\"",
+            ),
+            "accel.kdtree-sah.split",
+        ),
         (text.replace("rays = 33", "rays = 34"), "rays"),
         (text.replacen("repeats = 6", "repeats = 2", 1), "timing.repeats"),
         (text.replace("cow.off", "no-such.off"), "meshes[0].path"),
@@ -100,6 +136,7 @@ fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
     let mut small = spec.clone();
     small.meshes.truncate(1);
     small.structures.retain(|(s, _)| ["kdtree", "vlf"].contains(s));
+    small.issues = vec![penumbra::accel::Issue::Single];
     small.width = 8;
     small.height = 8;
     let (mut rows, _) = run_ao(&small, &mut CpuBackend::default(), &Progress::default()).unwrap();

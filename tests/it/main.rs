@@ -8,6 +8,7 @@ mod ao_experiment;
 mod axis_list;
 mod bad_input;
 mod blue_noise;
+mod bundles;
 mod cache_keys;
 mod command_line;
 mod common;

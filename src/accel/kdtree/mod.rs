@@ -24,11 +24,12 @@
 mod clip;
 mod gpu;
 pub mod median;
+pub mod packet;
 pub mod sah;
 mod settings;
 pub mod walk;
 
-pub use settings::{KdSettings, SahCosts, Split, PAPER_COSTS};
+pub use settings::{sah_params, sah_tuning, KdSettings, SahCosts, Split, PAPER_COSTS};
 
 use super::{Accelerator, BuildStats, GpuStructure, TriHit};
 use crate::geometry::LocalFrame;
@@ -99,6 +100,7 @@ pub struct KdTree {
     triangles: Triangles,
     settings: KdSettings,
     build_time: Duration,
+    name: &'static str,
 }
 
 /// Axis-aligned bounds of a triangle.
@@ -191,7 +193,14 @@ impl KdTree {
             triangles: triangles.clone(),
             settings,
             build_time: started.elapsed(),
+            name: "kdtree",
         }
+    }
+
+    /// The same tree under another registry name (`kdtree-sah`, the SAH tree registered beside
+    /// the median one).
+    pub fn named(self, name: &'static str) -> KdTree {
+        KdTree { name, ..self }
     }
 
     /// Bytes of nodes and triangle lists (the structure's own memory, triangles aside).
@@ -214,7 +223,7 @@ impl KdTree {
 
 impl Accelerator for KdTree {
     fn name(&self) -> &'static str {
-        "kdtree"
+        self.name
     }
 
     fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> Option<TriHit> {
@@ -223,6 +232,14 @@ impl Accelerator for KdTree {
 
     fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
         walk::walk(self, &self.triangles, origin, dir, tmax, skip, true).is_some()
+    }
+
+    fn any_hits(&self, queries: &[crate::accel::Query], hits: &mut [bool]) {
+        packet::any_hits(self, queries, hits)
+    }
+
+    fn bundles(&self) -> bool {
+        true
     }
 
     fn stats(&self) -> BuildStats {
@@ -262,7 +279,7 @@ impl Accelerator for KdTree {
         _step: DVec3,
     ) -> anyhow::Result<crate::accel::Updated> {
         match method {
-            "rebuild" => *self = KdTree::build(moved, self.settings),
+            "rebuild" => *self = KdTree::build(moved, self.settings).named(self.name),
             m => return Err(crate::accel::unknown_update(self, m)),
         }
         Ok(crate::accel::Updated::Rebuilt)

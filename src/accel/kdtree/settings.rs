@@ -170,3 +170,30 @@ impl KdSettings {
         }
     }
 }
+
+/// `[accel.kdtree-sah]`: the kd-tree under the SAH by default, registered beside the median tree
+/// so one experiment can time both side by side (the paper's open question, Section 9). `split`
+/// may be left out or say `sah`.
+pub fn sah_params(table: &toml::Table) -> Result<toml::Table, (String, String)> {
+    let mut table = table.clone();
+    match table.get("split").map(|v| v.as_str()) {
+        None => {
+            table.insert("split".into(), Split::Sah.name().into());
+        }
+        Some(Some("sah")) => {}
+        Some(_) => {
+            return Err((
+                "split".into(),
+                "`kdtree-sah` always splits by the SAH; the median tree is `kdtree`".into(),
+            ))
+        }
+    }
+    crate::accel::settings::validate::<KdSettings>(&table)
+}
+
+/// The SAH half of [`KdSettings`]' tuning grid.
+pub fn sah_tuning() -> toml::Table {
+    let mut grid = <KdSettings as crate::accel::settings::Params>::tuning();
+    grid.insert("split".into(), toml::Value::Array(vec![Split::Sah.name().into()]));
+    grid
+}

@@ -61,6 +61,18 @@ pub fn children(
     ]
 }
 
+/// The plane half-thickness for rays from `origin`: [`DELTA`] of the largest coordinate in play.
+pub fn delta(tree: &KdTree, origin: DVec3) -> f64 {
+    let scale = tree
+        .bounds
+        .0
+        .abs()
+        .max(tree.bounds.1.abs())
+        .max(origin.abs())
+        .max_element();
+    DELTA * scale.max(f64::MIN_POSITIVE)
+}
+
 /// Closest hit (or, with `any`, the first found) of triangles other than `skip` with
 /// `0 < t < tmax`.
 pub fn walk(
@@ -72,14 +84,7 @@ pub fn walk(
     skip: u32,
     any: bool,
 ) -> Option<TriHit> {
-    let scale = tree
-        .bounds
-        .0
-        .abs()
-        .max(tree.bounds.1.abs())
-        .max(origin.abs())
-        .max_element();
-    let delta = DELTA * scale.max(f64::MIN_POSITIVE);
+    let delta = delta(tree, origin);
     let (t0, t1) = clip(tree.bounds, origin, dir, tmax, delta)?;
     // Nodes examined: inner nodes descended through and leaves whose triangles are tested.
     let (mut nodes, mut prims) = (0u64, 0u64);

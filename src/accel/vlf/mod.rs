@@ -36,6 +36,7 @@
 //! since the build ([`dynamic`]), and removed triangles' ids are overwritten with [`DEAD`].
 
 pub mod bsp;
+mod bundle;
 pub mod directions;
 pub mod dynamic;
 mod gpu;
@@ -298,6 +299,14 @@ impl Accelerator for VisibilityField {
 
     fn any_hit(&self, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
         VisibilityField::any_hit(self, origin, dir, tmax, skip)
+    }
+
+    fn any_hits(&self, queries: &[crate::accel::Query], hits: &mut [bool]) {
+        VisibilityField::any_hits(self, queries, hits)
+    }
+
+    fn bundles(&self) -> bool {
+        true
     }
 
     fn stats(&self) -> BuildStats {

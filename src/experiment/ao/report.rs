@@ -5,6 +5,7 @@
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
 use crate::accel::settings::ParameterColumns;
+use crate::accel::Issue;
 use crate::experiment::outputs::Outputs;
 use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
@@ -25,6 +26,7 @@ struct Named<'a> {
     mesh: &'a str,
     triangles: usize,
     structure: &'a str,
+    issue: &'a str,
 }
 
 /// The columns after the parameters in ao.csv.
@@ -78,9 +80,15 @@ struct Candidate {
     chosen: bool,
 }
 
-/// The row of `structure` on `mesh`.
+/// The row of `structure` on `mesh` with single rays (the paper's measurement).
 fn find<'a>(rows: &'a [AoRow], mesh: &str, structure: &str) -> Option<&'a AoRow> {
-    rows.iter().find(|r| r.mesh == mesh && r.structure == structure)
+    find_issued(rows, mesh, structure, Issue::Single)
+}
+
+/// The row of `structure` on `mesh` with its rays issued as `issue`.
+fn find_issued<'a>(rows: &'a [AoRow], mesh: &str, structure: &str, issue: Issue) -> Option<&'a AoRow> {
+    rows.iter()
+        .find(|r| r.mesh == mesh && r.structure == structure && r.issue == issue)
 }
 
 /// Speed-up of `subject` over `other` on one mesh: `other`'s time over `subject`'s (median of
@@ -157,7 +165,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
             let v = find(rows, &m.name, subject)?;
             let others: Vec<String> = rows
                 .iter()
-                .filter(|o| o.mesh == m.name && o.structure != subject)
+                .filter(|o| o.mesh == m.name && o.structure != subject && o.issue == Issue::Single)
                 .map(|o| {
                     format!(
                         "{} {:.2} MB / {:.2} s",
@@ -221,6 +229,7 @@ pub fn write_ao(
                 mesh: &r.mesh,
                 triangles: r.triangles,
                 structure: r.structure,
+                issue: r.issue.name(),
             },
             ParameterColumns::of(&r.settings),
             Measured {
@@ -257,12 +266,11 @@ pub fn write_ao(
         .filter_map(|m| {
             let of_mesh: Vec<&AoRow> = rows.iter().filter(|r| r.mesh == m.name).collect();
             let first = of_mesh.first()?;
-            let bars = spec
-                .structures
+            let bars = variants(spec, rows)
                 .iter()
                 .enumerate()
-                .filter_map(|(i, (s, _))| {
-                    let r = of_mesh.iter().find(|r| r.structure == *s)?;
+                .filter_map(|(i, &(s, issue))| {
+                    let r = of_mesh.iter().find(|r| r.structure == s && r.issue == issue)?;
                     Some(Bar {
                         series: i,
                         value: r.frame.median,
@@ -278,11 +286,13 @@ pub fn write_ao(
             })
         })
         .collect();
-    let names: Vec<(usize, String)> = spec
-        .structures
+    let names: Vec<(usize, String)> = variants(spec, rows)
         .iter()
         .enumerate()
-        .map(|(i, (s, _))| (i, s.to_string()))
+        .map(|(i, &(s, issue))| match issue {
+            Issue::Single => (i, s.to_string()),
+            Issue::Bundled => (i, format!("{s} bundled")),
+        })
         .collect();
     grouped_bars(
         &out("plots/frame_time.png")?,
@@ -312,9 +322,13 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
     spec.meshes
         .iter()
         .filter_map(|m| {
-            let shots: Vec<Shot> = rows
+            // Bundled rays give the same image (checked bit for bit): one shot per structure.
+            let single: Vec<&AoRow> = rows
                 .iter()
-                .filter(|r| r.mesh == m.name)
+                .filter(|r| r.mesh == m.name && r.issue == Issue::Single)
+                .collect();
+            let shots: Vec<Shot> = single
+                .iter()
                 .map(|r| Shot {
                     label: format!("{}: {}", r.mesh, r.structure),
                     exr: format!("images/{}_{}.exr", r.mesh, r.structure),
@@ -326,11 +340,7 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
                     ],
                 })
                 .collect();
-            let reference = rows
-                .iter()
-                .filter(|r| r.mesh == m.name)
-                .position(|r| r.structure == "brute")
-                .unwrap_or(0);
+            let reference = single.iter().position(|r| r.structure == "brute").unwrap_or(0);
             (!shots.is_empty()).then(|| Gallery {
                 title: format!("{}: ambient occlusion", m.name),
                 width: spec.width,
@@ -379,13 +389,14 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
     );
     md += "## Verdict\n\n";
     md += &verdict(spec, rows);
-    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += &open_question(spec, rows);
+    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited, a kd-tree packet's node once for its rays; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         md += &format!(
             "| {} | {} | {} | {} | {:.2} | {:.1} | {} | {:.2} | {:.3e} | {:.3e} | {} |\n",
             r.mesh,
             r.triangles,
-            r.structure,
+            r.label(),
             r.settings.describe(),
             r.build_seconds,
             r.memory_bytes as f64 / 1e6,
@@ -419,6 +430,74 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh and structure), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
+    md
+}
+
+/// A structure and how its rays were issued.
+type Variant<'a> = (&'a str, Issue);
+
+/// Every (structure, issue) the experiment timed, structures in file order (a structure without
+/// bundles of its own is timed with single rays only).
+fn variants(spec: &AoSpec, rows: &[AoRow]) -> Vec<(&'static str, Issue)> {
+    spec.structures
+        .iter()
+        .flat_map(|(s, _)| spec.issues.iter().map(move |&i| (*s, i)))
+        .filter(|&(s, i)| rows.iter().any(|r| r.structure == s && r.issue == i))
+        .collect()
+}
+
+/// The paper's open question (Section 9: SAH and ray bundles for both algorithms), answered
+/// from the rows where the experiment timed more than the paper's set-up: the claim's subject
+/// against every other structure with the rays issued the same way, and what bundling gains
+/// each structure; one cell per mesh, `other`'s time over `subject`'s with its interval and the
+/// rule's word.
+pub fn open_question(spec: &AoSpec, rows: &[AoRow]) -> String {
+    if spec.issues.len() < 2 && spec.structures.len() < 3 {
+        return String::new();
+    }
+    let subject = spec.claim.subject.as_str();
+    let timed = variants(spec, rows);
+    // Each rival with its best way of issuing rays against the subject's single and bundled.
+    let mut pairs: Vec<(String, Variant, Variant)> = Vec::new();
+    for &(s, issue) in timed.iter().filter(|v| v.0 == subject) {
+        for &(other, other_issue) in timed.iter().filter(|v| v.0 != subject) {
+            pairs.push((
+                format!("`{other}` {} / `{subject}` {}", other_issue.name(), issue.name()),
+                (s, issue),
+                (other, other_issue),
+            ));
+        }
+    }
+    for &(s, _) in timed.iter().filter(|v| v.1 == Issue::Bundled) {
+        pairs.push((
+            format!("`{s}` single / bundled"),
+            (s, Issue::Bundled),
+            (s, Issue::Single),
+        ));
+    }
+    let mut md = "\n### The open question: SAH and ray bundles\n\nThe paper closes by asking how the field fares when a better split heuristic (SAH) and ray bundles are given to both algorithms. Each cell: the first named's frame time over the second's, median of per-round ratios with its 95 % interval, and the rule's word for the second (faster: above 1 beyond noise). Bundled: the AO rays of one grid line for 4096 receivers at a time, the field walking them in tile order, the kd-trees in packets of 8; a structure without bundles of its own (the BVHs) is timed with single rays only, its best order.\n\n| comparison |".to_string();
+    for m in &spec.meshes {
+        md += &format!(" {} |", m.name);
+    }
+    md += "\n|---|";
+    md += &"---|".repeat(spec.meshes.len());
+    md += "\n";
+    for (label, (a, ia), (b, ib)) in &pairs {
+        let cells: Vec<String> = spec
+            .meshes
+            .iter()
+            .map(
+                |m| match (find_issued(rows, &m.name, a, *ia), find_issued(rows, &m.name, b, *ib)) {
+                    (Some(x), Some(y)) => {
+                        let (e, c) = speedup(x, y);
+                        format!("{}x {}", e.show(2), c.word())
+                    }
+                    _ => "n/a".into(),
+                },
+            )
+            .collect();
+        md += &format!("| {label} | {} |\n", cells.join(" | "));
+    }
     md
 }

@@ -7,11 +7,12 @@
 
 use super::spec::{AoMesh, AoSpec};
 use crate::accel::work::Work;
-use crate::accel::AccelSettings;
+use crate::accel::{AccelSettings, Issue};
 use crate::experiment::progress::Progress;
 use crate::experiment::timing::{median_interval, Estimate, Schedule};
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
+use crate::scene::ambient::AmbientOcclusion;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Mesh, Scene};
 use glam::DVec3;
@@ -26,6 +27,8 @@ pub struct AoRow {
     pub triangles: usize,
     /// Structure name.
     pub structure: &'static str,
+    /// How the AO rays were issued.
+    pub issue: Issue,
     /// Its build parameters.
     pub settings: AccelSettings,
     /// Build time, seconds.
@@ -51,6 +54,14 @@ pub struct AoRow {
 }
 
 impl AoRow {
+    /// The structure, with `bundled` after it where the rays were bundled.
+    pub fn label(&self) -> String {
+        match self.issue {
+            Issue::Single => self.structure.to_string(),
+            Issue::Bundled => format!("{} bundled", self.structure),
+        }
+    }
+
     /// Rays (camera and AO) per second at the median frame time.
     pub fn rays_per_s(&self) -> f64 {
         (self.rays.0 + self.rays.1) as f64 / self.frame.median
@@ -184,6 +195,46 @@ fn tune(
     Ok((candidates[best].clone(), rows))
 }
 
+/// One untimed frame of `scene` (`structure` at `settings`, rays issued as `issue`): its image,
+/// rays and work, and whether the image equals `first` (the mesh's first image, kept).
+fn measure(
+    spec: &AoSpec,
+    mesh: &AoMesh,
+    (structure, settings, issue): (&'static str, &AccelSettings, Issue),
+    scene: &Scene,
+    backend: &mut dyn Backend,
+    first: &mut Option<Vec<f32>>,
+) -> anyhow::Result<AoRow> {
+    let stats = scene.accel.as_ref().expect("a mesh scene has a structure").stats();
+    let view = View {
+        camera: &scene.cameras["ao"],
+        width: spec.width,
+        height: spec.height,
+    };
+    let frame = backend.render(scene, view, SAMPLING)?;
+    let image = frame.ambient.expect("the scene asks for ambient occlusion");
+    let seen: Vec<f64> = image.iter().filter(|&&v| v >= 0.0).map(|&v| v as f64).collect();
+    let same_image = first.as_ref().is_none_or(|f| *f == image);
+    first.get_or_insert_with(|| image.clone());
+    Ok(AoRow {
+        mesh: mesh.name.clone(),
+        triangles: mesh.triangles.positions.len(),
+        structure,
+        issue,
+        settings: settings.clone(),
+        build_seconds: stats.build_time.as_secs_f64(),
+        memory_bytes: stats.memory_bytes,
+        frame_seconds: Vec::new(),
+        frame: Estimate::NAN,
+        rays: (frame.rays.primary, frame.rays.ambient),
+        work: frame.work,
+        receivers: seen.len(),
+        mean_ao: seen.iter().sum::<f64>() / seen.len().max(1) as f64,
+        same_image,
+        image,
+    })
+}
+
 /// Every mesh x structure of the experiment, in file order, each structure tuned per mesh
 /// first.
 pub fn run_ao(
@@ -205,36 +256,24 @@ pub fn run_ao(
             bar.message(format!("{}: {structure}", mesh.name));
             let (settings, tried) = tune(spec, mesh, (structure, candidates), backend)?;
             tuning.extend(tried);
-            let scene = ao_scene(spec, mesh, settings.clone())?;
-            let stats = scene.accel.as_ref().expect("a mesh scene has a structure").stats();
-            let view = View {
-                camera: &scene.cameras["ao"],
-                width: spec.width,
-                height: spec.height,
-            };
-            let frame = backend.render(&scene, view, SAMPLING)?;
-            let work = frame.work;
-            let image = frame.ambient.expect("the scene asks for ambient occlusion");
-            let seen: Vec<f64> = image.iter().filter(|&&v| v >= 0.0).map(|&v| v as f64).collect();
-            let same_image = first.as_ref().is_none_or(|f| *f == image);
-            first.get_or_insert_with(|| image.clone());
-            rows.push(AoRow {
-                mesh: mesh.name.clone(),
-                triangles: mesh.triangles.positions.len(),
-                structure,
-                settings,
-                build_seconds: stats.build_time.as_secs_f64(),
-                memory_bytes: stats.memory_bytes,
-                frame_seconds: Vec::new(),
-                frame: Estimate::NAN,
-                rays: (frame.rays.primary, frame.rays.ambient),
-                work,
-                receivers: seen.len(),
-                mean_ao: seen.iter().sum::<f64>() / seen.len().max(1) as f64,
-                same_image,
-                image,
-            });
-            scenes.push(scene);
+            // One build per structure: each way of issuing the rays shares it.
+            let built = ao_scene(spec, mesh, settings.clone())?;
+            let bundles = built.accel.as_ref().is_some_and(|a| a.bundles());
+            for &issue in spec.issues.iter().filter(|&&i| i == Issue::Single || bundles) {
+                let scene = built.clone().with_ambient(Some(AmbientOcclusion {
+                    issue,
+                    ..spec.ao.clone()
+                }));
+                rows.push(measure(
+                    spec,
+                    mesh,
+                    (structure, &settings, issue),
+                    &scene,
+                    backend,
+                    &mut first,
+                )?);
+                scenes.push(scene);
+            }
             bar.inc(1);
         }
         if schedule.repeats > 0 {

@@ -3,7 +3,7 @@
 //! grid lines from every camera hit (the visibility-field paper's Table 1 set-up).
 
 use crate::accel::settings::{candidates, read_tables};
-use crate::accel::AccelSettings;
+use crate::accel::{AccelSettings, Issue};
 use crate::config::{ConfigError, Source};
 use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
@@ -25,12 +25,18 @@ crate::experiment_file! {
         weighting: Weighting,
         max_distance: f64,
         structures: Vec<String>,
+        #[serde(default = "single")]
+        issue: Vec<Issue>,
         tuning: Tuning,
         claim: Claim,
         #[serde(default)]
         accel: BTreeMap<String, toml::Table>,
         meshes: Vec<MeshEntry>,
     }
+}
+
+fn single() -> Vec<Issue> {
+    vec![Issue::Single]
 }
 
 /// The paper's claim the verdict answers: `subject` renders faster than `baseline` (both among
@@ -119,6 +125,10 @@ pub struct AoSpec {
     pub ao: AmbientOcclusion,
     /// Registered structures to compare, each with its tuning candidates (one: not tuned).
     pub structures: Vec<(&'static str, Vec<AccelSettings>)>,
+    /// How the AO rays are issued, each timed for every structure (`issue = ["single",
+    /// "bundled"]`; the paper's measurement, single, where the file says nothing). Tuning uses
+    /// single rays.
+    pub issues: Vec<Issue>,
     /// The per-mesh tuning sweep.
     pub tuning: Tuning,
     /// The claim the verdict answers.
@@ -175,6 +185,18 @@ impl AoSpec {
             return Err(err(
                 &key_path!["max_distance"],
                 format!("must be positive, got {}", f.max_distance),
+            ));
+        }
+        if f.issue.is_empty() {
+            return Err(err(
+                &key_path!["issue"],
+                "list at least one of `single`, `bundled`".into(),
+            ));
+        }
+        if let Some(i) = (1..f.issue.len()).find(|&i| f.issue[..i].contains(&f.issue[i])) {
+            return Err(err(
+                &key_path!["issue", i],
+                format!("`{}` is listed twice", f.issue[i].name()),
             ));
         }
         let t = &f.tuning;
@@ -301,8 +323,10 @@ impl AoSpec {
                 rays: f.rays,
                 weighting: f.weighting,
                 max_distance: f.max_distance,
+                issue: Default::default(),
             },
             structures,
+            issues: f.issue,
             tuning: f.tuning,
             claim: f.claim,
             meshes,
