@@ -76,6 +76,7 @@ if [[ -n $changes ]]; then
     echo "warning: regenerating from a dirty tree (--allow-dirty): the manifests will say so and" >&2
     echo "warning: the stale-results test (tests/it/results_fresh.rs) will reject these results" >&2
 fi
+shopt -s nullglob
 for dir in results/*/; do
     name=$(basename "$dir")
     if [[ " ${order[*]} " != *" $name "* ]]; then
@@ -96,15 +97,20 @@ build_key() {
 
 rows=()
 failed=()
+total=0
 for name in "${run[@]}"; do
     echo "== $name: $sweep experiments/$name.toml --fresh" >&2
     start=$(now)
     status=0
     "$sweep" "experiments/$name.toml" --fresh || status=$?
     seconds=$(awk -v a="$start" -v b="$(now)" 'BEGIN { printf "%.0f", b - a }')
+    total=$((total + seconds))
     note=""
     if [[ $status -ne 0 ]]; then
         note="failed (exit status $status)"
+        failed+=("$name")
+    elif [[ ! -f results/$name/manifest.toml ]]; then
+        note="no results/$name/manifest.toml written"
         failed+=("$name")
     else
         manifest="results/$name/manifest.toml"
@@ -124,6 +130,7 @@ done
     echo "# $(nproc) cores, $(awk -F': ' '/^model name/ { print $2; exit }' /proc/cpuinfo)"
     printf '%-16s %8s\n' experiment seconds
     printf '%s\n' "${rows[@]}"
+    printf '%-16s %8s\n' total "$total"
 } | tee "$times"
 echo "(written to $times)" >&2
 if [[ ${#failed[@]} -gt 0 ]]; then
