@@ -14,7 +14,8 @@
 # Each experiment runs with --fresh (no journal resumed: its wall time is a whole run's). The
 # sweep binary writes into a staging folder and swaps it in when the run finishes, so a failed
 # or killed experiment leaves its earlier folder whole. A failed experiment does not stop the
-# others; the script exits non-zero if any failed. The table of wall seconds per experiment is
+# others; the script exits non-zero if any failed. The pages' screenshots (page.png, which the
+# binary does not write) are drawn again with scripts/page-screenshots.sh, which needs chromium. The table of wall seconds per experiment is
 # printed at the end and written to target/regenerate-times.txt (outside results/, which holds
 # only what the binary writes); the README's times are taken from it.
 set -euo pipefail
@@ -124,6 +125,21 @@ for name in "${run[@]}"; do
     rows+=("$(printf '%-16s %8s  %s' "$name" "$seconds" "$note")")
     echo "== $name: $seconds s $note" >&2
 done
+
+# A run replaces its whole folder, page.png included: the screenshots the README shows are drawn
+# again from the new pages.
+done_ok=()
+for name in "${run[@]}"; do
+    [[ " ${failed[*]} " == *" $name "* ]] || done_ok+=("$name")
+done
+if [[ ${#done_ok[@]} -gt 0 ]]; then
+    if command -v chromium >/dev/null; then
+        scripts/page-screenshots.sh "${done_ok[@]}" >&2
+    else
+        echo "$0: chromium is not installed: results/NAME/page.png not drawn (apt-get install chromium, then scripts/page-screenshots.sh ${done_ok[*]})" >&2
+        failed+=(page.png)
+    fi
+fi
 
 {
     echo "# scripts/regenerate.sh at $commit, $(date -u +%Y-%m-%dT%H:%M:%SZ)"
