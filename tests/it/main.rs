@@ -29,6 +29,7 @@ mod points_file;
 mod receiver_masks;
 mod regression;
 mod render_plan;
+mod results_fresh;
 mod rim_samples;
 mod sampling_properties;
 mod shape_order;
