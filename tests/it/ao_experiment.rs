@@ -111,6 +111,10 @@ fn bad_input_is_located_and_writes_nothing() {
         ),
         (text.replace("issue = [\"single\", \"bundled\"]", "issue = []"), "issue"),
         (
+            text.replace("issue = [\"single\", \"bundled\"]", "issue = [\"bundled\"]"),
+            "issue",
+        ),
+        (
             text.replace("issue = [\"single\", \"bundled\"]", "issue = [\"sideways\"]"),
             "issue",
         ),

@@ -222,3 +222,242 @@ fn a_bundled_ao_frame_is_the_single_frame() {
         }
     }
 }
+
+/// Rays no renderer casts but a caller may: NaN and infinite components, zero and subnormal
+/// directions, zero, negative and NaN `tmax`, origins far outside (1e300) and exactly on the
+/// box's planes with a zero component along them. Every structure's bundle answers as its single
+/// queries do, and as brute force where the ray is finite.
+#[test]
+fn degenerate_bundles_answer_as_single_queries() {
+    let s = soup(300, 12);
+    let (lo, hi) = bounds(&s);
+    let mid = (lo + hi) * 0.5;
+    let mut r = Rng(77);
+    let specials = [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        0.0,
+        -0.0,
+        f64::MIN_POSITIVE / 4.0,
+        -1e-300,
+        1.0,
+        -1.0,
+    ];
+    let mut rays: Vec<Ray> = Vec::new();
+    for _ in 0..3000 {
+        let mut origin = match r.index(4) {
+            0 => mid + r.unit() * 1.5,
+            1 => point_on(&s.positions[r.index(s.positions.len())], &mut r),
+            2 => DVec3::splat(1e300) * r.unit(),
+            _ => mid,
+        };
+        let mut dir = r.unit();
+        for a in 0..3 {
+            match r.index(6) {
+                0 => dir[a] = specials[r.index(specials.len())],
+                1 => origin[a] = [lo[a], hi[a], mid[a], f64::NAN][r.index(4)],
+                2 => dir[a] = 0.0,
+                _ => {}
+            }
+        }
+        let tmax = [f64::INFINITY, 0.0, -1.0, f64::NAN, 0.3, 5.0][r.index(6)];
+        let skip = [u32::MAX, r.index(s.positions.len()) as u32][r.index(2)];
+        rays.push((origin, dir, tmax, skip));
+    }
+    let qs = queries(&rays);
+    let finite = |q: &Query| {
+        q.origin.is_finite() && q.dir.is_finite() && q.tmax.is_finite() && q.origin.abs().max_element() < 1e10
+    };
+    let want: Vec<bool> = qs.iter().map(|q| brute_any(&s, q)).collect();
+    assert!(want.iter().filter(|&&w| w).count() > 100, "some of them hit");
+    for reg in REGISTRY {
+        let a = penumbra::accel::build(&s, &AccelSettings::default_for(reg))
+            .unwrap()
+            .unwrap();
+        let single: Vec<bool> = qs.iter().map(|q| a.any_hit(q.origin, q.dir, q.tmax, q.skip)).collect();
+        let mut hits = vec![true; qs.len()];
+        a.any_hits(&qs, &mut hits);
+        let differ: Vec<&Query> = (0..qs.len())
+            .filter(|&i| hits[i] != single[i])
+            .map(|i| &qs[i])
+            .collect();
+        assert!(
+            differ.is_empty(),
+            "{}: {} bundled answers differ from single, e.g. {:?}",
+            reg.name,
+            differ.len(),
+            &differ[..differ.len().min(3)]
+        );
+        if a.bundles() {
+            let wrong: Vec<&Query> = (0..qs.len())
+                .filter(|&i| finite(&qs[i]) && hits[i] != want[i])
+                .map(|i| &qs[i])
+                .collect();
+            assert!(
+                wrong.is_empty(),
+                "{}: {} answers differ from brute force, e.g. {:?}",
+                reg.name,
+                wrong.len(),
+                &wrong[..wrong.len().min(3)]
+            );
+        }
+    }
+}
+
+/// The field's bundle walk reads the overlay layer and skips the ids a move overwrote with
+/// DEAD, as its single walk does: after moving one object, inserting one and removing one,
+/// bundled answers equal single ones and brute force over the current triangles.
+#[test]
+fn a_field_bundle_after_updates_answers_as_brute_force() {
+    use penumbra::accel::vlf::{VisibilityField, VlfSettings};
+    use penumbra::accel::Accelerator;
+    let mut s = soup(400, 21);
+    let mut field = VisibilityField::build(
+        &s,
+        VlfSettings {
+            level: 4,
+            tiles: 16,
+            depth: 2,
+            ..VlfSettings::default()
+        },
+    )
+    .unwrap();
+    let step = v(0.05, -0.03, 0.02);
+    field.move_object(1, |p| p + step).unwrap();
+    for (t, &o) in s.positions.iter_mut().zip(&s.object_of) {
+        if o == 1 {
+            *t = t.map(|p| p + step);
+        }
+    }
+    field.remove_object(2).unwrap();
+    let mut r = Rng(4);
+    let added: Vec<[DVec3; 3]> = (0..40)
+        .map(|_| {
+            let c = v(3.0, -2.0, 1.5) + v(r.range(-0.8, 0.8), r.range(-0.8, 0.8), r.range(-0.4, 0.4));
+            [c, c + r.unit() * 0.2, c + r.unit() * 0.2]
+        })
+        .collect();
+    field.insert_object(9, &added).unwrap();
+    // The current scene: object 2 gone (a point no ray hits keeps the indices), 9 added.
+    let gone = [DVec3::splat(1e3); 3];
+    let mut now: Vec<[DVec3; 3]> = s
+        .positions
+        .iter()
+        .zip(&s.object_of)
+        .map(|(t, &o)| if o == 2 { gone } else { *t })
+        .collect();
+    now.extend(added);
+    let now = Triangles {
+        object_of: vec![0; now.len()],
+        positions: now,
+    };
+    let mut rays = random_segments(&now, 1500, &mut r);
+    rays.extend(shadow_rays(&now, 1500, &mut r));
+    rays.extend(ao_random(&now, 1500, &mut r));
+    let qs = queries(&rays);
+    let want: Vec<bool> = qs.iter().map(|q| brute_any(&now, q)).collect();
+    let single: Vec<bool> = qs
+        .iter()
+        .map(|q| field.any_hit(q.origin, q.dir, q.tmax, q.skip))
+        .collect();
+    let mut hits = vec![true; qs.len()];
+    Accelerator::any_hits(&field, &qs, &mut hits);
+    assert_eq!(single, want, "the updated field's single answers");
+    assert_eq!(hits, want, "the updated field's bundled answers");
+    assert!(want.iter().filter(|&&w| w).count() > 500 && want.iter().filter(|&&w| !w).count() > 500);
+}
+
+/// The bundled AO pass tests the scene's spheres and planes before it asks the structure (a
+/// ray a shape blocks is not in the bundle) and serves receivers on them (no triangle to skip):
+/// with a sphere and a plane beside the cow, per-pixel and shared disk points, the image, rays
+/// and queries equal the single pass's, and the shapes change the image.
+#[test]
+fn a_bundled_ao_frame_with_spheres_and_planes_is_the_single_frame() {
+    use penumbra::scene::shape::{Plane, Sphere};
+    let cow = penumbra::experiment::ao::spec::into_unit_ball(common::off_mesh("cow").positions);
+    let camera = penumbra::experiment::ao::runner::camera();
+    let mut backend = CpuBackend::default();
+    let mesh = penumbra::scene::Mesh {
+        source: "test".into(),
+        file_fnv1a: 0,
+        albedo: 0.5,
+        mirror: 0.0,
+        triangles: cow.positions.len(),
+        skipped: Default::default(),
+    };
+    let scene = |name: &'static str, shapes: bool, ao: AmbientOcclusion| {
+        let (spheres, planes) = if shapes {
+            (
+                vec![Sphere {
+                    center: v(0.45, -0.5, 0.35),
+                    radius: 0.3,
+                    albedo: 0.5,
+                }],
+                vec![Plane {
+                    point: v(0.0, 0.0, -0.45),
+                    normal: v(0.0, 0.0, 1.0),
+                    albedo: 0.5,
+                }],
+            )
+        } else {
+            (vec![], vec![])
+        };
+        penumbra::scene::Scene::analytic(spheres, planes, vec![])
+            .with_meshes(
+                vec![mesh.clone()],
+                Triangles {
+                    positions: cow.positions.clone(),
+                    object_of: vec![0; cow.positions.len()],
+                },
+                AccelSettings::named(name).unwrap(),
+            )
+            .with_cameras([("ao".to_string(), camera.clone())].into())
+            .with_ambient(Some(ao))
+    };
+    for pattern in [
+        penumbra::sampling::Pattern::PerPixel,
+        penumbra::sampling::Pattern::Shared,
+    ] {
+        let sampling = Sampling {
+            scheme: penumbra::sampling::DiskScheme::Uniform,
+            pattern,
+            seed: 5,
+        };
+        for name in ["vlf", "kdtree-sah"] {
+            for (directions, rays) in [
+                (AoDirections::grid(3), 19),
+                (AoDirections::Disk(penumbra::sampling::DiskScheme::Uniform), 16),
+            ] {
+                let mut frame = |issue: Issue, shapes: bool| {
+                    let ao = AmbientOcclusion {
+                        directions: directions.clone(),
+                        rays,
+                        weighting: Weighting::Cosine,
+                        max_distance: 3.0,
+                        issue,
+                    };
+                    let scene = scene(name, shapes, ao);
+                    let view = View {
+                        camera: &scene.cameras["ao"],
+                        width: 80,
+                        height: 60,
+                    };
+                    let f = backend.render(&scene, view, sampling).unwrap();
+                    (f.ambient.unwrap(), f.rays.ambient, f.work.queries)
+                };
+                let (single, bundled) = (frame(Issue::Single, true), frame(Issue::Bundled, true));
+                let what = format!("{name} {pattern:?} {rays} rays");
+                assert_eq!(single.0, bundled.0, "{what}: images differ");
+                assert_eq!(
+                    (single.1, single.2),
+                    (bundled.1, bundled.2),
+                    "{what}: rays or queries differ"
+                );
+                let plain = frame(Issue::Bundled, false).0;
+                let changed = (0..plain.len()).filter(|&i| plain[i] != single.0[i]).count();
+                assert!(changed > 1000, "{what}: the shapes change {changed} pixels");
+            }
+        }
+    }
+}

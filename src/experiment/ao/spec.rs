@@ -199,6 +199,12 @@ impl AoSpec {
                 format!("`{}` is listed twice", f.issue[i].name()),
             ));
         }
+        if !f.issue.contains(&Issue::Single) {
+            return Err(err(
+                &key_path!["issue"],
+                "list `single` too: the verdict on the claim compares single rays, and a structure without bundles of its own (the BVHs) is timed with them only".into(),
+            ));
+        }
         let t = &f.tuning;
         source.image_size(
             &key_path!["tuning", "width"],
