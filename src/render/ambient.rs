@@ -62,6 +62,14 @@ fn ray(ao: &AmbientOcclusion, r: &Receiver, k: u32, shared: Option<&[DVec2]>, si
     }
 }
 
+/// Rays per receiver: one per grid line, or the disk scheme's count.
+fn rays_per_receiver(ao: &AmbientOcclusion) -> u32 {
+    match &ao.directions {
+        AoDirections::Grid { lines, .. } => lines.len() as u32,
+        AoDirections::Disk(_) => ao.rays,
+    }
+}
+
 /// Weight seen and weight cast, summed ray by ray in ray order (so either way of issuing the
 /// rays gives the same value to the bit).
 #[derive(Clone, Copy, Default)]
@@ -99,11 +107,12 @@ pub fn occlusion(
 ) -> (f64, u64) {
     let origin = r.origin();
     let mut tally = Tally::default();
-    for k in 0..ao.rays {
+    let rays = rays_per_receiver(ao);
+    for k in 0..rays {
         let (d, weight) = ray(ao, r, k, shared, site);
         tally.add(weight, !blocked(scene, origin, d, ao.max_distance, r));
     }
-    (tally.value(), ao.rays as u64)
+    (tally.value(), rays as u64)
 }
 
 /// [`occlusion`] of many receivers (each with its site), with the rays issued direction-major:
@@ -120,7 +129,8 @@ pub fn occlusion_bundled(
     let mut bundle: Vec<Query> = Vec::with_capacity(receivers.len());
     let mut asked: Vec<(usize, f64)> = Vec::with_capacity(receivers.len());
     let mut hits = vec![false; receivers.len()];
-    for k in 0..ao.rays {
+    let rays = rays_per_receiver(ao);
+    for k in 0..rays {
         bundle.clear();
         asked.clear();
         for (i, &(r, site)) in receivers.iter().enumerate() {
@@ -146,7 +156,7 @@ pub fn occlusion_bundled(
             tallies[i].add(weight, !hit);
         }
     }
-    tallies.iter().map(|t| (t.value(), ao.rays as u64)).collect()
+    tallies.iter().map(|t| (t.value(), rays as u64)).collect()
 }
 
 #[cfg(test)]
