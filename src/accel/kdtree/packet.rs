@@ -1,8 +1,9 @@
 //! Packet traversal (Wald, Slusallek, Benthin & Wagner 2001, the coherent ray tracing the
 //! visibility-field paper's CRT baseline is named after): up to [`WIDTH`] rays whose directions
 //! share a sign octant descend the tree together. At an inner node each lane takes the
-//! children its own [`walk::children`] would give it ([`split_lanes`]); the packet enters a child when any lane does,
-//! near child first (the same child for every lane: the octant fixes it). A leaf's triangles are
+//! children its own [`walk::children`] would give it ([`split_lanes`]); the packet enters a
+//! child when any lane does, near child first (the same child for every lane: the octant fixes
+//! it). A leaf's triangles are
 //! tested against the lanes still open. Each lane therefore visits exactly the leaves of its
 //! single-ray walk, in the same order, and any-hit answers are the single queries'. A node is
 //! fetched once for the whole packet: the work counters count packet node visits and lane
