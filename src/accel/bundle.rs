@@ -41,4 +41,12 @@ impl Issue {
             Issue::Bundled => "bundled",
         }
     }
+
+    /// `structure` as tables and legends name it with its rays issued this way.
+    pub fn label(self, structure: &str) -> String {
+        match self {
+            Issue::Single => structure.to_string(),
+            Issue::Bundled => format!("{structure} bundled"),
+        }
+    }
 }

@@ -356,13 +356,13 @@ fn input_problem(input: &Input, repo: &Path) -> Option<String> {
             input.path
         ));
     }
-    match std::fs::read(repo.join(&relative)) {
+    match Input::read(&repo.join(&relative)) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             Some(format!("input `{}` no longer exists", relative.display()))
         }
         Err(e) => Some(format!("input `{}` cannot be read: {e}", relative.display())),
-        Ok(bytes) => {
-            let now = format!("{:016x}", fnv1a(&bytes));
+        Ok(current) => {
+            let now = current.fnv1a;
             (now != input.fnv1a).then(|| {
                 format!(
                     "input `{}` changed since the run (FNV-1a {} then, {now} now)",

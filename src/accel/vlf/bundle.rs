@@ -5,7 +5,7 @@
 //! is [`VisibilityField::any_hit`]'s, so answers and work counters equal the single queries';
 //! only the order of memory traffic changes.
 
-use super::query::TileRay;
+use super::query::{tile_cell, TileRay};
 use super::VisibilityField;
 use crate::accel::Query;
 
@@ -30,9 +30,8 @@ impl VisibilityField {
     /// The header index (direction x tile) of the tile `ray` enters first.
     fn entry_tile(&self, ray: &TileRay) -> usize {
         let n = self.settings.tiles as usize;
-        let cell = |v: f64| (v.max(0.0) as usize).min(n - 1);
         let (x, y) = (ray.o.x + ray.d.x * ray.t0, ray.o.y + ray.d.y * ray.t0);
-        ray.dir as usize * n * n + cell(y) * n + cell(x)
+        ray.dir as usize * n * n + tile_cell(y, n) * n + tile_cell(x, n)
     }
 
     /// Any hit for each query, walked in (direction, entry tile) order with prefetching.
@@ -44,9 +43,7 @@ impl VisibilityField {
             .filter_map(|(i, r)| r.as_ref().map(|r| (self.entry_tile(r), i as u32)))
             .collect();
         order.sort_unstable();
-        for h in hits.iter_mut() {
-            *h = false;
-        }
+        hits.fill(false);
         let overlay = !self.overlay_ids.is_empty();
         let first = &self.base.tile_first;
         for (p, &(_, i)) in order.iter().enumerate() {

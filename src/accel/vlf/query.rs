@@ -104,6 +104,13 @@ impl Leaf<'_> {
     }
 }
 
+/// The tile column or row of coordinate `v` (in tiles) among `n`, clamped to the grid: floor
+/// for v >= 0 is truncation (`as` saturates; NaN gives 0), so no libm call.
+#[inline(always)]
+pub fn tile_cell(v: f64, n: usize) -> usize {
+    (v.max(0.0) as usize).min(n - 1)
+}
+
 impl VisibilityField {
     /// The ray in the nearest direction's tile space, clipped to the ball and to (0, tmax);
     /// None when that leaves nothing.
@@ -159,8 +166,7 @@ impl VisibilityField {
         let (o, d) = (ray.o, ray.d);
         let (xa, xb) = (o.x + d.x * ray.t0, o.x + d.x * ray.t1);
         let (ya, yb) = (o.y + d.y * ray.t0, o.y + d.y * ray.t1);
-        // floor for v >= 0 is truncation (`as` saturates; NaN gives 0): no libm call.
-        let cell = |v: f64| (v.max(0.0) as usize).min(n - 1);
+        let cell = |v: f64| tile_cell(v, n);
         let (x0, x1) = (cell(xa.min(xb) - e), cell(xa.max(xb) + e));
         let (y0, y1) = (cell(ya.min(yb) - e), cell(ya.max(yb) + e));
         if x0 == x1 && y0 == y1 {

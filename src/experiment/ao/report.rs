@@ -289,10 +289,7 @@ pub fn write_ao(
     let names: Vec<(usize, String)> = variants(spec, rows)
         .iter()
         .enumerate()
-        .map(|(i, &(s, issue))| match issue {
-            Issue::Single => (i, s.to_string()),
-            Issue::Bundled => (i, format!("{s} bundled")),
-        })
+        .map(|(i, &(s, issue))| (i, issue.label(s)))
         .collect();
     grouped_bars(
         &out("plots/frame_time.png")?,

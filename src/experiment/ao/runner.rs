@@ -56,10 +56,7 @@ pub struct AoRow {
 impl AoRow {
     /// The structure, with `bundled` after it where the rays were bundled.
     pub fn label(&self) -> String {
-        match self.issue {
-            Issue::Single => self.structure.to_string(),
-            Issue::Bundled => format!("{} bundled", self.structure),
-        }
+        self.issue.label(self.structure)
     }
 
     /// Rays (camera and AO) per second at the median frame time.
