@@ -447,6 +447,13 @@ fn table() {
         let t0 = Instant::now();
         let m = build(name);
         eprintln!("{name}: built in {:.1} s", t0.elapsed().as_secs_f64());
+        let parts: Vec<String> = m
+            .vlf
+            .parts()
+            .iter()
+            .map(|(part, b)| format!("{part} {:.1} MB", *b as f64 / 1e6))
+            .collect();
+        eprintln!("{name}: vlf bytes by part: {}", parts.join(", "));
         let b = bytes(&m);
         let builds = [
             m.vlf.build_time.as_secs_f64(),
@@ -537,11 +544,6 @@ fn count_table() {
 fn counters(m: &Mesh, rays: &[Q]) -> [f64; 5] {
     use penumbra::accel::vlf::query::exact_t;
     let f = &m.vlf;
-    let mask = if f.settings.depth == 0 {
-        u32::MAX
-    } else {
-        (1 << (32 - 2 * f.settings.depth)) - 1
-    };
     let mut c = [0usize; 5];
     for &(o, d, tmax, skip) in rays {
         let hit = f.tile_ray(o, d, tmax).is_some_and(|ray| {
@@ -552,8 +554,8 @@ fn counters(m: &Mesh, rays: &[Q]) -> [f64; 5] {
                     c[0] += 1;
                     f.leaves(&f.base, &ray, tile, ta, tb, |leaf| {
                         c[1] += 1;
-                        c[2] += leaf.ids.len();
-                        leaf.each(mask, |id| {
+                        c[2] += leaf.entries();
+                        leaf.each(|id| {
                             if id == skip {
                                 return false;
                             }

@@ -61,46 +61,77 @@ pub fn uniform_plane(l: usize, z0: f32, scale: f32) -> f64 {
     z0 as f64 + l as f64 / scale as f64
 }
 
-/// Bits of a leaf entry holding the triangle index: a split tile's entries also carry the
-/// first leaf `f` and `L - 1 - last leaf` of the triangle's range, `depth` bits each above
-/// them, so that a walk visiting several leaves tests each triangle once (in its first visited
-/// leaf) without a mailbox. Depth 4 leaves 24 bits (16.7M triangles).
-pub fn id_bits(depth: u32) -> u32 {
-    32 - 2 * depth
+/// u32 words of a split tile's header: its split values (f32 bits, [`Split::stride`]) then
+/// two words per leaf packing its group bounds ([`LeafBounds`]).
+pub fn header_len(kind: Split, leaves: usize) -> usize {
+    kind.stride(leaves) + 2 * leaves
 }
 
-/// Mask of the triangle index in an entry.
-pub fn id_mask(depth: u32) -> u32 {
-    if depth == 0 {
-        u32::MAX
-    } else {
-        (1u32 << id_bits(depth)) - 1
+/// Most entries a split tile's block may hold: its leaf bounds are 16-bit.
+pub const MAX_BLOCK_ENTRIES: usize = u16::MAX as usize;
+
+/// Where one leaf's entries lie, counted in entries from the first entry after the header.
+///
+/// A triangle spanning leaves `f..=g` is listed in each of them; a walk that visits several
+/// leaves must test it once. Each leaf therefore orders its entries in four groups, by where
+/// the triangle's range starts and ends relative to leaf `l`: `f == l < g`, then `f == l == g`,
+/// then `f < l == g`, then `f < l < g`. A walk up (near to far along `+z`) tests all of the
+/// first leaf it visits and, in each later leaf, only the triangles starting there (the first
+/// two groups, `start..c`); a walk down tests, after its first leaf, only the triangles ending
+/// there (the middle two, `a..d`). Every triangle meeting the visited range is tested exactly
+/// once, with no mailbox and no key bits in the entries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LeafBounds {
+    /// First entry of the leaf (the previous leaf's end).
+    pub start: usize,
+    /// End of the `f == l < g` group.
+    pub a: usize,
+    /// End of the `f == l == g` group.
+    pub c: usize,
+    /// End of the `f < l == g` group.
+    pub d: usize,
+    /// End of the leaf.
+    pub end: usize,
+}
+
+impl LeafBounds {
+    /// Bounds of leaf `l` from its header words (`pairs`: the two words per leaf).
+    #[inline(always)]
+    pub fn read(pairs: &[u32], l: usize) -> LeafBounds {
+        let (w0, w1) = (pairs[2 * l], pairs[2 * l + 1]);
+        LeafBounds {
+            start: if l == 0 { 0 } else { (pairs[2 * l - 1] >> 16) as usize },
+            a: (w0 & 0xffff) as usize,
+            c: (w0 >> 16) as usize,
+            d: (w1 & 0xffff) as usize,
+            end: (w1 >> 16) as usize,
+        }
+    }
+
+    /// The entries a walk tests in this leaf: all of them in the first leaf it visits, else
+    /// those starting here walking up or ending here walking down.
+    #[inline(always)]
+    pub fn tested(&self, first_visited: bool, up: bool) -> (usize, usize) {
+        match (first_visited, up) {
+            (true, _) => (self.start, self.end),
+            (false, true) => (self.start, self.c),
+            (false, false) => (self.a, self.d),
+        }
     }
 }
 
-/// A split tile's entry for triangle `id` spanning leaves `first..=last` of `2^depth`.
-pub fn entry(id: u32, first: usize, last: usize, depth: u32) -> u32 {
-    let leaves = 1usize << depth;
-    id | (first as u32) << id_bits(depth) | ((leaves - 1 - last) as u32) << (id_bits(depth) + depth)
-}
-
-/// u32 words of a split tile's header: its split values (f32 bits, [`Split::stride`]) then
-/// each leaf's end, counted from the first id after the header.
-pub fn header_len(kind: Split, leaves: usize) -> usize {
-    kind.stride(leaves) + leaves
-}
-
-/// Builds the split of one tile into `block` (appended): the header ([`header_len`]), then
-/// each leaf's triangles in leaf order; `boxes` gets each entry's footprint box (0 for header
-/// words). `items` holds (triangle, z_lo, z_hi, box) with widened clipped depth ranges. Returns false, writing nothing, when the depth range is empty (every
-/// triangle at one depth: no split helps).
+/// Builds the split of one tile into `block` (appended): the header ([`header_len`]), then each
+/// leaf's entries in the group order of [`LeafBounds`], each entry written by `push(block, id,
+/// box)`. `items` holds (triangle, z_lo, z_hi, box) with widened clipped depth ranges. Returns
+/// false, writing nothing, when the depth range is empty (every triangle at one depth: no
+/// split helps) or the entries would overflow the 16-bit leaf bounds.
 pub fn build(
     items: &[(u32, f64, f64, u16)],
     kind: Split,
     depth: u32,
     block: &mut Vec<u32>,
-    boxes: &mut Vec<u16>,
     scratch: &mut Vec<f64>,
+    push: impl Fn(&mut Vec<u32>, u32, u16),
 ) -> bool {
     let leaves = 1usize << depth;
     let lo = items.iter().fold(f64::INFINITY, |a, it| a.min(it.1));
@@ -110,7 +141,6 @@ pub fn build(
     if z1 <= z0 {
         return false;
     }
-    let head = block.len();
     let mut planes = [0f32; 1024];
     let stride = kind.stride(leaves);
     match kind {
@@ -136,19 +166,30 @@ pub fn build(
         Split::Uniform => uniform_leaf(z, planes[0], planes[1], leaves),
         Split::Median => median_leaf(z, &bits),
     };
-    block.extend_from_slice(&bits);
-    block.resize(head + stride + leaves, 0);
-    boxes.resize(block.len(), 0);
-    let first = block.len();
     let ranges: Vec<(usize, usize)> = items.iter().map(|it| (leaf(it.1), leaf(it.2))).collect();
+    let total: usize = ranges.iter().map(|r| r.1 - r.0 + 1).sum();
+    if total > MAX_BLOCK_ENTRIES {
+        return false;
+    }
+    let head = block.len();
+    block.extend_from_slice(&bits);
+    block.resize(head + header_len(kind, leaves), 0);
+    let mut count = 0u32;
     for l in 0..leaves {
-        for (it, r) in items.iter().zip(&ranges) {
-            if r.0 <= l && l <= r.1 {
-                block.push(entry(it.0, r.0, r.1, depth));
-                boxes.push(it.3);
+        // (starts here, ends here) of each group, in order.
+        let groups = [(true, false), (true, true), (false, true), (false, false)];
+        let mut ends = [0u32; 4];
+        for (group, end) in groups.iter().zip(&mut ends) {
+            for (it, &(f, g)) in items.iter().zip(&ranges) {
+                if f <= l && l <= g && (f == l, g == l) == *group {
+                    push(block, it.0, it.3);
+                    count += 1;
+                }
             }
+            *end = count;
         }
-        block[head + stride + l] = (block.len() - first) as u32;
+        block[head + stride + 2 * l] = ends[0] | ends[1] << 16;
+        block[head + stride + 2 * l + 1] = ends[2] | ends[3] << 16;
     }
     true
 }

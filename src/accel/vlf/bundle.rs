@@ -15,7 +15,7 @@ const AHEAD: usize = 8;
 
 /// A hint that `value` is read soon.
 #[inline(always)]
-fn prefetch<T>(value: &T) {
+pub(super) fn prefetch<T>(value: &T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch only hints the cache; it cannot fault and changes no value.
     unsafe {
@@ -45,16 +45,14 @@ impl VisibilityField {
         order.sort_unstable();
         hits.fill(false);
         let overlay = !self.overlay_ids.is_empty();
-        let first = &self.base.tile_first;
+        let offsets = &self.base.offsets;
         for (p, &(_, i)) in order.iter().enumerate() {
             if let Some(&(k, _)) = order.get(p + AHEAD) {
-                prefetch(&first[k]);
+                offsets.prefetch(k);
             }
             if let Some(&(k, _)) = order.get(p + AHEAD / 2) {
-                let start = (first[k] & !super::layer::SPLIT) as usize;
-                if let (Some(id), Some(b)) = (self.base.ids.get(start), self.base.boxes.get(start)) {
-                    prefetch(id);
-                    prefetch(b);
+                if let Some(w) = self.base.words.get(offsets.block(k).0) {
+                    prefetch(w);
                 }
             }
             let (q, ray) = (

@@ -2,15 +2,15 @@
 //! rasterise the object as at build time, remove its id, change the geometry, insert it again).
 //!
 //! The flat base arrays cannot grow in place, so removal rasterises the object's triangles in
-//! every direction and overwrites their ids with [`DEAD`] in the tiles they cover (no array
+//! every direction and marks their entries removed in the tiles they cover (no array
 //! changes size), and insertion puts the object into the overlay layer, a second field over
 //! only the inserted or moved triangles, rebuilt from those alone (cost proportional to them,
 //! not to the scene). Objects must stay inside the build's ball: anything else needs a full
 //! rebuild, and is refused.
 
-use super::layer::{to_tile, Layer, SPLIT};
+use super::layer::{entry_id, kill, to_tile, Layer};
 use super::raster::for_each_tile;
-use super::{VisibilityField, DEAD, EPS};
+use super::{VisibilityField, EPS};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -23,7 +23,7 @@ impl VisibilityField {
             .collect()
     }
 
-    /// Overwrites `tris` (all in the base layer) with [`DEAD`] in every tile that lists them.
+    /// Marks `tris` (all in the base layer) removed in every tile that lists them.
     fn kill_in_base(&mut self, tris: &[u32]) {
         if tris.is_empty() {
             return;
@@ -32,36 +32,32 @@ impl VisibilityField {
         let n2 = (n * n) as usize;
         let e = EPS * self.frame.half_tiles;
         let dirs = self.frame.directions.len();
-        let tile_first = &self.base.tile_first;
-        // Disjoint per-direction slices of `ids`.
+        let offsets = &self.base.offsets;
+        let (wide, step) = (self.base.wide, self.base.entry_words());
+        // Disjoint per-direction slices of `words`.
         let mut slices = Vec::with_capacity(dirs);
-        let mut rest: &mut [u32] = &mut self.base.ids;
+        let mut rest: &mut [u32] = &mut self.base.words;
         let mut at = 0usize;
         for k in 0..dirs {
-            let end = (tile_first[(k + 1) * n2] & !SPLIT) as usize;
+            let end = offsets.block((k + 1) * n2 - 1).1;
             let (head, tail) = rest.split_at_mut(end - at);
             slices.push((k, at, head));
             rest = tail;
             at = end;
         }
         let (frame, world) = (&self.frame, &self.world);
-        let mask = super::bsp::id_mask(self.settings.depth);
         let header = super::bsp::header_len(self.settings.split, 1 << self.settings.depth);
-        slices.into_par_iter().for_each(|(k, base, ids)| {
+        slices.into_par_iter().for_each(|(k, base, words)| {
             let rot = frame.directions.rotation(k as u32);
             for &t in tris {
                 let p = world[t as usize].map(|v| to_tile(frame, &rot, v).truncate());
                 for_each_tile(p, n, e, |tx, ty| {
-                    let tile = k * n2 + (ty * n + tx) as usize;
-                    let (first, next) = (tile_first[tile], tile_first[tile + 1]);
-                    let mut s = (first & !SPLIT) as usize - base;
-                    let end = (next & !SPLIT) as usize - base;
-                    if first & SPLIT != 0 {
-                        s += header; // split values and leaf ends, not triangles
-                    }
-                    for id in &mut ids[s..end] {
-                        if *id & mask == t {
-                            *id = DEAD;
+                    let (start, end, split) = offsets.block(k * n2 + (ty * n + tx) as usize);
+                    // A split tile's header (split values and leaf bounds) holds no triangles.
+                    let s = start - base + if split { header } else { 0 };
+                    for w in words[s..end - base].iter_mut().step_by(step) {
+                        if entry_id(*w, wide) == t {
+                            kill(w, wide);
                         }
                     }
                 });
@@ -111,13 +107,10 @@ impl VisibilityField {
     pub fn insert_object(&mut self, object: u32, positions: &[[DVec3; 3]]) -> anyhow::Result<std::ops::Range<u32>> {
         self.check_inside(positions)?;
         let first = self.world.len() as u32;
-        let mask = super::bsp::id_mask(self.settings.depth);
         anyhow::ensure!(
-            (first as usize + positions.len()) < mask as usize,
-            "visibility field: {} triangles do not fit the index bits a tile-BSP depth of {} leaves in an entry (at most {}); rebuild with a smaller depth",
-            first as usize + positions.len(),
-            self.settings.depth,
-            mask - 1
+            (first as usize + positions.len()) < u32::MAX as usize,
+            "visibility field: {} triangles do not fit u32 indices",
+            first as usize + positions.len()
         );
         self.world.extend_from_slice(positions);
         self.tri.extend(positions.iter().flat_map(super::query::pack));

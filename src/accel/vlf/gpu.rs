@@ -1,11 +1,11 @@
 //! The visibility field's GPU form, read by `vlf.wgsl`: the triangles in input order, a header
 //! (the ball in the frame's local coordinates, the settings, the rotation rows and which id
-//! chunk holds each direction), the direction table, the layers' `tile_first` arrays and their
-//! `ids`. The per-entry footprint boxes stay on the CPU: they halve the memory a GPU walk
-//! reads, and SIMD lanes gain little from skipping single tests.
+//! chunk holds each direction), the direction table, the layers' tile offsets (one u32 per tile,
+//! [`super::layer::Offsets::flat`]) and their words. The WGSL reads the entries' ids and skips
+//! their footprint boxes: SIMD lanes gain little from skipping single tests.
 //!
-//! The base layer's `ids` exceed wgpu's portable 128 MiB storage binding on large scenes (274
-//! MB on the body at the paper's settings), so they are bound as up to [`ID_CHUNKS`] chunks of
+//! The base layer's words can exceed wgpu's portable 128 MiB storage binding on large scenes,
+//! so they are bound as up to [`ID_CHUNKS`] chunks of
 //! whole directions, each at most [`CHUNK_BYTES`]; a direction's tile offsets are rebased on its
 //! chunk's first word in the WGSL. The overlay layer (objects moved since the build) has its
 //! own binding.
@@ -25,7 +25,7 @@ pub const ID_CHUNKS: usize = 4;
 pub const CHUNK_BYTES: usize = 128 << 20;
 
 /// Header words before the rotation rows (`VLF_H_ROWS` in the WGSL).
-const HEADER: usize = 18;
+const HEADER: usize = 19;
 
 /// Widening of the GPU's bounds in ball radii beyond the structure's own: f32 rounding of
 /// coordinates of the order of the ball is ~1e-7 of its radius; this leaves a thousandfold
@@ -42,13 +42,13 @@ pub(super) fn bytes(field: &VisibilityField) -> usize {
     let overlay = if field.overlay_ids.is_empty() {
         (0, 1)
     } else {
-        (field.overlay.tile_first.len(), field.overlay.ids.len().max(1))
+        (field.overlay.offsets.tiles() + 1, field.overlay.words.len().max(1))
     };
     std::mem::size_of::<GpuTri>() * field.world.len().max(1)
         + 4 * (HEADER + 10 * dirs)
         + 4 * field.frame.directions.table.len()
-        + 4 * (field.base.tile_first.len() + overlay.0)
-        + 4 * (field.base.ids.len().max(1) + overlay.1)
+        + 4 * (field.base.offsets.tiles() + 1 + overlay.0)
+        + 4 * (field.base.words.len().max(1) + overlay.1)
 }
 
 /// The buffers `vlf.wgsl` binds at group 2, in binding order, or an error naming the array that
@@ -65,7 +65,8 @@ pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::
         (&field.base, (!field.overlay_ids.is_empty()).then_some(&field.overlay));
 
     // Chunks of whole directions, in order.
-    let word = |k: usize| (base.tile_first[k * n2] & !super::layer::SPLIT) as usize;
+    let tile_first = base.offsets.flat();
+    let word = |k: usize| (tile_first[k * n2] & !super::layer::SPLIT) as usize;
     let mut chunk_of = Vec::with_capacity(dirs);
     let mut chunk_start = vec![0usize];
     for k in 0..dirs {
@@ -84,11 +85,11 @@ pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::
     anyhow::ensure!(
         chunk_start.len() <= ID_CHUNKS,
         "visibility field: the id buffer takes {} bytes, over the {} bytes of {ID_CHUNKS} chunks the GPU binds by {} bytes; use fewer tiles or directions",
-        base.ids.len() * 4,
+        base.words.len() * 4,
         ID_CHUNKS * CHUNK_BYTES,
-        (base.ids.len() * 4).saturating_sub(ID_CHUNKS * CHUNK_BYTES)
+        (base.words.len() * 4).saturating_sub(ID_CHUNKS * CHUNK_BYTES)
     );
-    chunk_start.push(base.ids.len());
+    chunk_start.push(base.words.len());
 
     let mut head: Vec<u32> = Vec::with_capacity(HEADER + 10 * dirs);
     head.extend(centre.as_vec3().to_array().map(f32::to_bits));
@@ -99,18 +100,19 @@ pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::
         u32::from(s.split == Split::Median),
         f.directions.table_side,
         1 + u32::from(overlay.is_some()),
-        base.tile_first.len() as u32,
+        tile_first.len() as u32,
         ((eps * f.half_tiles) as f32).to_bits(),
         (eps as f32).to_bits(),
     ]);
     head.extend((0..ID_CHUNKS).map(|c| *chunk_start.get(c).unwrap_or(&0) as u32));
     head.push(dirs as u32);
+    head.push(u32::from(base.wide) | u32::from(overlay.is_some_and(|l| l.wide)) << 1);
     debug_assert_eq!(head.len(), HEADER);
     head.extend(f.directions.rows.iter().map(|&r| (r as f32).to_bits()));
     head.extend(&chunk_of);
 
-    let mut tile_first = base.tile_first.clone();
-    tile_first.extend(overlay.map_or(&[][..], |l| &l.tile_first[..]));
+    let mut tile_first = tile_first;
+    tile_first.extend(overlay.map_or(Vec::new(), |l| l.offsets.flat()));
     let triangles: Vec<GpuTri> = field
         .world
         .iter()
@@ -145,11 +147,11 @@ pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::
             (Some(&a), Some(&b)) if c + 1 < chunk_start.len() => (a, b),
             _ => (0, 0),
         };
-        buffers.push((label, words(&base.ids[a..b])));
+        buffers.push((label, words(&base.words[a..b])));
     }
     buffers.push((
         "visibility field overlay id buffer",
-        words(overlay.map_or(&[][..], |l| &l.ids[..])),
+        words(overlay.map_or(&[][..], |l| &l.words[..])),
     ));
     debug_assert_eq!(buffers.len(), GPU_BUFFERS as usize);
     Ok(GpuStructure {

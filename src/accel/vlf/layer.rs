@@ -1,23 +1,28 @@
 //! One set of parallel subfields over a subset of the triangles, in flat arrays (paper Sections
 //! 3.2 and 4): per direction, `n x n` tiles in CSR form, each tile either a plain list of
-//! triangle ids or a tile BSP. Built direction by direction in parallel.
+//! triangle entries or a tile BSP. Built direction by direction in parallel.
 //!
-//! Layout (every array a flat `Vec` of plain numbers, indexed with u32; the GPU reads the same):
-//! - `tile_first[k * n^2 + ty * n + tx]` (`D n^2 + 1` entries): start of the tile's block in
-//!   `ids`; the block ends where the next tile's starts (mask [`SPLIT`] off both). An empty tile
-//!   costs this one offset.
-//! - Bit 31 ([`SPLIT`]) set: the tile is split, and its block starts with a header of
-//!   [`bsp::header_len`] words, so that one tile's lookup touches one region of memory: the
-//!   split values as f32 bits (`z0, scale` for uniform slabs, the `L - 1` planes for median
-//!   splits; [`Split::stride`]), then for each of the `L = 2^depth` leaves its end `E_l`,
-//!   counted from the first word after the header `h`: leaf `l` is `ids[h + E_{l-1} .. h + E_l]`
-//!   (`E_{-1} = 0`).
-//! - Otherwise `ids[start .. end]` are the tile's triangles, in increasing index order.
-//! - `boxes[i]` (u16) is the footprint of `ids[i]`'s triangle within its tile on a 16 x 16
-//!   sub-grid ([`super::raster::sub_box`]); 0 for header words. Not in the paper: the tiles'
-//!   lateral resolution is what bounds the candidates (the beam through a surface seen at a
-//!   grazing angle holds many triangles), and this refines it per entry for two bytes
-//!   (measured on the body: 68 exact tests per AO ray without it, 9.5 with it).
+//! Layout (flat `Vec`s of plain numbers, indexed with u32; the GPU reads the same words):
+//! - [`Offsets`]: where tile `k = dir n^2 + ty n + tx` starts in `words`, and whether it is
+//!   split; its block ends where tile `k + 1`'s starts. Where every row of tiles spans under
+//!   2^15 words (all meshes here), a u32 per row of tiles and a u16 per tile; otherwise a u32
+//!   per tile. An empty tile costs its offset alone.
+//! - `words`: the blocks. A plain tile's block is its entries, in increasing triangle order. A
+//!   split tile's starts with a header of [`bsp::header_len`] words (the split values as f32
+//!   bits, `z0, scale` for uniform slabs or the `L - 1` planes for median splits,
+//!   [`super::Split::stride`]; then two words per leaf, [`bsp::LeafBounds`]), then each leaf's
+//!   entries, so one tile's lookup touches one region of memory.
+//! - An entry is the triangle index and its footprint box within the tile on a 16 x 16
+//!   sub-grid ([`super::raster::sub_box`]): one word `id | box << 16` when every index of the
+//!   layer fits 16 bits (`id` 0xffff marks a removed triangle), else two words `id, box`
+//!   (`u32::MAX` removed). The box is not in the paper: the tiles' lateral resolution is what
+//!   bounds the candidates (the beam through a surface seen at a grazing angle holds many
+//!   triangles), and this refines it per entry for two bytes (measured on the body: 68 exact
+//!   tests per AO ray without it, 9.5 with it); beside the id it costs no second cache line.
+//!
+//! Today's layout holds each entry in 4 bytes where the first held 6 (a u32 id with the leaf
+//! range in its top bits, a u16 box in a second array), and each tile offset in 2 bytes where
+//! it held 4: on the cow, man and body (depth 2-3) about two thirds of the bytes.
 
 use super::bsp;
 use super::raster::{clipped_z_range, for_each_tile, sub_box};
@@ -25,28 +30,141 @@ use super::{Frame, VlfSettings, EPS};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Flag in `tile_first` marking a split tile.
+/// Largest triangle index a narrow (one-word) entry holds; the next value marks a removed one.
+const NARROW_DEAD: u32 = 0xffff;
+
+/// Where each tile's block starts in a layer's `words`, and which tiles are split.
+#[derive(Clone, Debug)]
+pub enum Offsets {
+    /// Per row of tiles (`dir n + ty`; one more closes the last) its first word; per tile (one
+    /// more, 0, closes the last) its start relative to its row's, bit 15 marking a split tile.
+    Rows {
+        /// Tiles per side.
+        n: usize,
+        /// First word of each row of tiles.
+        row: Vec<u32>,
+        /// Offset of each tile from its row's first word, bit 15 = split.
+        tile: Vec<u16>,
+    },
+    /// Per tile (one more closes the last) its first word, bit 31 marking a split tile.
+    Flat(Vec<u32>),
+}
+
+impl Default for Offsets {
+    fn default() -> Self {
+        Offsets::Flat(Vec::new())
+    }
+}
+
+/// Split flag of a [`Offsets::Flat`] offset.
 pub const SPLIT: u32 = 1 << 31;
+/// Split flag of a [`Offsets::Rows`] tile offset.
+const ROW_SPLIT: u16 = 1 << 15;
+
+impl Offsets {
+    /// Words `start..end` of tile `k`'s block, and whether the tile is split.
+    #[inline(always)]
+    pub fn block(&self, k: usize) -> (usize, usize, bool) {
+        match self {
+            Offsets::Rows { n, row, tile } => {
+                let (a, b) = (tile[k], tile[k + 1]);
+                (
+                    (row[k / n] + (a & !ROW_SPLIT) as u32) as usize,
+                    (row[(k + 1) / n] + (b & !ROW_SPLIT) as u32) as usize,
+                    a & ROW_SPLIT != 0,
+                )
+            }
+            Offsets::Flat(first) => {
+                let (a, b) = (first[k], first[k + 1]);
+                ((a & !SPLIT) as usize, (b & !SPLIT) as usize, a & SPLIT != 0)
+            }
+        }
+    }
+
+    /// Hints that tile `k`'s offsets are read soon.
+    #[inline(always)]
+    pub fn prefetch(&self, k: usize) {
+        match self {
+            Offsets::Rows { n, row, tile } => {
+                super::bundle::prefetch(&row[k / n]);
+                super::bundle::prefetch(&tile[k]);
+            }
+            Offsets::Flat(first) => super::bundle::prefetch(&first[k]),
+        }
+    }
+
+    /// Tiles (all directions).
+    pub fn tiles(&self) -> usize {
+        match self {
+            Offsets::Rows { tile, .. } => tile.len().saturating_sub(1),
+            Offsets::Flat(first) => first.len().saturating_sub(1),
+        }
+    }
+
+    /// Bytes the offsets occupy.
+    pub fn bytes(&self) -> usize {
+        match self {
+            Offsets::Rows { row, tile, .. } => 4 * row.len() + 2 * tile.len(),
+            Offsets::Flat(first) => 4 * first.len(),
+        }
+    }
+
+    /// Every tile's first word with [`SPLIT`], and one more closing the last (the GPU's form).
+    pub fn flat(&self) -> Vec<u32> {
+        match self {
+            Offsets::Flat(first) => first.clone(),
+            Offsets::Rows { .. } => (0..=self.tiles())
+                .map(|k| {
+                    if k == self.tiles() {
+                        return self.block(k - 1).1 as u32;
+                    }
+                    let (start, _, split) = self.block(k);
+                    start as u32 | if split { SPLIT } else { 0 }
+                })
+                .collect(),
+        }
+    }
+
+    /// The compact form of `flat` (tiles per side `n`) where every row's offsets fit 15 bits.
+    fn compact(flat: Vec<u32>, n: usize) -> Offsets {
+        let tiles = flat.len() - 1;
+        let start = |k: usize| flat[k] & !SPLIT;
+        let fits = (0..tiles).all(|k| start(k) - start(k / n * n) < ROW_SPLIT as u32);
+        if !fits || tiles % n != 0 {
+            return Offsets::Flat(flat);
+        }
+        let mut row: Vec<u32> = (0..tiles / n).map(|r| start(r * n)).collect();
+        row.push(start(tiles));
+        let mut tile: Vec<u16> = Vec::with_capacity(tiles + 1);
+        huge_pages(&tile);
+        tile.extend(
+            (0..tiles).map(|k| (start(k) - row[k / n]) as u16 | if flat[k] & SPLIT != 0 { ROW_SPLIT } else { 0 }),
+        );
+        tile.push(0);
+        Offsets::Rows { n, row, tile }
+    }
+}
 
 /// The flat arrays of one layer (see the module doc).
 #[derive(Clone, Debug, Default)]
 pub struct Layer {
-    /// Per tile, start in `ids` (bit 31: split); one more entry closes the last tile.
-    pub tile_first: Vec<u32>,
-    /// Triangle ids, and the header at the head of each split tile's block.
-    pub ids: Vec<u32>,
-    /// Per entry of `ids`, the footprint box of the triangle in its tile
-    /// ([`super::raster::sub_box`]; 0 for header words).
-    pub boxes: Vec<u16>,
+    /// Each tile's block in `words`.
+    pub offsets: Offsets,
+    /// The blocks: split-tile headers and entries.
+    pub words: Vec<u32>,
+    /// Whether entries take two words (some triangle index exceeds 16 bits).
+    pub wide: bool,
+    /// Words of split-tile headers (the rest are entries).
+    pub header_words: usize,
     /// Triangles indexed (distinct).
     pub triangles: usize,
 }
 
-/// One direction's part before merging (offsets relative to its own arrays).
+/// One direction's part before merging (offsets relative to its own words, bit 31 = split).
 struct Part {
     tile_first: Vec<u32>,
-    ids: Vec<u32>,
-    boxes: Vec<u16>,
+    words: Vec<u32>,
+    header_words: usize,
 }
 
 /// Asks the kernel to back `v`'s (not yet touched) capacity with transparent huge pages: a
@@ -78,43 +196,91 @@ fn huge_pages<T>(v: &Vec<T>) {
 impl Layer {
     /// Bytes the arrays occupy.
     pub fn bytes(&self) -> usize {
-        4 * (self.tile_first.len() + self.ids.len()) + 2 * self.boxes.len()
+        self.offsets.bytes() + 4 * self.words.len()
+    }
+
+    /// Bytes per part: tile offsets, split-tile headers, entries.
+    pub fn parts(&self) -> [(&'static str, usize); 3] {
+        [
+            ("tile offsets", self.offsets.bytes()),
+            ("split headers", 4 * self.header_words),
+            ("entries", 4 * (self.words.len() - self.header_words)),
+        ]
+    }
+
+    /// Words per entry.
+    #[inline(always)]
+    pub fn entry_words(&self) -> usize {
+        1 + usize::from(self.wide)
     }
 
     /// Split tiles.
     pub fn split_tiles(&self) -> usize {
-        self.tile_first.iter().filter(|f| *f & SPLIT != 0).count()
+        (0..self.offsets.tiles()).filter(|&k| self.offsets.block(k).2).count()
+    }
+
+    /// Marks the entry at word `at` (its first word) as a removed triangle.
+    pub fn kill_at(&mut self, at: usize) {
+        kill(&mut self.words[at], self.wide);
     }
 
     /// Builds the layer over triangles `subset` of `world`.
     pub fn build(world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, settings: &VlfSettings) -> anyhow::Result<Layer> {
         let dirs = frame.directions.len();
+        let wide = subset.iter().any(|&t| t >= NARROW_DEAD);
         let parts: Vec<Part> = (0..dirs as u32)
             .into_par_iter()
-            .map(|k| direction_part(k, world, subset, frame, settings))
+            .map(|k| direction_part(k, world, subset, frame, settings, wide))
             .collect();
-        let total_ids: usize = parts.iter().map(|p| p.ids.len()).sum();
+        let total: usize = parts.iter().map(|p| p.words.len()).sum();
         anyhow::ensure!(
-            total_ids < SPLIT as usize,
-            "visibility field: {total_ids} tile entries exceed the 2^31 a u32 offset with a flag bit addresses; use fewer directions or tiles"
+            total < SPLIT as usize,
+            "visibility field: {total} words of tile entries exceed the 2^31 a u32 offset with a flag bit addresses; use fewer directions or tiles"
         );
-        let mut layer = Layer {
-            tile_first: Vec::with_capacity(parts.iter().map(|p| p.tile_first.len()).sum::<usize>() + 1),
-            ids: Vec::with_capacity(total_ids),
-            boxes: Vec::with_capacity(total_ids),
-            triangles: subset.len(),
-        };
-        huge_pages(&layer.tile_first);
-        huge_pages(&layer.ids);
-        huge_pages(&layer.boxes);
+        let mut tile_first = Vec::with_capacity(parts.iter().map(|p| p.tile_first.len()).sum::<usize>() + 1);
+        let mut words = Vec::with_capacity(total);
+        huge_pages(&words);
+        let mut header_words = 0;
         for p in parts {
-            let base = layer.ids.len() as u32;
-            layer.tile_first.extend(p.tile_first.iter().map(|f| f + base));
-            layer.ids.extend_from_slice(&p.ids);
-            layer.boxes.extend_from_slice(&p.boxes);
+            let base = words.len() as u32;
+            tile_first.extend(p.tile_first.iter().map(|f| f + base));
+            words.extend_from_slice(&p.words);
+            header_words += p.header_words;
         }
-        layer.tile_first.push(layer.ids.len() as u32);
-        Ok(layer)
+        tile_first.push(words.len() as u32);
+        Ok(Layer {
+            offsets: Offsets::compact(tile_first, settings.tiles as usize),
+            words,
+            wide,
+            header_words,
+            triangles: subset.len(),
+        })
+    }
+}
+
+/// Marks the entry whose first word is `w` removed.
+#[inline]
+pub fn kill(w: &mut u32, wide: bool) {
+    *w = if wide { u32::MAX } else { (*w & !0xffff) | NARROW_DEAD };
+}
+
+/// The triangle index of the entry whose first word is `w` (`u32::MAX` for a removed one).
+#[inline(always)]
+pub fn entry_id(w: u32, wide: bool) -> u32 {
+    match (wide, w & 0xffff) {
+        (true, _) => w,
+        (false, NARROW_DEAD) => u32::MAX,
+        (false, id) => id,
+    }
+}
+
+/// Appends the entry for triangle `id` with footprint `b`.
+#[inline]
+fn push_entry(words: &mut Vec<u32>, id: u32, b: u16, wide: bool) {
+    if wide {
+        words.extend([id, b as u32]);
+    } else {
+        words.push(id | (b as u32) << 16);
     }
 }
 
@@ -130,7 +296,14 @@ pub fn to_tile(frame: &Frame, rot: &[DVec3; 3], p: DVec3) -> DVec3 {
     )
 }
 
-fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, settings: &VlfSettings) -> Part {
+fn direction_part(
+    k: u32,
+    world: &[[DVec3; 3]],
+    subset: &[u32],
+    frame: &Frame,
+    settings: &VlfSettings,
+    wide: bool,
+) -> Part {
     let n = settings.tiles;
     let tiles = (n * n) as usize;
     let rot = frame.directions.rotation(k);
@@ -159,17 +332,20 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
         fill[t as usize] += 1;
     }
     drop(pairs);
+    let per_entry = 1 + usize::from(wide);
     let mut part = Part {
         tile_first: Vec::with_capacity(tiles),
-        ids: Vec::with_capacity(sorted.len()),
-        boxes: Vec::with_capacity(sorted.len()),
+        words: Vec::with_capacity(sorted.len() * per_entry),
+        header_words: 0,
     };
+    let header = bsp::header_len(settings.split, 1 << settings.depth);
+    let push = |words: &mut Vec<u32>, id: u32, b: u16| push_entry(words, id, b, wide);
     let (mut items, mut scratch) = (Vec::new(), Vec::new());
     for t in 0..tiles {
         let list = &sorted[start[t] as usize..start[t + 1] as usize];
-        let at = part.ids.len() as u32;
+        let at = part.words.len() as u32;
+        let (tx, ty) = (t as u32 % n, t as u32 / n);
         if settings.depth > 0 && list.len() > settings.leaf_size as usize {
-            let (tx, ty) = (t as u32 % n, t as u32 / n);
             items.clear();
             items.extend(list.iter().map(|&i| {
                 let (lo, hi) = clipped_z_range(&proj[i as usize], tx, ty, e);
@@ -184,19 +360,23 @@ fn direction_part(k: u32, world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, s
                 &items,
                 settings.split,
                 settings.depth,
-                &mut part.ids,
-                &mut part.boxes,
+                &mut part.words,
                 &mut scratch,
+                push,
             ) {
                 part.tile_first.push(at | SPLIT);
+                part.header_words += header;
                 continue;
             }
         }
         part.tile_first.push(at);
-        let (tx, ty) = (t as u32 % n, t as u32 / n);
-        part.ids.extend(list.iter().map(|&i| subset[i as usize]));
-        part.boxes
-            .extend(list.iter().map(|&i| sub_box(&proj[i as usize], tx, ty, e)));
+        for &i in list {
+            push(
+                &mut part.words,
+                subset[i as usize],
+                sub_box(&proj[i as usize], tx, ty, e),
+            );
+        }
     }
     part
 }

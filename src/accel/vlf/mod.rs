@@ -19,21 +19,23 @@
 //! and walks its leaves in reverse.
 //!
 //! # Flat arrays
-//! All u32/f32/f64 `Vec`s, addressable with u32 indices:
+//! All u32/u16/f32/f64 `Vec`s, addressable with u32 indices:
 //! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
-//! - per layer ([`layer::Layer`], layout in its module doc): `tile_first` (u32, `D n^2 + 1`, bit
-//!   31 = split), `ids` (u32: triangle ids; a split tile's block starts with its split values
-//!   as f32 bits and its leaf ends), `boxes` (u16 per `ids` word: the triangle's footprint in
-//!   its tile on a 16 x 16 sub-grid, so most candidates are dropped with four compares);
+//! - per layer ([`layer::Layer`], layout in its module doc): the tile offsets (a u16 per tile
+//!   under a u32 per row of tiles), and `words`: each tile's entries (triangle id and its
+//!   footprint box on a 16 x 16 sub-grid of the tile, so most candidates are dropped with four
+//!   compares; one word each while ids fit 16 bits), a split tile's led by its split values and
+//!   its leaves' bounds;
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
-//! On the GPU (`gpu.rs`, `vlf.wgsl`) the same arrays are read but for `boxes`. Sizes on the body
-//! (32K triangles, 513 directions, 128^2 tiles, depth 4, leaf size 32): `tile_first` 34 MB,
-//! `ids` 274 MB, `boxes` 137 MB; `ids` is bound in chunks of whole directions under wgpu's
+//! On the GPU (`gpu.rs`, `vlf.wgsl`) the same words are read, with one u32 offset per tile. Sizes
+//! on the body (32K triangles, 513 directions, 128^2 tiles, leaf size 32) at depth 2: tile
+//! offsets 17 MB, split headers 16 MB, entries 190 MB (223 MB; 333 MB in the first layout's
+//! 6-byte entries and u32 offsets); the words are bound in chunks of whole directions under wgpu's
 //! portable 128 MiB storage-binding size.
 //!
 //! The base layer indexes every triangle; a second, small layer holds objects inserted or moved
-//! since the build ([`dynamic`]), and removed triangles' ids are overwritten with [`DEAD`].
+//! since the build ([`dynamic`]), and removed triangles' entries are marked removed in place.
 
 pub mod bsp;
 mod bundle;
@@ -62,13 +64,10 @@ use std::time::{Duration, Instant};
 /// Far above f64 rounding of scenes within ~1e6 radii of their origin, far below a tile.
 pub const EPS: f64 = 1e-6;
 
-/// A removed triangle's slot in a layer's `ids` (its index bits are all ones, never a triangle:
-/// indices stay below [`bsp::id_mask`]).
-pub const DEAD: u32 = u32::MAX;
-
 /// Build parameters (paper Section 6 fixes 513 directions and 128 x 128 tiles; tile-BSP depth
 /// 3-5 was best there). With the per-entry footprint boxes, depth 2 was faster still on the
-/// body (0.93-1.05 against 0.84-0.92 Mrays/s AO any-hit, 370 MB against 445 MB).
+/// body (0.93-1.05 against 0.84-0.92 Mrays/s AO any-hit, 370 MB against 445 MB in the first
+/// layout; 223 MB against 318 MB in today's).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct VlfSettings {
@@ -91,7 +90,7 @@ impl Default for VlfSettings {
             tiles: 128,
             depth: 4,
             split: Split::Uniform,
-            // Measured on the body (513 dirs, 128^2, depth 4): 32 gives 445 MB and 0.92 Mrays/s
+            // Measured on the body (513 dirs, 128^2, depth 4, first layout): 32 gives 445 MB and 0.92 Mrays/s
             // AO any-hit where 8 gave 600 MB and 0.84 (fewer split tiles, fewer duplicates).
             leaf_size: 32,
         }
@@ -196,12 +195,12 @@ pub fn ball(world: &[[DVec3; 3]]) -> (DVec3, f64) {
 }
 
 /// A lower bound on the field's peak bytes while it is built over `triangles` triangles: its
-/// arrays hold a 4-byte offset per tile of every direction and at least one 6-byte entry (id
-/// and footprint box) per triangle per direction, and the build holds them twice (every
+/// arrays hold at least a 2-byte offset per tile of every direction and a 4-byte entry (id and
+/// footprint box) per triangle per direction, and the build holds the entries twice (every
 /// direction's part, then the merged arrays); besides, the packed triangles.
 pub fn min_bytes(triangles: usize, s: &VlfSettings) -> u64 {
     let directions = 2 * s.level as u64 * s.level as u64 + 1;
-    let arrays = directions * (s.tiles as u64).pow(2) * 4 + triangles as u64 * directions * 6;
+    let arrays = directions * (s.tiles as u64).pow(2) * 2 + triangles as u64 * directions * 4;
     2 * arrays + triangles as u64 * 72
 }
 
@@ -224,12 +223,9 @@ impl VisibilityField {
         );
         let world = triangles.positions.clone();
         anyhow::ensure!(
-            world.len() < bsp::id_mask(settings.depth) as usize,
-            "visibility field: {} triangles do not fit the {} index bits a tile-BSP depth of {} leaves in an entry (at most {}); use a smaller depth",
-            world.len(),
-            bsp::id_bits(settings.depth).min(32),
-            settings.depth,
-            bsp::id_mask(settings.depth) - 1
+            world.len() < u32::MAX as usize,
+            "visibility field: {} triangles do not fit u32 indices",
+            world.len()
         );
         let (centre, radius) = ball(&world);
         let frame = Frame {
@@ -281,10 +277,23 @@ impl VisibilityField {
     /// Bytes of the structure's arrays (both layers, the table and rotations; not the
     /// triangles, which every structure needs).
     pub fn bytes(&self) -> usize {
-        self.base.bytes()
-            + self.overlay.bytes()
-            + 4 * self.frame.directions.table.len()
-            + 8 * self.frame.directions.rows.len()
+        self.parts().iter().map(|p| p.1).sum()
+    }
+
+    /// [`VisibilityField::bytes`] by part: the base layer's tile offsets, split-tile headers
+    /// and entries, the overlay layer, and the direction table with its rotations.
+    pub fn parts(&self) -> [(&'static str, usize); 5] {
+        let [offsets, headers, entries] = self.base.parts();
+        [
+            offsets,
+            headers,
+            entries,
+            ("overlay", self.overlay.bytes()),
+            (
+                "directions",
+                4 * self.frame.directions.table.len() + 8 * self.frame.directions.rows.len(),
+            ),
+        ]
     }
 }
 
@@ -311,7 +320,12 @@ impl Accelerator for VisibilityField {
 
     fn stats(&self) -> BuildStats {
         let bytes = self.bytes();
-        let entries = self.base.ids.len();
+        let entries = (self.base.words.len() - self.base.header_words) / self.base.entry_words();
+        let parts: Vec<String> = self
+            .parts()
+            .iter()
+            .map(|(part, b)| format!("{part} {:.1} MB", *b as f64 / 1e6))
+            .collect();
         BuildStats {
             parameters: self.settings.describe(),
             build_time: self.build_time,
@@ -319,14 +333,15 @@ impl Accelerator for VisibilityField {
             memory_bytes: bytes as u64,
             triangles: self.world.len(),
             description: format!(
-                "visibility field ({}): {} tile entries ({:.1} per triangle per direction), {} split tiles, built in {:.1} ms; {:.1} MB ({:.0} bytes per triangle)",
+                "visibility field ({}): {} tile entries ({:.1} per triangle per direction), {} split tiles, built in {:.1} ms; {:.1} MB ({:.0} bytes per triangle: {})",
                 self.settings.describe(),
                 entries,
                 entries as f64 / (self.world.len().max(1) * self.frame.directions.len()) as f64,
                 self.base.split_tiles(),
                 self.build_time.as_secs_f64() * 1e3,
                 bytes as f64 / 1e6,
-                bytes as f64 / self.world.len().max(1) as f64
+                bytes as f64 / self.world.len().max(1) as f64,
+                parts.join(", ")
             ),
         }
     }

@@ -10,7 +10,7 @@
 //! the first.
 
 use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
-use super::layer::{Layer, SPLIT};
+use super::layer::Layer;
 use super::raster::sub_range;
 use super::{VisibilityField, EPS};
 use crate::accel::work;
@@ -67,33 +67,39 @@ pub fn exact_t(origin: DVec3, dir: DVec3, k: &[f64]) -> f64 {
 /// One leaf's entries as a walk visits them.
 #[derive(Clone, Copy, Debug)]
 pub struct Leaf<'a> {
-    /// Entries (triangle index in the low [`bsp::id_bits`], leaf range above).
-    pub ids: &'a [u32],
-    /// Their footprint boxes ([`super::raster::sub_box`]).
-    pub boxes: &'a [u16],
-    /// The ray's own sub-cell box over the tile, packed the same way.
+    /// The entries to test ([`super::layer`]: one word each, or two when `wide`).
+    pub words: &'a [u32],
+    /// Whether entries take two words.
+    pub wide: bool,
+    /// The ray's own sub-cell box over the tile, packed as the entries' boxes.
     pub ray_box: [u32; 4],
     /// The t beyond which no hit in a later leaf of this tile lies.
     pub exit: f64,
-    /// Shift of the entry's key (first leaf, or `L - 1 -` last leaf walking down).
-    pub shift: u32,
-    /// Mask of the key after the shift (`2^depth - 1`; 0 in an unsplit tile).
-    pub key_mask: u32,
-    /// Entries whose key is below this were tested in an earlier leaf of this walk.
-    pub lim: u32,
 }
 
 impl Leaf<'_> {
-    /// Calls `f` with each triangle index not yet tested in this tile (nor dead); stops when
-    /// it returns true (returning true).
+    /// Entries the leaf lists for this walk.
+    pub fn entries(&self) -> usize {
+        self.words.len() >> usize::from(self.wide)
+    }
+
+    /// Calls `f` with each triangle index whose footprint box meets the ray's (removed ones
+    /// skipped); stops when it returns true (returning true).
     #[inline(always)]
-    pub fn each(&self, mask: u32, mut f: impl FnMut(u32) -> bool) -> bool {
+    pub fn each(&self, mut f: impl FnMut(u32) -> bool) -> bool {
+        if self.wide {
+            self.scan(self.words.chunks_exact(2).map(|w| (w[0], w[1])), u32::MAX, &mut f)
+        } else {
+            self.scan(self.words.iter().map(|&w| (w & 0xffff, w >> 16)), 0xffff, &mut f)
+        }
+    }
+
+    #[inline(always)]
+    fn scan(&self, entries: impl Iterator<Item = (u32, u32)>, dead: u32, f: &mut impl FnMut(u32) -> bool) -> bool {
         let [rx0, rx1, ry0, ry1] = self.ray_box;
-        for (&e, &b) in self.ids.iter().zip(self.boxes) {
-            let id = e & mask;
-            let b = b as u32;
-            let apart = (b & 15 > rx1) | ((b >> 4) & 15 < rx0) | ((b >> 8) & 15 > ry1) | (b >> 12 < ry0);
-            if apart || id == mask || ((e >> self.shift) & self.key_mask) < self.lim {
+        for (id, b) in entries {
+            let apart = (b & 15 > rx1) | ((b >> 4) & 15 < rx0) | ((b >> 8) & 15 > ry1) | ((b >> 12) & 15 < ry0);
+            if apart || id == dead {
                 continue;
             }
             if f(id) {
@@ -231,9 +237,7 @@ impl VisibilityField {
         mut leaf: impl FnMut(Leaf) -> bool,
     ) -> bool {
         let n2 = (self.settings.tiles * self.settings.tiles) as usize;
-        let k = ray.dir as usize * n2 + tile;
-        let (first, next) = (layer.tile_first[k], layer.tile_first[k + 1]);
-        let (start, end) = ((first & !SPLIT) as usize, (next & !SPLIT) as usize);
+        let (start, end, split) = layer.offsets.block(ray.dir as usize * n2 + tile);
         let e = EPS * self.frame.half_tiles;
         let n = self.settings.tiles as usize;
         let (tx, ty) = ((tile % n) as f64, (tile / n) as f64);
@@ -242,48 +246,25 @@ impl VisibilityField {
         let (rx0, rx1) = sub_range(xa.min(xb), xa.max(xb), e);
         let (ry0, ry1) = sub_range(ya.min(yb), ya.max(yb), e);
         let ray_box = [rx0, rx1, ry0, ry1];
-        if first & SPLIT == 0 {
+        let wide = layer.wide;
+        if !split {
             return start < end
                 && leaf(Leaf {
-                    ids: &layer.ids[start..end],
-                    boxes: &layer.boxes[start..end],
+                    words: &layer.words[start..end],
+                    wide,
                     ray_box,
                     exit: f64::INFINITY,
-                    shift: 0,
-                    key_mask: 0,
-                    lim: 0,
                 });
         }
         let leaves = 1usize << self.settings.depth;
         let kind = self.settings.split;
         let stride = kind.stride(leaves);
-        let head = &layer.ids[start..start + stride + leaves];
-        let ends = &head[stride..];
-        let h = start + stride + leaves;
+        let head = &layer.words[start..start + bsp::header_len(kind, leaves)];
+        let bounds = &head[stride..];
+        let (h, w) = (start + head.len(), layer.entry_words());
         let (za, zb) = (ray.o.z + ray.d.z * ta, ray.o.z + ray.d.z * tb);
         let (zlo, zhi) = (za.min(zb) - EPS, za.max(zb) + EPS);
-        let leaf_range = |l: usize| {
-            let a = if l == 0 { 0 } else { ends[l - 1] as usize };
-            h + a..h + ends[l] as usize
-        };
         let up = ray.d.z >= 0.0;
-        let depth = self.settings.depth;
-        let lmask = (leaves - 1) as u32;
-        // Entries whose range began in a leaf already visited are skipped (see bsp::entry).
-        let shift = bsp::id_bits(depth) + if up { 0 } else { depth };
-        let lim = |l: usize, l0: usize, l1: usize| -> u32 {
-            if up {
-                if l == l0 {
-                    0
-                } else {
-                    l as u32
-                }
-            } else if l == l1 {
-                0
-            } else {
-                lmask - l as u32
-            }
-        };
         // Depth of the boundary between leaves b - 1 and b.
         let boundary = |b: usize| -> f64 {
             match kind {
@@ -305,14 +286,12 @@ impl VisibilityField {
             } else {
                 (boundary(l) + EPS - ray.o.z) * ray.inv_dz
             };
+            let (a, b) = bsp::LeafBounds::read(bounds, l).tested(i == 0, up);
             if leaf(Leaf {
-                ids: &layer.ids[leaf_range(l)],
-                boxes: &layer.boxes[leaf_range(l)],
+                words: &layer.words[h + w * a..h + w * b],
+                wide,
                 ray_box,
                 exit,
-                shift,
-                key_mask: lmask,
-                lim: lim(l, l0, l1),
             }) {
                 return true;
             }
@@ -324,7 +303,6 @@ impl VisibilityField {
     #[inline]
     pub(super) fn any_in(&self, layer: &Layer, ray: &TileRay, origin: DVec3, dir: DVec3, tmax: f64, skip: u32) -> bool {
         let tri = &self.tri;
-        let mask = bsp::id_mask(self.settings.depth);
         let (nodes, prims) = (Cell::new(0u64), Cell::new(0u64));
         let hit = self.walk(
             ray,
@@ -333,7 +311,7 @@ impl VisibilityField {
                 nodes.set(nodes.get() + 1);
                 self.leaves(layer, ray, tile, ta, tb, |leaf| {
                     nodes.set(nodes.get() + 1);
-                    leaf.each(mask, |id| {
+                    leaf.each(|id| {
                         if id == skip {
                             return false;
                         }
@@ -362,7 +340,6 @@ impl VisibilityField {
         best: &mut (f64, u32),
     ) {
         let tri = &self.tri;
-        let mask = bsp::id_mask(self.settings.depth);
         let cell = Cell::new(*best);
         let (nodes, prims) = (Cell::new(0u64), Cell::new(0u64));
         self.walk(
@@ -373,7 +350,7 @@ impl VisibilityField {
                 self.leaves(layer, ray, tile, ta, tb, |leaf| {
                     nodes.set(nodes.get() + 1);
                     let mut b = cell.get();
-                    leaf.each(mask, |id| {
+                    leaf.each(|id| {
                         if id == skip {
                             return false;
                         }

@@ -2,8 +2,9 @@
 // buffers gpu.rs lays out: the nearest stored line from the lookup table, the segment clipped
 // to the scene's ball and moved into that direction's tile space, the tiles it touches walked
 // front to back (columns along the major axis, rows within each), and in each tile the leaves
-// between its entry and exit depth visited linearly, each triangle tested in the first leaf
-// that lists it. One walk serves both queries: any-hit stops at the first hit, closest-hit
+// between its entry and exit depth visited linearly, each triangle tested once (bsp.rs,
+// LeafBounds: after the first leaf, only the triangles that start there walking up, or end
+// there walking down). One walk serves both queries: any-hit stops at the first hit, closest-hit
 // where no later tile or leaf can hold a nearer one. Bounds are widened well beyond f32
 // rounding, so the candidates hold every triangle `triangle_t` hits; ties in t go to the lower
 // triangle index.
@@ -33,7 +34,9 @@ const VLF_H_EPS_TILE: u32 = 11u;
 const VLF_H_EPS_Z: u32 = 12u;
 const VLF_H_CHUNK_START: u32 = 13u;
 const VLF_H_DIRS: u32 = 17u;
-const VLF_H_ROWS: u32 = 18u;
+// Bit 0: the base layer's entries take two words (id, box); bit 1: the overlay's.
+const VLF_H_WIDE: u32 = 18u;
+const VLF_H_ROWS: u32 = 19u;
 
 fn vlf_f(i: u32) -> f32 {
     return bitcast<f32>(vlf_head[i]);
@@ -135,25 +138,22 @@ fn vlf_cell(v: f32) -> u32 {
     return u32(clamp(floor(v), 0.0, f32(vlf_head[VLF_H_TILES] - 1u)));
 }
 
-// Which entries of a leaf to test: the triangle index is `entry & mask` (all ones: removed);
-// an entry whose key `(entry >> shift) & key_mask` is below `lim` was tested in an earlier
-// leaf of this walk (bsp.rs: the key is its first leaf, or L - 1 - its last walking down).
+// Entries a..b (words) of a leaf: one word `id | box << 16` each, or two (`id`, `box`) when
+// wide; an id of all ones (in its 16 or 32 bits) is a removed triangle.
 struct VlfLeaf {
     a: u32,
     b: u32,
-    mask: u32,
-    shift: u32,
-    key_mask: u32,
-    lim: u32,
+    wide: bool,
 }
 
 fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, best_in: AccelHit, any: bool) -> AccelHit {
     var best = best_in;
+    let step = select(1u, 2u, leaf.wide);
+    let mask = select(0xffffu, 0xffffffffu, leaf.wide);
     var i = leaf.a;
-    for (; i < leaf.b && !(any && best.triangle != NO_HIT); i++) {
-        let e = vlf_word(at, i);
-        let id = e & leaf.mask;
-        if (id == leaf.mask || id == skip || ((e >> leaf.shift) & leaf.key_mask) < leaf.lim) {
+    for (; i < leaf.b && !(any && best.triangle != NO_HIT); i += step) {
+        let id = vlf_word(at, i) & mask;
+        if (id == mask || id == skip) {
             continue;
         }
         let tri = vlf_tris[id];
@@ -211,32 +211,40 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
     let first = vlf_tile_first[k];
     let start = (first & ~VLF_SPLIT) - rebase;
     let end = (vlf_tile_first[k + 1u] & ~VLF_SPLIT) - rebase;
+    let wide = ((vlf_head[VLF_H_WIDE] >> layer) & 1u) == 1u;
     if ((first & VLF_SPLIT) == 0u) {
-        return vlf_leaf(at, VlfLeaf(start, end, 0xffffffffu, 0u, 0u, 0u), o, d, skip, best_in, any);
+        return vlf_leaf(at, VlfLeaf(start, end, wide), o, d, skip, best_in, any);
     }
     var best = best_in;
     let depth = vlf_head[VLF_H_DEPTH];
     let leaves = 1u << depth;
     let stride = select(leaves - 1u, 2u, vlf_head[VLF_H_MEDIAN] == 0u);
-    let ends = start + stride;
-    let h = ends + leaves;
+    let bounds = start + stride;
+    let h = bounds + 2u * leaves;
+    let step = select(1u, 2u, wide);
     let e = ray.e_z;
     let za = ray.o.z + ray.d.z * ta;
     let zb = ray.o.z + ray.d.z * tb;
     let l0 = vlf_leaf_of(at, min(za, zb) - e, start, leaves);
     let l1 = vlf_leaf_of(at, max(za, zb) + e, start, leaves);
     let up = ray.d.z >= 0.0;
-    let bits = 32u - 2u * depth;
-    let shift = bits + select(depth, 0u, up);
     var i = 0u;
     var done = false;
     for (; i <= l1 - l0 && !done; i++) {
         let l = select(l1 - i, l0 + i, up);
-        let a = h + select(vlf_word(at, ends + l - 1u), 0u, l == 0u);
-        let first_visited = l == select(l1, l0, up);
-        let lim = select(select(leaves - 1u - l, l, up), 0u, first_visited);
-        let leaf = VlfLeaf(a, h + vlf_word(at, ends + l), (1u << bits) - 1u, shift, leaves - 1u, lim);
-        best = vlf_leaf(at, leaf, o, d, skip, best, any);
+        // The leaf's group bounds (bsp.rs, LeafBounds): all of the first leaf visited, then
+        // only the triangles starting here walking up, ending here walking down.
+        let w0 = vlf_word(at, bounds + 2u * l);
+        let w1 = vlf_word(at, bounds + 2u * l + 1u);
+        var a = select(vlf_word(at, bounds + 2u * l - 1u) >> 16u, 0u, l == 0u);
+        var b = w1 >> 16u;
+        if (i > 0u && up) {
+            b = w0 >> 16u;
+        } else if (i > 0u) {
+            a = w0 & 0xffffu;
+            b = w1 & 0xffffu;
+        }
+        best = vlf_leaf(at, VlfLeaf(h + step * a, h + step * b, wide), o, d, skip, best, any);
         if (best.triangle != NO_HIT && l != select(l0, l1, up)) {
             // Closest hit: later leaves only hold hits beyond this leaf's exit plane.
             let exit = (vlf_leaf_exit(at, l, up, start, e) - ray.o.z) / ray.d.z;
