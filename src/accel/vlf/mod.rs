@@ -195,12 +195,12 @@ pub fn ball(world: &[[DVec3; 3]]) -> (DVec3, f64) {
 }
 
 /// A lower bound on the field's peak bytes while it is built over `triangles` triangles: its
-/// arrays hold at least a 2-byte offset per tile of every direction and a 4-byte entry (id and
-/// footprint box) per triangle per direction, and the build holds the entries twice (every
-/// direction's part, then the merged arrays); besides, the packed triangles.
+/// build writes a 4-byte offset per tile of every direction (compacted to 2 bytes at the end)
+/// and at least a 4-byte entry (id and footprint box) per triangle per direction, and holds
+/// them twice (every direction's part, then the merged arrays); besides, the packed triangles.
 pub fn min_bytes(triangles: usize, s: &VlfSettings) -> u64 {
     let directions = 2 * s.level as u64 * s.level as u64 + 1;
-    let arrays = directions * (s.tiles as u64).pow(2) * 2 + triangles as u64 * directions * 4;
+    let arrays = directions * (s.tiles as u64).pow(2) * 4 + triangles as u64 * directions * 4;
     2 * arrays + triangles as u64 * 72
 }
 
