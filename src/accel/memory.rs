@@ -58,9 +58,10 @@ mod tests {
             },
         )
         .unwrap();
-        // 8193 directions x 512^2 tile offsets of 4 bytes, held twice while building.
-        let e = check(&huge, 1000, Some(16 << 30)).unwrap_err();
-        assert!(e.contains("needs at least 17.3 GB") && e.contains("the 17.2 GB"), "{e}");
+        // 8193 directions x 512^2 tile offsets of 4 bytes, held twice while building, and
+        // 1000 x 8193 entries of 4 bytes, twice: 17.25 GB.
+        let e = check(&huge, 1000, Some(15 << 30)).unwrap_err();
+        assert!(e.contains("needs at least 17.2 GB") && e.contains("the 16.1 GB"), "{e}");
         assert!(
             check(&huge, 1000, Some(32 << 30)).is_ok(),
             "a machine with room builds it"
