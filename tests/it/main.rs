@@ -40,5 +40,6 @@ mod timing_phase;
 mod visibility_field;
 mod visibility_field_edges;
 mod visibility_field_gpu;
+mod visibility_field_lean;
 mod visibility_field_meshes;
 mod whitted;

@@ -264,3 +264,61 @@ fn dynamic_updates_on_the_gpu_match_brute_force() {
     let hits = assert_matches_brute_force(&current, &updated, &probes);
     assert!(hits > probes.len() / 10, "{hits} of {} rays hit", probes.len());
 }
+
+/// The field's WGSL walk at the 16-bit id boundary: 0xffff triangles (one-word entries, the
+/// last id 0xfffe) and 0x10000 (two words), answering as the BVH's WGSL when built, after the
+/// object with the last indices is removed, after a move (a narrow overlay, under a wide base
+/// for 0x10000) and after an insert past 0xffff (a wide overlay over a narrow base). The BVH,
+/// not brute force, is the reference: brute force's two loops over 65K triangles pass lavapipe's
+/// 65535-iteration loop cap (`render::gpu::loop_cap`) and its any-hit comes back cut short.
+#[test]
+fn ids_at_the_16_bit_boundary_on_the_gpu_match_the_bvh() {
+    use crate::visibility_field_lean::{boundary_scene, boundary_updates, lean_rays};
+    use penumbra::accel::vlf::{Split, VisibilityField};
+    let on_gpu = |field: &VisibilityField, t: &Triangles, label: &str| {
+        let Some(mut gpu) = common::gpu() else { return };
+        let probes: Vec<_> = lean_rays(t, field, 300, 5)
+            .into_iter()
+            .map(|(o, d, tmax, _)| (o, d, tmax))
+            .collect();
+        // The field's WGSL is chosen by its name; "brute" only keeps the scene's own build cheap.
+        let mut scene = common::triangles_scene(t, "brute");
+        scene.accel = Some(std::sync::Arc::new(field.clone()));
+        let vlf = gpu.probe(&scene, &probes).unwrap();
+        let bvh = gpu.probe(&common::triangles_scene(t, "bvh"), &probes).unwrap();
+        let mut hits = 0;
+        for (i, (v, b)) in vlf.iter().zip(&bvh).enumerate() {
+            assert_eq!(v.any, b.any, "{label}: any-hit differs on ray {i} {:?}", probes[i]);
+            hits += b.any as usize;
+            match (v.closest, b.closest) {
+                // Equal t on two triangles: the field takes the lower index, the BVH the first
+                // it meets.
+                (Some((tv, iv)), Some((tb, ib))) => assert!(
+                    tv == tb && iv <= ib,
+                    "{label}: closest ({tv}, {iv}) vs BVH ({tb}, {ib}) on ray {i} {:?}",
+                    probes[i]
+                ),
+                (None, None) => {}
+                (v, b) => panic!("{label}: closest {v:?} vs BVH {b:?} on ray {i} {:?}", probes[i]),
+            }
+        }
+        assert!(hits > probes.len() / 10, "{label}: {hits} of {} rays hit", probes.len());
+    };
+    for (n, split) in [(0xffff, Split::Uniform), (0x10000, Split::Median)] {
+        let t = boundary_scene(n, 7);
+        let settings = VlfSettings {
+            level: 2,
+            tiles: 8,
+            depth: 3,
+            split,
+            leaf_size: 8,
+        };
+        let mut field = VisibilityField::build(&t, settings).unwrap();
+        assert_eq!(field.base.wide, n > 0xffff);
+        on_gpu(&field, &t, &format!("{n}: built"));
+        let mut current = t.clone();
+        boundary_updates(&mut field, &mut current, |f, c, label| {
+            on_gpu(f, c, &format!("{n}: {label}"))
+        });
+    }
+}

@@ -380,3 +380,43 @@ fn direction_part(
     }
     part
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Offsets, SPLIT};
+
+    /// Every tile's block and split flag read back from `o` as written in `flat`.
+    fn same_blocks(o: &Offsets, flat: &[u32]) {
+        assert_eq!(o.tiles(), flat.len() - 1);
+        for k in 0..o.tiles() {
+            let want = (
+                (flat[k] & !SPLIT) as usize,
+                (flat[k + 1] & !SPLIT) as usize,
+                flat[k] & SPLIT != 0,
+            );
+            assert_eq!(o.block(k), want, "tile {k}");
+        }
+        assert_eq!(o.flat(), flat);
+    }
+
+    /// A row whose last tile starts 32767 words after the row's first fits 15 bits (a split
+    /// flag beside it included); one at 32768 falls back to u32 offsets; a row spanning more
+    /// than 2^15 words in its last tile still fits.
+    #[test]
+    fn rows_at_the_15_bit_bound() {
+        // 2 tiles per side, 1 direction: rows (0, 1) and (2, 3).
+        let fit = vec![0, 32_767 | SPLIT, 100_000, 100_000 + 32_767, 200_000];
+        let o = Offsets::compact(fit.clone(), 2);
+        assert!(matches!(o, Offsets::Rows { .. }));
+        same_blocks(&o, &fit);
+        let over = vec![0, 32_768 | SPLIT, 100_000, 100_001 | SPLIT, 100_002];
+        let o = Offsets::compact(over.clone(), 2);
+        assert!(matches!(o, Offsets::Flat(_)));
+        same_blocks(&o, &over);
+        let second_row_over = vec![5 | SPLIT, 6, 7, 7 + 32_768, 7 + 32_769];
+        assert!(matches!(Offsets::compact(second_row_over, 2), Offsets::Flat(_)));
+        let empty_tiles = vec![9, 9, 9 | SPLIT, 9, 9];
+        let o = Offsets::compact(empty_tiles.clone(), 2);
+        same_blocks(&o, &empty_tiles);
+    }
+}
