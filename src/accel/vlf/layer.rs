@@ -4,9 +4,10 @@
 //!
 //! Layout (flat `Vec`s of plain numbers, indexed with u32; the GPU reads the same words):
 //! - [`Offsets`]: where tile `k = dir n^2 + ty n + tx` starts in `words`, and whether it is
-//!   split; its block ends where tile `k + 1`'s starts. Where every row of tiles spans under
-//!   2^15 words (all meshes here), a u32 per row of tiles and a u16 per tile; otherwise a u32
-//!   per tile. An empty tile costs its offset alone.
+//!   split; its block ends where tile `k + 1`'s starts. Where every tile starts under 2^15
+//!   words after its row's first (all meshes here; a row's last block may run longer), a u32
+//!   per row of tiles and a u16 per tile; otherwise a u32 per tile. An empty tile costs its
+//!   offset alone.
 //! - `words`: the blocks. A plain tile's block is its entries, in increasing triangle order. A
 //!   split tile's starts with a header of [`bsp::header_len`] words (the split values as f32
 //!   bits, `z0, scale` for uniform slabs or the `L - 1` planes for median splits,

@@ -22,10 +22,10 @@
 //! All u32/u16/f32/f64 `Vec`s, addressable with u32 indices:
 //! - `directions.table` (u32, `side^2`), `directions.rows` (f64, 9 per direction; f32 on the GPU);
 //! - per layer ([`layer::Layer`], layout in its module doc): the tile offsets (a u16 per tile
-//!   under a u32 per row of tiles), and `words`: each tile's entries (triangle id and its
-//!   footprint box on a 16 x 16 sub-grid of the tile, so most candidates are dropped with four
-//!   compares; one word each while ids fit 16 bits), a split tile's led by its split values and
-//!   its leaves' bounds;
+//!   under a u32 per row of tiles, or a u32 per tile where a row is too full), and `words`:
+//!   each tile's entries (triangle id and its footprint box on a 16 x 16 sub-grid of the tile,
+//!   so most candidates are dropped with four compares; one word each while ids fit 16 bits),
+//!   a split tile's led by its split values and its leaves' bounds;
 //! - the frame: `centre` (3), `radius`, and the settings `tiles`, `depth`, `split`.
 //!
 //! On the GPU (`gpu.rs`, `vlf.wgsl`) the same words are read, with one u32 offset per tile. Sizes
