@@ -25,8 +25,8 @@ fn mismatches(field: &VisibilityField, t: &penumbra::mesh::Triangles, rays: &[Ra
     bad
 }
 
-/// Small triangles in a slab, each split tile deep (1024 leaves): tiles whose leaves would list
-/// more entries than the 16-bit leaf bounds address stay plain lists; every answer is exact.
+/// Small triangles in a slab, each split tile deep (1024 leaves): every answer is exact. (Tiles
+/// whose leaves would overflow the 16-bit leaf bounds: `visibility_field_lean`.)
 #[test]
 fn deep_tile_bsp_with_many_triangles_is_exact() {
     let mut r = Rng(5);
