@@ -273,7 +273,7 @@ fn dynamic_updates_on_the_gpu_match_brute_force() {
 /// 65535-iteration loop cap (`render::gpu::loop_cap`) and its any-hit comes back cut short.
 #[test]
 fn ids_at_the_16_bit_boundary_on_the_gpu_match_the_bvh() {
-    use crate::visibility_field_lean::{boundary_scene, boundary_updates, lean_rays};
+    use crate::visibility_field_lean::{boundary_scene, boundary_settings, boundary_updates, lean_rays};
     use penumbra::accel::vlf::{Split, VisibilityField};
     let on_gpu = |field: &VisibilityField, t: &Triangles, label: &str| {
         let Some(mut gpu) = common::gpu() else { return };
@@ -306,14 +306,7 @@ fn ids_at_the_16_bit_boundary_on_the_gpu_match_the_bvh() {
     };
     for (n, split) in [(0xffff, Split::Uniform), (0x10000, Split::Median)] {
         let t = boundary_scene(n, 7);
-        let settings = VlfSettings {
-            level: 2,
-            tiles: 8,
-            depth: 3,
-            split,
-            leaf_size: 8,
-        };
-        let mut field = VisibilityField::build(&t, settings).unwrap();
+        let mut field = VisibilityField::build(&t, boundary_settings(split)).unwrap();
         assert_eq!(field.base.wide, n > 0xffff);
         on_gpu(&field, &t, &format!("{n}: built"));
         let mut current = t.clone();

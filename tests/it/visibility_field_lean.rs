@@ -30,6 +30,17 @@ pub fn boundary_scene(n: usize, seed: u32) -> Triangles {
     }
 }
 
+/// A small field over a [`boundary_scene`]: few directions and tiles, split tiles of 8 leaves.
+pub fn boundary_settings(split: Split) -> VlfSettings {
+    VlfSettings {
+        level: 2,
+        tiles: 8,
+        depth: 3,
+        split,
+        leaf_size: 8,
+    }
+}
+
 /// Rays aimed at the triangles with the highest indices: from outside the scene (no skip) and
 /// from a point on each along a random direction, skipping it.
 pub fn rays_at_the_last(t: &Triangles, n: usize, r: &mut Rng) -> Vec<Ray> {
@@ -147,14 +158,7 @@ fn ids_at_the_16_bit_boundary_are_exact() {
         (0x10000, Split::Uniform),
     ] {
         let t = boundary_scene(n, 7);
-        let settings = VlfSettings {
-            level: 2,
-            tiles: 8,
-            depth: 3,
-            split,
-            leaf_size: 8,
-        };
-        let mut field = VisibilityField::build(&t, settings).unwrap();
+        let mut field = VisibilityField::build(&t, boundary_settings(split)).unwrap();
         assert_eq!(field.base.wide, n > 0xffff, "{n} triangles");
         let rays = lean_rays(&t, &field, 400, n as u32);
         let hits = assert_exact(&field, &t, &rays, &format!("{n}: built"));

@@ -114,15 +114,17 @@ impl Offsets {
     pub fn flat(&self) -> Vec<u32> {
         match self {
             Offsets::Flat(first) => first.clone(),
-            Offsets::Rows { .. } => (0..=self.tiles())
-                .map(|k| {
-                    if k == self.tiles() {
-                        return self.block(k - 1).1 as u32;
-                    }
-                    let (start, _, split) = self.block(k);
-                    start as u32 | if split { SPLIT } else { 0 }
-                })
-                .collect(),
+            Offsets::Rows { .. } => {
+                // `compact` makes rows only for layers with tiles.
+                let last = self.block(self.tiles() - 1).1 as u32;
+                (0..self.tiles())
+                    .map(|k| {
+                        let (start, _, split) = self.block(k);
+                        start as u32 | if split { SPLIT } else { 0 }
+                    })
+                    .chain([last])
+                    .collect()
+            }
         }
     }
 
@@ -212,7 +214,7 @@ impl Layer {
     /// Words per entry.
     #[inline(always)]
     pub fn entry_words(&self) -> usize {
-        1 + usize::from(self.wide)
+        entry_words(self.wide)
     }
 
     /// Split tiles.
@@ -262,17 +264,34 @@ impl Layer {
 /// Marks the entry whose first word is `w` removed.
 #[inline]
 pub fn kill(w: &mut u32, wide: bool) {
-    *w = if wide { u32::MAX } else { (*w & !0xffff) | NARROW_DEAD };
+    *w |= dead_id(wide);
 }
 
-/// The triangle index of the entry whose first word is `w` (`u32::MAX` for a removed one).
+/// The id field of the entry whose first word is `w`: a triangle index, or all ones
+/// ([`dead_id`]) for a removed one.
 #[inline(always)]
 pub fn entry_id(w: u32, wide: bool) -> u32 {
-    match (wide, w & 0xffff) {
-        (true, _) => w,
-        (false, NARROW_DEAD) => u32::MAX,
-        (false, id) => id,
+    if wide {
+        w
+    } else {
+        w & NARROW_DEAD
     }
+}
+
+/// The id field of a removed entry.
+#[inline(always)]
+pub fn dead_id(wide: bool) -> u32 {
+    if wide {
+        u32::MAX
+    } else {
+        NARROW_DEAD
+    }
+}
+
+/// Words per entry: one (`id | box << 16`) or, when wide, two (`id`, `box`).
+#[inline(always)]
+pub fn entry_words(wide: bool) -> usize {
+    1 + usize::from(wide)
 }
 
 /// Appends the entry for triangle `id` with footprint `b`.
@@ -333,10 +352,9 @@ fn direction_part(
         fill[t as usize] += 1;
     }
     drop(pairs);
-    let per_entry = 1 + usize::from(wide);
     let mut part = Part {
         tile_first: Vec::with_capacity(tiles),
-        words: Vec::with_capacity(sorted.len() * per_entry),
+        words: Vec::with_capacity(sorted.len() * entry_words(wide)),
         header_words: 0,
     };
     let header = bsp::header_len(settings.split, 1 << settings.depth);

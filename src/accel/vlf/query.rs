@@ -10,7 +10,7 @@
 //! the first.
 
 use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
-use super::layer::Layer;
+use super::layer::{dead_id, entry_id, entry_words, Layer};
 use super::raster::sub_range;
 use super::{VisibilityField, EPS};
 use crate::accel::work;
@@ -80,17 +80,19 @@ pub struct Leaf<'a> {
 impl Leaf<'_> {
     /// Entries the leaf lists for this walk.
     pub fn entries(&self) -> usize {
-        self.words.len() >> usize::from(self.wide)
+        self.words.len() / entry_words(self.wide)
     }
 
     /// Calls `f` with each triangle index whose footprint box meets the ray's (removed ones
     /// skipped); stops when it returns true (returning true).
     #[inline(always)]
     pub fn each(&self, mut f: impl FnMut(u32) -> bool) -> bool {
+        // Two loops, so that each compiles without a branch on the width per entry.
         if self.wide {
-            self.scan(self.words.chunks_exact(2).map(|w| (w[0], w[1])), u32::MAX, &mut f)
+            self.scan(self.words.chunks_exact(2).map(|w| (w[0], w[1])), dead_id(true), &mut f)
         } else {
-            self.scan(self.words.iter().map(|&w| (w & 0xffff, w >> 16)), 0xffff, &mut f)
+            let narrow = |&w: &u32| (entry_id(w, false), w >> 16);
+            self.scan(self.words.iter().map(narrow), dead_id(false), &mut f)
         }
     }
 
