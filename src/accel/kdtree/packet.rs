@@ -3,11 +3,10 @@
 //! share a sign octant descend the tree together. At an inner node each lane takes the
 //! children its own [`walk::children`] would give it ([`split_lanes`]); the packet enters a
 //! child when any lane does, near child first (the same child for every lane: the octant fixes
-//! it). A leaf's triangles are
-//! tested against the lanes still open. Each lane therefore visits exactly the leaves of its
-//! single-ray walk, in the same order, and any-hit answers are the single queries'. A node is
-//! fetched once for the whole packet: the work counters count packet node visits and lane
-//! triangle tests.
+//! it). A leaf's triangles are tested against the lanes still open. Each lane therefore visits
+//! exactly the leaves of its single-ray walk, in the same order, and any-hit answers are the
+//! single queries'. A node is fetched once for the whole packet: the work counters count packet
+//! node visits and lane triangle tests.
 
 use super::walk::{self, clip, STACK};
 use super::KdTree;
