@@ -3,9 +3,14 @@
 //! temporary file is named after the host, the process and its start, so writers on several
 //! machines sharing a folder (shards filling one ground-truth cache) never write into each
 //! other's temporary file.
+//!
+//! What a run reads back from a folder it writes into (a results folder's journal, cache and
+//! shards; the files the `page` binary rebuilds a page from) is read only from folders and
+//! regular files, never through a symbolic link and never from a pipe or device: a link planted
+//! there would make a run read or write outside the folder, a pipe would block it for ever.
 
 use anyhow::Context;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::Path;
 
 /// Writes `bytes` to `path` atomically, creating parent folders.
@@ -17,7 +22,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let tmp = temporary(path);
     let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
+        // A fresh file: never one (or a link) already at the temporary name.
+        let mut f = std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
         std::fs::rename(&tmp, path)
@@ -26,6 +32,135 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result.with_context(|| format!("writing {}", path.display()))
+}
+
+/// A path refused as a place to read or write (a link, pipe, device or folder where a regular
+/// file or a plain folder belongs): bad input, exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Refused(pub String);
+
+/// Opens `path` for reading if it is a regular file: a final symbolic link is not followed and a
+/// pipe, device or folder is refused before anything is read (the open does not block).
+pub fn open_regular(path: &Path) -> anyhow::Result<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| match e.raw_os_error() {
+            Some(libc::ELOOP) => Refused(format!(
+                "{}: a symbolic link; refused (it could lead outside the folder)",
+                path.display()
+            )),
+            _ => Refused(format!("{}: cannot open: {e}", path.display())),
+        })?;
+    let kind = file
+        .metadata()
+        .with_context(|| format!("{}: cannot read its metadata", path.display()))?
+        .file_type();
+    if !kind.is_file() {
+        return Err(Refused(format!(
+            "{}: not a regular file ({}); refused",
+            path.display(),
+            describe(kind)
+        ))
+        .into());
+    }
+    Ok(file)
+}
+
+/// The bytes of the regular file `path` ([`open_regular`]).
+pub fn read_regular(path: &Path) -> anyhow::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    open_regular(path)?
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("reading {}", path.display()))?;
+    Ok(bytes)
+}
+
+/// The text of the regular file `path` ([`open_regular`]).
+pub fn read_regular_text(path: &Path) -> anyhow::Result<String> {
+    String::from_utf8(read_regular(path)?).map_err(|_| anyhow::anyhow!("{}: not UTF-8 text", path.display()))
+}
+
+/// Checks that `root`, if it exists, and everything under it are folders and regular files: no
+/// symbolic link (which a write or a removal would follow out of the tree), pipe, socket or
+/// device. The error names the first offending path.
+pub fn check_plain_tree(root: &Path) -> anyhow::Result<()> {
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(p) = stack.pop() {
+        let kind = match std::fs::symlink_metadata(&p) {
+            Ok(m) => m.file_type(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && p == root => return Ok(()),
+            Err(e) => anyhow::bail!("{}: cannot read its metadata: {e}", p.display()),
+        };
+        if kind.is_dir() {
+            for e in std::fs::read_dir(&p).with_context(|| format!("listing {}", p.display()))? {
+                stack.push(e.with_context(|| format!("listing {}", p.display()))?.path());
+            }
+        } else if !kind.is_file() {
+            return Err(Refused(format!(
+                "{}: {}, where only folders and regular files belong; remove it",
+                p.display(),
+                describe(kind)
+            ))
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `dir`, if it exists, is a folder itself, not a symbolic link to one (or a file).
+pub fn check_plain_folder(dir: &Path) -> anyhow::Result<()> {
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_dir() => Ok(()),
+        Ok(m) => Err(Refused(format!(
+            "{}: {}, not a folder; refused",
+            dir.display(),
+            describe(m.file_type())
+        ))
+        .into()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => anyhow::bail!("{}: cannot read its metadata: {e}", dir.display()),
+    }
+}
+
+/// A file type in a few words, for refusals.
+fn describe(kind: std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if kind.is_symlink() {
+        "a symbolic link"
+    } else if kind.is_dir() {
+        "a folder"
+    } else if kind.is_fifo() {
+        "a named pipe"
+    } else if kind.is_socket() {
+        "a socket"
+    } else if kind.is_block_device() || kind.is_char_device() {
+        "a device"
+    } else if kind.is_file() {
+        "a regular file"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// A word from an input file as an error message may show it: quoted when it reads as a number
+/// (digits, sign, point, exponent, or `nan` and `inf`), else only described. Naming the wrong file (a points path
+/// that reaches a system file) then never prints what that file holds.
+pub fn shown(word: &str) -> String {
+    let numeric = !word.is_empty()
+        && word.len() <= 32
+        && (word.parse::<f64>().is_ok()
+            || word
+                .chars()
+                .all(|c| c.is_ascii_digit() || matches!(c, '+' | '-' | '.' | 'e' | 'E')));
+    if numeric {
+        format!("`{word}`")
+    } else {
+        format!("a word of {} characters", word.chars().count())
+    }
 }
 
 /// This host's and process's temporary file for `path`, beside it.
@@ -72,5 +207,70 @@ mod tests {
         std::fs::create_dir(temporary(&p)).unwrap();
         assert!(write_atomic(&p, b"lost").is_err());
         assert_eq!(std::fs::read(&p).unwrap(), b"kept");
+    }
+
+    #[test]
+    fn links_pipes_and_folders_are_refused_as_inputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let (file, link, fifo) = (dir.path().join("f"), dir.path().join("l"), dir.path().join("p"));
+        std::fs::write(&file, b"text").unwrap();
+        std::os::unix::fs::symlink(&file, &link).unwrap();
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        assert_eq!(read_regular_text(&file).unwrap(), "text");
+        let e = read_regular(&link).unwrap_err().to_string();
+        assert!(e.contains("symbolic link"), "{e}");
+        // Refused at once, not blocked on a pipe no one writes.
+        let e = read_regular(&fifo).unwrap_err().to_string();
+        assert!(e.contains("named pipe"), "{e}");
+        let e = read_regular(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("a folder"), "{e}");
+        let e = read_regular(Path::new("/dev/null")).unwrap_err().to_string();
+        assert!(e.contains("device"), "{e}");
+    }
+
+    #[test]
+    fn a_tree_with_a_link_or_pipe_anywhere_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("cache");
+        assert!(check_plain_tree(&root).is_ok(), "a missing tree is plain");
+        std::fs::create_dir_all(root.join("a/b")).unwrap();
+        std::fs::write(root.join("a/b/x"), b"x").unwrap();
+        assert!(check_plain_tree(&root).is_ok());
+        std::os::unix::fs::symlink("/tmp", root.join("a/b/out")).unwrap();
+        let e = check_plain_tree(&root).unwrap_err().to_string();
+        assert!(e.contains("a/b/out") && e.contains("symbolic link"), "{e}");
+        std::fs::remove_file(root.join("a/b/out")).unwrap();
+        assert!(std::process::Command::new("mkfifo")
+            .arg(root.join("a/q"))
+            .status()
+            .unwrap()
+            .success());
+        let e = check_plain_tree(&root).unwrap_err().to_string();
+        assert!(e.contains("a/q") && e.contains("named pipe"), "{e}");
+        // The root itself a link to a folder.
+        let elsewhere = dir.path().join("elsewhere");
+        std::fs::create_dir(&elsewhere).unwrap();
+        std::os::unix::fs::symlink(&elsewhere, dir.path().join("linked")).unwrap();
+        assert!(check_plain_tree(&dir.path().join("linked")).is_err());
+        assert!(check_plain_folder(&dir.path().join("linked")).is_err());
+        assert!(check_plain_folder(&elsewhere).is_ok());
+        assert!(check_plain_folder(&dir.path().join("missing")).is_ok());
+    }
+
+    #[test]
+    fn a_write_replaces_a_planted_link_and_never_follows_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = dir.path().join("outside");
+        std::fs::write(&outside, b"theirs").unwrap();
+        let target = dir.path().join("index.html");
+        std::os::unix::fs::symlink(&outside, &target).unwrap();
+        write_atomic(&target, b"ours").unwrap();
+        assert_eq!(std::fs::read(&outside).unwrap(), b"theirs");
+        assert!(!std::fs::symlink_metadata(&target).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"ours");
     }
 }

@@ -5,21 +5,89 @@
 
 use super::{registered, AccelSettings};
 
-/// Bytes a build may take: what the system says is available to a new process (`MemAvailable`
-/// in /proc/meminfo), or less where the environment's `PENUMBRA_MEMORY_BYTES` says so (a share of
-/// a shared machine); `None` where neither says.
-pub fn available_bytes() -> Option<u64> {
-    let system = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
-        let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
-    });
-    let share = std::env::var("PENUMBRA_MEMORY_BYTES")
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok());
-    match (system, share) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
+/// The memory a process may still take, and the limit that says so.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Budget {
+    /// Bytes a build may take.
+    pub bytes: u64,
+    /// Which limit is the smallest, in words (for refusals).
+    pub limit: &'static str,
+}
+
+impl Budget {
+    /// `bytes` under `limit`.
+    pub fn new(bytes: u64, limit: &'static str) -> Budget {
+        Budget { bytes, limit }
     }
+
+    /// "the 4.0 GB that LIMIT leaves", for refusals.
+    pub fn describe(&self) -> String {
+        format!("the {:.1} GB that {} leaves", self.bytes as f64 / 1e9, self.limit)
+    }
+}
+
+/// The smallest of the limits a build runs into: the memory the system has free
+/// (`MemAvailable` in /proc/meminfo), what the process's address-space limit (`RLIMIT_AS`, as
+/// `ulimit -v` sets it) leaves above what it already maps, what its control group's
+/// `memory.max` leaves above its `memory.current` (cgroup v2: a container's or a batch job's
+/// share), and the environment's `PENUMBRA_MEMORY_BYTES` (a share stated by hand); `None` where
+/// none says. A build past any of them aborts the process, so each is checked before one starts.
+pub fn available() -> Option<Budget> {
+    smallest([
+        mem_available().map(|b| Budget::new(b, "the memory the system has available (MemAvailable)")),
+        address_space_left().map(|b| Budget::new(b, "the address-space limit (RLIMIT_AS, ulimit -v)")),
+        cgroup_left().map(|b| Budget::new(b, "the control group's memory.max")),
+        std::env::var("PENUMBRA_MEMORY_BYTES")
+            .ok()
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .map(|b| Budget::new(b, "PENUMBRA_MEMORY_BYTES")),
+    ])
+}
+
+/// The smallest of the limits that say something.
+fn smallest(limits: [Option<Budget>; 4]) -> Option<Budget> {
+    limits.into_iter().flatten().min_by_key(|b| b.bytes)
+}
+
+/// `MemAvailable` in /proc/meminfo, in bytes.
+fn mem_available() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    kilobytes(&info, "MemAvailable:")
+}
+
+/// The address-space limit less the process's current virtual size (`VmSize`).
+fn address_space_left() -> Option<u64> {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes the limit into the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0 || limit.rlim_cur == libc::RLIM_INFINITY {
+        return None;
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let mapped = kilobytes(&status, "VmSize:").unwrap_or(0);
+    Some(limit.rlim_cur.saturating_sub(mapped))
+}
+
+/// The process's cgroup v2 `memory.max` less its `memory.current`; `None` where it has no
+/// limit ("max") or no cgroup v2.
+fn cgroup_left() -> Option<u64> {
+    let own = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = own.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).ok();
+    let max = read("memory.max")?.trim().parse::<u64>().ok()?;
+    let current = read("memory.current")
+        .and_then(|c| c.trim().parse::<u64>().ok())
+        .unwrap_or(0);
+    Some(max.saturating_sub(current))
+}
+
+/// The number of kilobytes on the line of `text` starting with `key`, in bytes.
+fn kilobytes(text: &str, key: &str) -> Option<u64> {
+    let line = text.lines().find(|l| l.starts_with(key))?;
+    line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kb| kb * 1024)
 }
 
 /// The lower bound on the bytes of `settings`' structure over `triangles` triangles.
@@ -29,16 +97,16 @@ pub fn estimate(settings: &AccelSettings, triangles: usize) -> u64 {
 }
 
 /// Refuses to build `settings`' structure over `triangles` triangles when its lower-bound
-/// estimate exceeds `available` bytes; the message gives both.
-pub fn check(settings: &AccelSettings, triangles: usize, available: Option<u64>) -> Result<(), String> {
+/// estimate exceeds what `available` leaves; the message gives both and names the limit.
+pub fn check(settings: &AccelSettings, triangles: usize, available: Option<Budget>) -> Result<(), String> {
     let need = estimate(settings, triangles);
     match available {
-        Some(free) if need > free => Err(format!(
-            "`{}` ({}) over {triangles} triangles needs at least {:.1} GB, more than the {:.1} GB this machine has available",
+        Some(budget) if need > budget.bytes => Err(format!(
+            "`{}` ({}) over {triangles} triangles needs at least {:.1} GB, more than {}",
             settings.name,
             settings.describe(),
             need as f64 / 1e9,
-            free as f64 / 1e9
+            budget.describe()
         )),
         _ => Ok(()),
     }
@@ -60,14 +128,17 @@ mod tests {
         .unwrap();
         // 8193 directions x 512^2 tile offsets of 4 bytes, held twice while building, and
         // 1000 x 8193 entries of 4 bytes, twice: 17.25 GB.
-        let e = check(&huge, 1000, Some(15 << 30)).unwrap_err();
-        assert!(e.contains("needs at least 17.2 GB") && e.contains("the 16.1 GB"), "{e}");
+        let e = check(&huge, 1000, Some(Budget::new(15 << 30, "a test's limit"))).unwrap_err();
         assert!(
-            check(&huge, 1000, Some(32 << 30)).is_ok(),
+            e.contains("needs at least 17.2 GB") && e.contains("the 16.1 GB that a test's limit leaves"),
+            "{e}"
+        );
+        assert!(
+            check(&huge, 1000, Some(Budget::new(32 << 30, "room"))).is_ok(),
             "a machine with room builds it"
         );
         let small = AccelSettings::named("vlf").unwrap();
-        assert!(check(&small, 1000, Some(1 << 30)).is_ok());
+        assert!(check(&small, 1000, Some(Budget::new(1 << 30, "a GiB"))).is_ok());
         assert!(
             check(&huge, 1000, None).is_ok(),
             "no figure from the system: no refusal"
@@ -76,6 +147,20 @@ mod tests {
         for r in super::super::REGISTRY {
             let s = AccelSettings::default_for(r);
             assert!((r.memory)(2_000_000, &s) > (r.memory)(1000, &s), "{}", r.name);
+        }
+    }
+
+    #[test]
+    fn the_smallest_limit_is_the_budget_and_is_named() {
+        let status = "Name:\tsweep\nVmPeak:\t  200 kB\nVmSize:\t  123 kB\n";
+        assert_eq!(kilobytes(status, "VmSize:"), Some(123 * 1024));
+        assert_eq!(kilobytes(status, "VmRSS:"), None);
+        let (a, b) = (Budget::new(5, "a"), Budget::new(3, "b"));
+        assert_eq!(smallest([Some(a), None, Some(b), None]), Some(b));
+        assert_eq!(smallest([None; 4]), None);
+        // This machine's budget is at most what the system has free.
+        if let (Some(all), Some(free)) = (available(), mem_available()) {
+            assert!(all.bytes <= free);
         }
     }
 }

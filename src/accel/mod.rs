@@ -360,9 +360,39 @@ pub fn build(triangles: &Triangles, settings: &AccelSettings) -> anyhow::Result<
     if triangles.positions.is_empty() {
         return Ok(None);
     }
-    memory::check(settings, triangles.positions.len(), memory::available_bytes()).map_err(anyhow::Error::msg)?;
-    (r.build)(triangles, settings).map(Some)
+    let n = triangles.positions.len();
+    memory::check(settings, n, memory::available()).map_err(anyhow::Error::msg)?;
+    if n < LARGE_BUILD {
+        return (r.build)(triangles, settings).map(Some);
+    }
+    // A build is one call that reports nothing until it returns: say that it started, that it
+    // is still going every PROGRESS_SECONDS, and what it took.
+    tracing::info!("building {} over {n} triangles", r.name);
+    let started = std::time::Instant::now();
+    let (done, waiting) = std::sync::mpsc::channel::<()>();
+    let name = r.name;
+    let watch = std::thread::spawn(move || {
+        while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+            waiting.recv_timeout(std::time::Duration::from_secs(PROGRESS_SECONDS))
+        {
+            tracing::info!(
+                "still building {name} over {n} triangles ({:.0} s so far)",
+                started.elapsed().as_secs_f64()
+            );
+        }
+    });
+    let built = (r.build)(triangles, settings);
+    drop(done);
+    let _ = watch.join();
+    tracing::info!("built {} in {:.1} s", r.name, started.elapsed().as_secs_f64());
+    built.map(Some)
 }
+
+/// Triangle count from which a build says when it starts, how it goes and what it took.
+pub const LARGE_BUILD: usize = 200_000;
+
+/// Seconds between a large build's progress lines.
+const PROGRESS_SECONDS: u64 = 15;
 
 /// An accelerator name as written in a scene file.
 #[derive(Debug, Clone, Deserialize, PartialEq, Eq)]

@@ -1,7 +1,9 @@
 //! `page RESULTS_FOLDER...`: rebuilds each results folder's comparison page (index.html) from
 //! the files in it, without rerunning its experiment: for folders written before pages existed,
 //! or after the page changed. A fresh run writes a richer page (labels, table links, FLIP maps
-//! against each gallery's reference) than one rebuilt from file names.
+//! against each gallery's reference) than one rebuilt from file names. Exit status: 0 done, 2 a
+//! folder refused (no report.md; a link, pipe or device where its files or folders belong; an
+//! unreadable image), 1 else.
 
 use clap::Parser;
 use std::path::PathBuf;
@@ -20,7 +22,12 @@ fn main() -> std::process::ExitCode {
     for dir in &args.folders {
         if let Err(e) = penumbra::output::page::rebuild(dir) {
             eprintln!("error: {e:#}");
-            return std::process::ExitCode::FAILURE;
+            // A folder whose files cannot be taken as they are is bad input (status 2).
+            return if e.is::<penumbra::files::Refused>() {
+                std::process::ExitCode::from(2)
+            } else {
+                std::process::ExitCode::FAILURE
+            };
         }
         println!("wrote {}", dir.join("index.html").display());
     }

@@ -8,7 +8,8 @@ use super::manifest::{peak_rss, utc, Build, Input, Machine, Manifest, RunInfo, S
 use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
 use super::sweep::merge::MergeRefused;
-use super::{load, Finished, Run};
+use super::{load, Experiment, Finished, Run};
+use crate::render::gpu::gpu_gap;
 use crate::render::{cpu::CpuBackend, open_backend, Backend, BackendChoice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -36,6 +37,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         ))
         .into());
     }
+    let choice = backend_for(experiment.as_ref(), choice)?;
     let mut inputs = Vec::new();
     for path in experiment.inputs() {
         inputs.push(Input::read(&path).map_err(|e| BadInput(format!("{}: cannot read: {e}", path.display())))?);
@@ -56,7 +58,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         .map(|p| p.to_path_buf())
         .collect();
     let home = resolve_home(&out).map_err(BadInput)?;
-    let result = run_into(experiment.as_ref(), cli, &home, started, started_utc, inputs);
+    let result = run_into(experiment.as_ref(), cli, choice, &home, started, started_utc, inputs);
     if result.is_err() {
         for p in &made {
             let _ = std::fs::remove_dir(p);
@@ -69,6 +71,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
 fn run_into(
     experiment: &dyn super::Experiment,
     cli: &Cli,
+    choice: BackendChoice,
     home: &std::path::Path,
     started: Instant,
     started_utc: String,
@@ -77,7 +80,6 @@ fn run_into(
     let header = experiment.header().clone();
     let kind = header.kind.name();
     let accepts = experiment.accepts();
-    let choice = cli.backend.or(header.backend).unwrap_or(BackendChoice::Auto);
     check_home(home, kind, &header.name, &cli.experiment, cli.fresh).map_err(BadInput)?;
     let out = Outputs::begin(home).map_err(|e| BadInput(format!("{e:#}")))?;
     let mut backend: Box<dyn Backend> = if accepts.gpu {
@@ -141,11 +143,36 @@ fn run_into(
     }
 }
 
+/// The backend a run opens: `choice`, except that `auto` takes the f64 CPU backend where a scene
+/// asks for something the GPU has no kernel for (and says so), and `gpu` for such a scene is
+/// refused before any work, naming the scene file and key.
+fn backend_for(experiment: &dyn Experiment, choice: BackendChoice) -> Result<BackendChoice, BadInput> {
+    let gap = experiment
+        .scenes()
+        .into_iter()
+        .find_map(|(path, scene)| gpu_gap(scene).map(|gap| (path, gap)));
+    Ok(match (choice, gap) {
+        (BackendChoice::Gpu, Some((path, gap))) => {
+            return Err(BadInput(format!(
+                "{}: {gap}; --backend gpu (or backend = \"gpu\") cannot render this scene: use backend = \"cpu\" or \"auto\"",
+                path.display()
+            )))
+        }
+        (BackendChoice::Auto, Some((path, gap))) => {
+            info!("backend auto: the f64 CPU backend, because {}: {gap}", path.display());
+            BackendChoice::Cpu
+        }
+        (choice, _) => choice,
+    })
+}
+
 /// The exit status of an outcome: 0 done, 2 bad input, 3 runs failed, 4 merge refused, 1 else.
 pub fn exit_status(result: &anyhow::Result<()>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.is::<BadInput>() || e.is::<crate::config::ConfigError>() => ExitCode::from(2),
+        Err(e) if e.is::<BadInput>() || e.is::<crate::config::ConfigError>() || e.is::<crate::files::Refused>() => {
+            ExitCode::from(2)
+        }
         Err(e) if e.is::<RunsFailed>() => ExitCode::from(3),
         Err(e) if e.is::<MergeRefused>() => ExitCode::from(4),
         Err(_) => ExitCode::from(1),

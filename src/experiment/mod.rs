@@ -86,6 +86,13 @@ pub trait Experiment {
     /// Every file it read (experiment, scenes, meshes), hashed into the manifest.
     fn inputs(&self) -> Vec<PathBuf>;
 
+    /// The scenes it renders, each with the file it was read from: the driver checks them
+    /// against the GPU's kernels before it chooses a backend. Kinds that render on the CPU
+    /// only list none.
+    fn scenes(&self) -> Vec<(&Path, &crate::scene::Scene)> {
+        Vec::new()
+    }
+
     /// What `--dry-run` prints: every unit and its render plan.
     fn dry_run(&self, cli: &Cli) -> anyhow::Result<String>;
 

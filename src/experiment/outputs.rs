@@ -9,6 +9,7 @@
 //! [`Outputs::path`], which refuses anything that would leave the staging folder. The other
 //! outputs have fixed names.
 
+use crate::files::{check_plain_folder, check_plain_tree};
 use anyhow::{bail, Context};
 use std::fs::File;
 use std::os::unix::fs::MetadataExt;
@@ -85,7 +86,9 @@ impl Outputs {
     /// A fresh staging folder for `home` (a folder [`resolve_home`] gave: `.NAME.staging.HOST.PID`
     /// beside it), with `home` locked against other runs; staging folders that killed runs of
     /// this host left behind are removed, after the state they were carrying over ([`KEPT`]) is
-    /// moved back into `home` where `home` lacks it.
+    /// moved back into `home` where `home` lacks it. Kept state holding a symbolic link or a
+    /// special file, and a link or file named like a staging folder, are refused with their path
+    /// before anything is moved or removed.
     pub fn begin(home: &Path) -> anyhow::Result<Outputs> {
         let lock = lock(home)?;
         let name = home
@@ -98,27 +101,42 @@ impl Outputs {
             .unwrap_or(Path::new("."));
         std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
         let prefix = format!(".{name}.staging.{}.", host());
+        // Links and special files among the kept state would lead writes (the journal, a
+        // cached ground truth) or reads outside the folder: refused before anything moves.
+        for kept in KEPT {
+            check_plain_tree(&home.join(kept))?;
+        }
+        let mut dead = Vec::new();
         if let Ok(entries) = std::fs::read_dir(parent) {
             for e in entries.flatten() {
                 let n = e.file_name().to_string_lossy().into_owned();
-                let dead = n
+                let is_dead = n
                     .strip_prefix(&prefix)
                     .and_then(|pid| pid.parse::<u32>().ok())
                     .is_some_and(|pid| pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists());
-                if dead {
+                if is_dead {
+                    // Named like a killed run's staging folder: it must be one (a folder, its
+                    // kept state plain), or the cleanup would follow a planted link.
+                    check_plain_folder(&e.path())?;
                     for kept in KEPT {
-                        let (from, to) = (e.path().join(kept), home.join(kept));
-                        if from.exists() && !to.exists() {
-                            let _ = std::fs::create_dir_all(home);
-                            let _ = std::fs::rename(&from, &to);
-                        }
+                        check_plain_tree(&e.path().join(kept))?;
                     }
-                    let _ = std::fs::remove_dir_all(e.path());
+                    dead.push(e.path());
                 }
             }
         }
+        for d in dead {
+            for kept in KEPT {
+                let (from, to) = (d.join(kept), home.join(kept));
+                if from.exists() && std::fs::symlink_metadata(&to).is_err() {
+                    let _ = std::fs::rename(&from, &to);
+                }
+            }
+            let _ = std::fs::remove_dir_all(&d);
+        }
         let staging = parent.join(format!("{prefix}{}", std::process::id()));
-        if staging.exists() {
+        if std::fs::symlink_metadata(&staging).is_ok() {
+            check_plain_folder(&staging)?;
             std::fs::remove_dir_all(&staging).with_context(|| format!("clearing {}", staging.display()))?;
         }
         std::fs::create_dir(&staging).with_context(|| format!("creating {}", staging.display()))?;
@@ -246,7 +264,7 @@ pub fn check_home(home: &Path, kind: &str, name: &str, experiment: &Path, fresh:
         return Ok(());
     }
     let manifest = home.join("manifest.toml");
-    let Some(table) = std::fs::read_to_string(&manifest)
+    let Some(table) = crate::files::read_regular_text(&manifest)
         .ok()
         .and_then(|t| t.parse::<toml::Table>().ok())
     else {
@@ -313,6 +331,45 @@ mod tests {
         assert!(!dead.exists());
         assert_eq!(std::fs::read(home.join(".journal/groups.csv")).unwrap(), b"journaled");
         drop(out);
+    }
+
+    #[test]
+    fn planted_links_are_refused_and_nothing_outside_moves() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(&home).unwrap();
+        // A foreign folder holding what a staging folder would carry, and a link to it named
+        // like a killed run's staging folder.
+        let foreign = dir.path().join("foreign");
+        std::fs::create_dir_all(foreign.join(".journal")).unwrap();
+        std::fs::create_dir_all(foreign.join("cache")).unwrap();
+        std::fs::write(foreign.join(".journal/groups.csv"), b"theirs").unwrap();
+        let planted = dir.path().join(format!(".r.staging.{}.{}", host(), u32::MAX - 1));
+        std::os::unix::fs::symlink(&foreign, &planted).unwrap();
+        let e = Outputs::begin(&home).unwrap_err().to_string();
+        assert!(
+            e.contains(&planted.display().to_string()) && e.contains("symbolic link"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read(foreign.join(".journal/groups.csv")).unwrap(), b"theirs");
+        assert!(foreign.join("cache").is_dir() && !home.join(".journal").exists());
+        std::fs::remove_file(&planted).unwrap();
+        // Kept state that is a link, or holds one, or a pipe.
+        std::os::unix::fs::symlink(&foreign, home.join("cache")).unwrap();
+        let e = Outputs::begin(&home).unwrap_err().to_string();
+        assert!(e.contains("r/cache") && e.contains("symbolic link"), "{e}");
+        std::fs::remove_file(home.join("cache")).unwrap();
+        std::fs::create_dir_all(home.join("shards/1-of-2/.journal")).unwrap();
+        std::os::unix::fs::symlink(
+            foreign.join(".journal/groups.csv"),
+            home.join("shards/1-of-2/.journal/groups.csv"),
+        )
+        .unwrap();
+        let e = Outputs::begin(&home).unwrap_err().to_string();
+        assert!(e.contains("groups.csv"), "{e}");
+        std::fs::remove_file(home.join("shards/1-of-2/.journal/groups.csv")).unwrap();
+        assert!(Outputs::begin(&home).is_ok(), "plain state is accepted");
+        assert_eq!(std::fs::read(foreign.join(".journal/groups.csv")).unwrap(), b"theirs");
     }
 
     #[test]

@@ -117,20 +117,159 @@ pub const MAX_COORDINATE: f64 = 1e7;
 /// A vertex coordinate read from `word`, or why not (`inf` and `nan` pass: such triangles are
 /// dropped and counted later).
 pub fn coordinate(word: &str) -> Result<f64, String> {
-    let c: f64 = word.parse().map_err(|_| format!("bad vertex coordinate `{word}`"))?;
+    let c: f64 = word
+        .parse()
+        .map_err(|_| format!("bad vertex coordinate: {}", crate::files::shown(word)))?;
     if c.is_finite() && c.abs() > MAX_COORDINATE {
         return Err(format!("vertex coordinate {c:e} beyond +-{MAX_COORDINATE:e}"));
     }
     Ok(c)
 }
 
-/// Refuses a face of `corners` corners that would take the file past [`MAX_FILE_TRIANGLES`]
-/// when `stored` triangles are already kept.
-pub fn fan_fits(stored: usize, corners: usize) -> Result<(), String> {
+/// Most corners one face may have. A polygon of more is no modelled surface (a cylinder cap of
+/// 65,536 segments is already far below a pixel), and a face of a million corners, a few
+/// megabytes of text, would become a million overlapping triangles.
+pub const MAX_FACE_CORNERS: usize = 1 << 16;
+
+/// Refuses a face of `corners` corners: more than [`MAX_FACE_CORNERS`], or one that would take
+/// the file past [`MAX_FILE_TRIANGLES`] when `stored` triangles are already kept.
+pub fn face_fits(stored: usize, corners: usize) -> Result<(), String> {
+    if corners > MAX_FACE_CORNERS {
+        return Err(format!(
+            "a face of {corners} corners; a face may have at most {MAX_FACE_CORNERS} (split it into smaller polygons)"
+        ));
+    }
     if stored + corners.saturating_sub(2) > MAX_FILE_TRIANGLES {
         return Err(format!(
-            "this face takes the file past {MAX_FILE_TRIANGLES} triangles (polygons count as fans of corners - 2)"
+            "this face takes the file past {MAX_FILE_TRIANGLES} triangles (a polygon counts as its corners - 2)"
         ));
     }
     Ok(())
+}
+
+impl MeshFile {
+    /// Appends the triangles of the planar convex polygon `face` (3 corners or more, in order),
+    /// in group `group`. Triangles and quads are fanned from the first corner, as every format
+    /// reader does. A larger polygon is split by diagonals halving its corner range, so its
+    /// triangles stay compact (a fan's are slivers all meeting at one corner, whose overlapping
+    /// boxes no tree separates), and a triangle the face already gave with the same corners
+    /// (a polygon that lists its corners over and over) is kept once.
+    pub fn push_face(&mut self, face: &[[f64; 3]], group: u32) {
+        let n = face.len();
+        if n <= 4 {
+            for k in 1..n.saturating_sub(1) {
+                self.triangles.push([face[0], face[k], face[k + 1]]);
+                self.group_of.push(group);
+            }
+            return;
+        }
+        let key = |t: &[[f64; 3]; 3]| {
+            let mut k = t.map(|p| p.map(f64::to_bits));
+            k.sort_unstable();
+            k
+        };
+        let mut seen = std::collections::HashSet::new();
+        // Each range (a, b) is the sub-polygon a, a + 1, .., b closed by the diagonal b -> a.
+        let mut ranges = vec![(0, n - 1)];
+        while let Some((a, b)) = ranges.pop() {
+            if b - a < 2 {
+                continue;
+            }
+            let m = (a + b) / 2;
+            let t = [face[a], face[m], face[b]];
+            if seen.insert(key(&t)) {
+                self.triangles.push(t);
+                self.group_of.push(group);
+            }
+            ranges.push((m, b));
+            ranges.push((a, m));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(t: &[[f64; 3]; 3]) -> f64 {
+        let (a, b, c) = (t[0], t[1], t[2]);
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+        0.5 * (u[0] * v[1] - u[1] * v[0])
+    }
+
+    fn circle(n: usize) -> Vec<[f64; 3]> {
+        (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn triangles_and_quads_are_fanned_from_the_first_corner() {
+        let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let mut m = MeshFile::default();
+        m.push_face(&quad[..3], 7);
+        m.push_face(&quad, 7);
+        assert_eq!(
+            m.triangles,
+            vec![
+                [quad[0], quad[1], quad[2]],
+                [quad[0], quad[1], quad[2]],
+                [quad[0], quad[2], quad[3]]
+            ]
+        );
+        assert_eq!(m.group_of, vec![7; 3]);
+    }
+
+    #[test]
+    fn a_large_polygon_is_covered_once_by_compact_triangles() {
+        for n in [5, 6, 7, 64, 1000, MAX_FACE_CORNERS] {
+            let face = circle(n);
+            let mut m = MeshFile::default();
+            m.push_face(&face, 0);
+            assert_eq!(m.triangles.len(), n - 2, "n = {n}");
+            // Every triangle counter-clockwise (no fold) and the areas add up to the polygon's.
+            let exact = 0.5 * n as f64 * (std::f64::consts::TAU / n as f64).sin();
+            let total: f64 = m.triangles.iter().map(area).sum();
+            assert!(m.triangles.iter().all(|t| area(t) > 0.0), "n = {n}");
+            assert!((total - exact).abs() < 1e-9 * exact, "n = {n}: {total} vs {exact}");
+            // No sliver spans the polygon the way a fan's do: the mean edge is far below its
+            // diameter (a fan's mean edge is about 1.3 diameters / 2).
+            let edge = |t: &[[f64; 3]; 3]| {
+                (0..3)
+                    .map(|i| {
+                        let (p, q) = (t[i], t[(i + 1) % 3]);
+                        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+                    })
+                    .sum::<f64>()
+                    / 3.0
+            };
+            let mean = m.triangles.iter().map(edge).sum::<f64>() / m.triangles.len() as f64;
+            if n >= 1000 {
+                assert!(mean < 0.1, "n = {n}: mean edge {mean}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_polygon_repeating_its_corners_gives_each_triangle_once() {
+        let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        let face: Vec<[f64; 3]> = (0..MAX_FACE_CORNERS).map(|k| quad[k % 4]).collect();
+        let mut m = MeshFile::default();
+        m.push_face(&face, 0);
+        // At most one triangle per multiset of 3 of the 4 points: C(4 + 2, 3) = 20.
+        assert!(m.triangles.len() <= 20, "{} triangles", m.triangles.len());
+    }
+
+    #[test]
+    fn faces_past_the_corner_or_file_limits_are_refused() {
+        assert!(face_fits(0, MAX_FACE_CORNERS).is_ok());
+        let e = face_fits(0, MAX_FACE_CORNERS + 1).unwrap_err();
+        assert!(e.contains("65537 corners"), "{e}");
+        let e = face_fits(MAX_FILE_TRIANGLES - 2, 5).unwrap_err();
+        assert!(e.contains("past 16777216 triangles"), "{e}");
+        assert!(face_fits(MAX_FILE_TRIANGLES - 3, 5).is_ok());
+    }
 }

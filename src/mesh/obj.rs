@@ -1,9 +1,9 @@
 //! A Wavefront OBJ reader for triangle meshes: `v` positions, `f` faces (any of the `v`,
 //! `v/vt`, `v//vn`, `v/vt/vn` forms, negative indices relative to the end), `g`/`o` groups.
-//! Polygons are split into triangle fans. Everything else (normals, texture coordinates,
+//! Polygons are split into triangles ([`MeshFile::push_face`]). Everything else (normals, texture coordinates,
 //! materials) is ignored. Errors name the file and line.
 
-use super::file::{coordinate, fan_fits, MeshFile, MeshFileError};
+use super::file::{coordinate, face_fits, MeshFile, MeshFileError, MAX_FACE_CORNERS};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -37,7 +37,9 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                 let mut corners = Vec::new();
                 for w in words {
                     let idx = w.split('/').next().unwrap_or("");
-                    let k: i64 = idx.parse().map_err(|_| err(line_no, format!("bad face index `{w}`")))?;
+                    let k: i64 = idx
+                        .parse()
+                        .map_err(|_| err(line_no, format!("bad face index: {}", crate::files::shown(w))))?;
                     let n = positions.len() as i64;
                     let resolved = if k > 0 { k - 1 } else { n + k };
                     if k == 0 || resolved < 0 || resolved >= n {
@@ -47,6 +49,9 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                         ));
                     }
                     corners.push(positions[resolved as usize]);
+                    if corners.len() > MAX_FACE_CORNERS {
+                        break;
+                    }
                 }
                 if corners.len() < 3 {
                     return Err(err(
@@ -54,15 +59,18 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                         format!("a face needs at least 3 vertices, got {}", corners.len()),
                     ));
                 }
-                fan_fits(mesh.triangles.len(), corners.len()).map_err(|e| err(line_no, e))?;
+                if corners.len() > MAX_FACE_CORNERS {
+                    return Err(err(
+                        line_no,
+                        format!("a face of more than {MAX_FACE_CORNERS} corners; split it into smaller polygons"),
+                    ));
+                }
+                face_fits(mesh.triangles.len(), corners.len()).map_err(|e| err(line_no, e))?;
                 let g = match group {
                     Some(g) => g,
                     None => *group.insert(id_of(&mut mesh, &mut group_ids, "default".into())),
                 };
-                for k in 1..corners.len() - 1 {
-                    mesh.triangles.push([corners[0], corners[k], corners[k + 1]]);
-                    mesh.group_of.push(g);
-                }
+                mesh.push_face(&corners, g);
             }
             Some("g") | Some("o") => {
                 let name = words.collect::<Vec<_>>().join(" ");

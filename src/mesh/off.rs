@@ -1,10 +1,10 @@
 //! An Object File Format (OFF) reader: the `OFF` header, `vertices faces edges`, then vertex
 //! positions and faces as `n i0 .. i(n-1)` with zero-based indices. Colours after a vertex's
 //! three coordinates or a face's indices are ignored; `#` starts a comment. Polygons are split
-//! into triangle fans. OFF has no groups: every face is in group `default`. Errors name the file
+//! into triangles ([`MeshFile::push_face`]). OFF has no groups: every face is in group `default`. Errors name the file
 //! and line.
 
-use super::file::{coordinate, fan_fits, MeshFile, MeshFileError};
+use super::file::{coordinate, face_fits, MeshFile, MeshFileError};
 use std::path::Path;
 
 /// Parses OFF text; `file` is only used in errors.
@@ -27,7 +27,10 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
     if words.first() != Some(&"OFF") {
         return Err(err(
             header_line,
-            format!("expected `OFF`, got `{}`", words.first().unwrap_or(&"")),
+            format!(
+                "expected `OFF`, got {}",
+                crate::files::shown(words.first().unwrap_or(&""))
+            ),
         ));
     }
     words.remove(0);
@@ -44,7 +47,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
             .get(k)
             .ok_or_else(|| err(counts_line, format!("missing the {what} count")))?;
         w.parse()
-            .map_err(|_| err(counts_line, format!("bad {what} count `{w}`")))
+            .map_err(|_| err(counts_line, format!("bad {what} count: {}", crate::files::shown(w))))
     };
     let (n_vertices, n_faces) = (count(0, "vertex")?, count(1, "face")?);
     // No more vertices than lines: a header's count sizes nothing by itself.
@@ -71,11 +74,13 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
             .ok_or_else(|| err(last_line, format!("file ends after {k} of {n_faces} faces")))?;
         let mut ws = l.split_whitespace();
         let w = ws.next().unwrap_or("");
-        let corners: usize = w.parse().map_err(|_| err(n, format!("bad face vertex count `{w}`")))?;
+        let corners: usize = w
+            .parse()
+            .map_err(|_| err(n, format!("bad face vertex count: {}", crate::files::shown(w))))?;
         if corners < 3 {
             return Err(err(n, format!("a face needs at least 3 vertices, got {corners}")));
         }
-        fan_fits(mesh.triangles.len(), corners).map_err(|e| err(n, e))?;
+        face_fits(mesh.triangles.len(), corners).map_err(|e| err(n, e))?;
         // The count is checked against the words on the line before anything is sized by it.
         let listed: Vec<&str> = ws.collect();
         if listed.len() < corners {
@@ -83,16 +88,15 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
         }
         let mut face = Vec::with_capacity(corners);
         for &w in &listed[..corners] {
-            let i: usize = w.parse().map_err(|_| err(n, format!("bad face index `{w}`")))?;
+            let i: usize = w
+                .parse()
+                .map_err(|_| err(n, format!("bad face index: {}", crate::files::shown(w))))?;
             let p = positions
                 .get(i)
                 .ok_or_else(|| err(n, format!("face index {i} refers to no vertex ({n_vertices} defined)")))?;
             face.push(*p);
         }
-        for c in 1..corners - 1 {
-            mesh.triangles.push([face[0], face[c], face[c + 1]]);
-            mesh.group_of.push(0);
-        }
+        mesh.push_face(&face, 0);
     }
     Ok(mesh)
 }
@@ -126,16 +130,21 @@ mod tests {
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", 6, "at least 3"),
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", 6, "fewer than"),
             ("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 6, "after 1 of 2 faces"),
-            // Corner counts no file may fan out into: refused, never allocated.
+            // Corner counts no face may have: refused, never allocated.
             (
                 "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n18446744073709551615 0 1 2\n",
                 6,
-                "past 16777216 triangles",
+                "at most 65536",
             ),
             (
                 "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n100000000000 0 1 2\n",
                 6,
-                "past 16777216",
+                "at most 65536",
+            ),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n65537 0 1 2\n",
+                6,
+                "a face of 65537 corners",
             ),
             // Within the budget but longer than its line.
             ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000 0 1 2\n", 6, "fewer than"),

@@ -6,8 +6,7 @@ use crate::scene::{Light, Scene};
 use serde::Serialize;
 use std::fmt;
 
-/// Lights a frame may hold (ray counters are sized for this).
-pub const MAX_LIGHTS: usize = 8;
+pub use crate::scene::MAX_LIGHTS;
 
 /// One pass of the plan.
 #[derive(Clone, Debug, PartialEq, Serialize)]

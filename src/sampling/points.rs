@@ -178,17 +178,19 @@ fn read_pairs(file: &Path) -> Result<Pairs, ConfigError> {
             return Err(at_line(
                 file,
                 i + 1,
-                format!("expected two numbers, got {} value(s): `{line}`", tokens.len()),
+                format!("expected two numbers, got {} value(s)", tokens.len()),
             ));
         }
         let mut v = [0.0; 2];
         let texts = [tokens[0].to_string(), tokens[1].to_string()];
         for (slot, t) in v.iter_mut().zip(&tokens) {
-            *slot = t
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| at_line(file, i + 1, format!("`{t}` is not a finite number")))?;
+            *slot = t.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| {
+                at_line(
+                    file,
+                    i + 1,
+                    format!("{} is not a finite number", crate::files::shown(t)),
+                )
+            })?;
         }
         pairs.push(Pair {
             line: i + 1,

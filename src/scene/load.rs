@@ -102,6 +102,16 @@ impl Scene {
                 albedo: v.albedo(p.albedo, &key_path!["planes", i, "albedo"])?,
             });
         }
+        if file.lights.len() > super::MAX_LIGHTS {
+            return Err(source.error(
+                &key_path!["lights", super::MAX_LIGHTS],
+                format!(
+                    "{} lights listed; a scene may hold at most {}",
+                    file.lights.len(),
+                    super::MAX_LIGHTS
+                ),
+            ));
+        }
         let mut lights = Vec::new();
         for (i, l) in file.lights.iter().enumerate() {
             let at = |k: &str| key_path!["lights", i, k];

@@ -99,6 +99,10 @@ pub struct Scene {
     pub shading: Shading,
 }
 
+/// Lights a scene may hold: the renderers' per-light ray counters and the GPU's light buffer are
+/// sized for this, so a scene file with more is refused where it lists them.
+pub const MAX_LIGHTS: usize = 8;
+
 /// The light transport a scene asks for (the visibility-field paper's two shadings, Section 6):
 /// OpenGL-like is `shadows = false` (local diffuse shading from every light, no rays beyond the
 /// camera's); Whitted is `mirror_depth > 0` (mirror reflections from meshes that declare a mirror

@@ -110,6 +110,8 @@ struct Case {
     args: Vec<&'static str>,
     env: Vec<(&'static str, &'static str)>,
     names: Vec<&'static str>,
+    /// Words that must not appear in the message (the contents of a file the user did not mean).
+    hidden: Vec<&'static str>,
 }
 
 fn case(what: &'static str, name: &'static str, text: String, names: &[&'static str]) -> Case {
@@ -121,6 +123,7 @@ fn case(what: &'static str, name: &'static str, text: String, names: &[&'static 
         args: vec![],
         env: vec![],
         names: names.to_vec(),
+        hidden: vec![],
     }
 }
 
@@ -134,6 +137,45 @@ fn without_table(text: &str, header: &str) -> String {
 
 /// Contents that make a case's file a named pipe (reading one would block for ever).
 const FIFO: &[u8] = b"<fifo>";
+
+/// Contents that make a case's file a symbolic link to the path after the marker (relative to
+/// the working folder).
+const LINK: &str = "<link>";
+
+/// A case file that is a symbolic link to `target`.
+fn link(target: &str) -> Vec<u8> {
+    format!("{LINK}{target}").into_bytes()
+}
+
+/// Makes a case's file under `work`: a pipe, a link, or the bytes (parents created).
+fn plant(work: &Path, file: &str, bytes: &[u8]) {
+    let path = work.join(file);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    if bytes == FIFO {
+        let made = Command::new("mkfifo").arg(&path).status().unwrap();
+        assert!(made.success(), "mkfifo");
+    } else if let Some(target) = bytes.strip_prefix(LINK.as_bytes()) {
+        std::os::unix::fs::symlink(work.join(std::str::from_utf8(target).unwrap()), &path).unwrap();
+    } else {
+        std::fs::write(&path, bytes).unwrap();
+    }
+}
+
+/// The name of a staging folder a killed run of `name` on this host would have left.
+fn dead_staging(name: &str) -> &'static str {
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
+    Box::leak(format!("results/.{name}.staging.{}.{}", host.trim(), u32::MAX - 1).into_boxed_str())
+}
+
+/// An OBJ file of three vertices and one face listing them `corners` times over.
+fn obj_face_of(corners: usize) -> Vec<u8> {
+    let mut text = String::from("v 0 0 0.5\nv 0.1 0 0.5\nv 0 0.1 0.5\nf");
+    for k in 0..corners {
+        text.push_str([" 1", " 2", " 3"][k % 3]);
+    }
+    text.push('\n');
+    text.into_bytes()
+}
 
 /// An OFF file whose one face claims `corners` corners.
 fn off_claiming(corners: &str) -> Vec<u8> {
@@ -225,7 +267,7 @@ fn cases() -> Vec<Case> {
                 "\"bad.off\"",
                 1,
             ),
-            &["bad.off:6", "meshes[0].path", "past 16777216 triangles"],
+            &["bad.off:6", "meshes[0].path", "at most 65536"],
         );
         c.files.push(("bad.off", off_claiming(corners)));
         v.push(c);
@@ -356,14 +398,14 @@ fn cases() -> Vec<Case> {
         &["exp.toml", "key `sweep`", "runs"],
     ));
     let mut c = case(
-        "an OFF face fanning out to 17 million triangles",
+        "an OFF face of 17 million corners",
         "ao-ci",
         ao.replacen(
             &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
             "\"bad.off\"",
             1,
         ),
-        &["bad.off:6", "meshes[0].path", "triangles"],
+        &["bad.off:6", "meshes[0].path", "corners"],
     );
     c.files.push(("bad.off", off_claiming("17000000")));
     v.push(c);
@@ -529,6 +571,163 @@ fn cases() -> Vec<Case> {
     );
     c.files = files;
     v.push(c);
+    // Links planted in a results folder: refused with their path, nothing followed or moved.
+    for (what, planted, target, names) in [
+        (
+            "a link named like a killed run's staging folder",
+            dead_staging("tiny"),
+            "elsewhere",
+            vec![".tiny.staging.", "symbolic link"],
+        ),
+        (
+            "a results folder's cache that is a link",
+            "results/tiny/cache",
+            "elsewhere",
+            vec!["results/tiny/cache", "symbolic link"],
+        ),
+        (
+            "a results folder's journal that is a link",
+            "results/tiny/.journal",
+            "elsewhere/.journal",
+            vec!["results/tiny/.journal", "symbolic link"],
+        ),
+        (
+            "a journal file inside a shard that is a link",
+            "results/tiny/shards/1-of-2/.journal/groups.csv",
+            "elsewhere/.journal/groups.csv",
+            vec!["shards/1-of-2/.journal/groups.csv", "symbolic link"],
+        ),
+    ] {
+        let mut c = case(what, "tiny", sweep.clone(), &names);
+        c.files = vec![
+            ("elsewhere/.journal/groups.csv", b"theirs\n".to_vec()),
+            ("elsewhere/cache/ground-truth-0000000000000000.bin", b"theirs".to_vec()),
+            (planted, link(target)),
+        ];
+        v.push(c);
+    }
+    let mut c = case(
+        "a pipe in a results folder's cache",
+        "tiny",
+        sweep.clone(),
+        &["results/tiny/cache/ground-truth-0000000000000000.bin", "named pipe"],
+    );
+    c.files = vec![("results/tiny/cache/ground-truth-0000000000000000.bin", FIFO.to_vec())];
+    v.push(c);
+    // A face of a million corners: refused at its line, at once.
+    let with_mesh = |file: &str| {
+        ao.replacen(
+            &format!("\"{}/meshes/cow.off\"", common::repo("assets").display()),
+            &format!("\"{file}\""),
+            1,
+        )
+    };
+    let mut c = case(
+        "an OBJ face of a million corners",
+        "ao-ci",
+        with_mesh("huge.obj"),
+        &["huge.obj:4", "meshes[0].path", "more than 65536 corners"],
+    );
+    c.files.push(("huge.obj", obj_face_of(1_000_000)));
+    v.push(c);
+    let mut c = case(
+        "an OFF face of a million corners",
+        "ao-ci",
+        with_mesh("huge.off"),
+        &["huge.off:6", "meshes[0].path", "a face of 1000000 corners"],
+    );
+    let listed: String = (0..1_000_000).map(|k| [" 0", " 1", " 2"][k % 3]).collect();
+    c.files.push((
+        "huge.off",
+        format!("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000000{listed}\n").into_bytes(),
+    ));
+    v.push(c);
+    // Limits of the scene checked with the scene, before a backend opens.
+    let nine_lights = |t: String| {
+        let light = &t[t.find("[[lights]]").unwrap()..];
+        format!("{t}{}", format!("\n{light}").repeat(8))
+    };
+    let (text, files) = with_scene(&nine_lights);
+    let mut c = case(
+        "a sweep scene with nine lights",
+        "tiny",
+        text,
+        &["s.toml", "lights[8]", "at most 8"],
+    );
+    c.files = files;
+    v.push(c);
+    let mut c = case(
+        "an fps scene with nine lights",
+        "fps",
+        fps.replacen(
+            &format!(
+                "\"{}/sphere-two-lights.toml\"",
+                common::repo("experiments/scenes").display()
+            ),
+            "\"s.toml\"",
+            1,
+        ),
+        &["s.toml", "lights[8]", "at most 8"],
+    );
+    c.files = vec![("s.toml", scene_edit(nine_lights).into_bytes())];
+    v.push(c);
+    // What the GPU has no kernel for, asked of the GPU by name.
+    for (what, edit, key) in [
+        (
+            "OpenGL-like shading on --backend gpu",
+            Box::new(|t: String| format!("{t}\n[shading]\nshadows = false\n")) as Box<dyn Fn(String) -> String>,
+            "shading.shadows",
+        ),
+        (
+            "Whitted mirror chains on --backend gpu",
+            Box::new(|t: String| {
+                format!("{t}\n[shading]\nmirror_depth = 2\n\n[[meshes]]\npath = \"tri.obj\"\nmirror = 0.5\n")
+            }),
+            "shading.mirror_depth",
+        ),
+        (
+            "a mirror material on --backend gpu",
+            Box::new(|t: String| format!("{t}\n[[meshes]]\npath = \"tri.obj\"\nmirror = 0.5\n")),
+            "meshes[0].mirror",
+        ),
+    ] {
+        let (text, mut files) = with_scene(&*edit);
+        files.push(("tri.obj", b"v 0 0 0.5\nv 0.1 0 0.5\nv 0 0.1 0.5\nf 1 2 3\n".to_vec()));
+        let mut c = case(what, "tiny", text, &["s.toml", key, "--backend gpu"]);
+        c.files = files;
+        c.args = vec!["--backend", "gpu"];
+        v.push(c);
+    }
+    // A points path that reaches a file the user did not mean: named, its contents not shown.
+    let mut c = case(
+        "a points path reaching another file",
+        "tiny",
+        sweep.replace(
+            "schemes = [\"uniform\", \"paper\"]",
+            "schemes = [\"uniform\", \"points:p\"]",
+        ) + "\n[points.p]\npath = \"../../secret\"\n",
+        &["secret:1", "two numbers"],
+    );
+    c.files = vec![(
+        "../../secret",
+        b"someone:x:1000:1000:hidden-word:/home/someone\n".to_vec(),
+    )];
+    c.hidden = vec!["someone", "hidden-word"];
+    v.push(c);
+    v.push(case(
+        "a viewpoint listed twice",
+        "frames-ci",
+        frames
+            .replace(
+                "generator = \"classroom\"",
+                "generator = \"random-triangles\"\ntriangles = [1000]",
+            )
+            .replace(
+                "[path]\nframes = 3",
+                "[path]\nframes = 3\nviewpoints = [\"outside\", \"outside\"]",
+            ),
+        &["exp.toml", "path.viewpoints[1]", "twice"],
+    ));
     v.push(case(
         "an experiment file that is a device",
         "tiny",
@@ -546,12 +745,7 @@ fn every_hostile_input_is_refused_with_its_place_and_nothing_written() {
     for c in &all {
         let s = Scratch::new(&c.text, c.name);
         for (file, bytes) in &c.files {
-            if bytes == FIFO {
-                let made = Command::new("mkfifo").arg(s.work.join(file)).status().unwrap();
-                assert!(made.success(), "mkfifo");
-            } else {
-                std::fs::write(s.work.join(file), bytes).unwrap();
-            }
+            plant(&s.work, file, bytes);
         }
         let before = snapshot(&s.root);
         let mut args = vec![if c.what == "an experiment file that is a device" {
@@ -571,6 +765,11 @@ fn every_hostile_input_is_refused_with_its_place_and_nothing_written() {
         for n in &c.names {
             if !stderr.contains(n) {
                 wrong.push(format!("does not name `{n}`"));
+            }
+        }
+        for h in &c.hidden {
+            if stderr.contains(h) {
+                wrong.push(format!("shows `{h}`, from a file's contents"));
             }
         }
         if snapshot(&s.root) != before {
@@ -687,4 +886,152 @@ fn a_linked_results_folder_is_followed_and_a_held_one_refused() {
     drop(held);
     let (code, stderr) = s.run(&["exp.toml"]);
     assert_eq!(code, 0, "{stderr}");
+}
+
+/// Runs `command`, failing the test if it runs past a minute (a read of a pipe blocks for ever).
+fn output_within_a_minute(mut command: Command) -> (i32, String) {
+    let mut child = command
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut stderr = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+            return (status.code().unwrap_or(-1), stderr);
+        }
+        if start.elapsed().as_secs() > 60 {
+            child.kill().unwrap();
+            panic!("still running after a minute: {command:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// The `page` binary on a results folder with a link or a pipe where its files or folders
+/// belong: exit 2 naming the path, at once, and nothing written anywhere (the folder included).
+#[test]
+fn page_refuses_links_and_pipes_where_a_folders_files_belong() {
+    use penumbra::output::images::write_exr;
+    let cases: Vec<(&str, &str, Vec<u8>)> = vec![
+        ("images/ a link", "images", link("../elsewhere")),
+        ("plots/ a link", "plots", link("../elsewhere")),
+        ("report.md a link", "report.md", link("../elsewhere/report.md")),
+        ("report.md a pipe", "report.md", FIFO.to_vec()),
+        ("a table a pipe", "runs.csv", FIFO.to_vec()),
+        ("a table a link", "more.csv", link("../elsewhere/t.csv")),
+        ("an image a pipe", "images/b.exr", FIFO.to_vec()),
+        ("an image a link", "images/b.exr", link("../elsewhere/x.exr")),
+    ];
+    let mut failures = Vec::new();
+    for (what, planted, bytes) in &cases {
+        let dir = tempfile::tempdir().unwrap();
+        let (folder, elsewhere) = (dir.path().join("r"), dir.path().join("elsewhere"));
+        for d in [&folder, &elsewhere] {
+            std::fs::create_dir_all(d.join("images")).unwrap();
+            std::fs::create_dir_all(d.join("plots")).unwrap();
+            std::fs::write(d.join("report.md"), "# a report\n").unwrap();
+            std::fs::write(d.join("t.csv"), "a,b\n1,2\n").unwrap();
+        }
+        std::fs::write(folder.join("runs.csv"), "a,b\n1,2\n").unwrap();
+        write_exr(&folder.join("images/a.exr"), &[0.5; 16], 4, 4).unwrap();
+        // An image with no PNG beside it: a rebuild through a link would draw one there.
+        write_exr(&elsewhere.join("x.exr"), &[0.25; 16], 4, 4).unwrap();
+        let path = folder.join(planted);
+        if std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir()) {
+            std::fs::remove_dir_all(&path).unwrap();
+        } else {
+            let _ = std::fs::remove_file(&path);
+        }
+        plant(&folder, planted, bytes);
+        let before = snapshot(dir.path());
+        let mut page = Command::new(env!("CARGO_BIN_EXE_page"));
+        page.arg(&folder);
+        let (code, stderr) = output_within_a_minute(page);
+        let mut wrong = Vec::new();
+        if code != 2 {
+            wrong.push(format!("exit {code}"));
+        }
+        if !stderr.contains(&format!("r/{planted}")) {
+            wrong.push(format!("does not name r/{planted}"));
+        }
+        if snapshot(dir.path()) != before {
+            wrong.push("wrote something".into());
+        }
+        if !wrong.is_empty() {
+            failures.push(format!("{what}: {}\n{stderr}", wrong.join(", ")));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// `backend = "auto"` renders on the f64 CPU backend a scene asking for a pass the GPU has no
+/// kernel for, and says which backend and why (the same file asked of the GPU by name is refused
+/// above); a face of the most corners a face may have, on a circle, loads, builds and renders.
+#[test]
+fn auto_takes_the_cpu_for_a_pass_the_gpu_lacks() {
+    let corners = penumbra::mesh::file::MAX_FACE_CORNERS;
+    let mut circle = String::new();
+    for k in 0..corners {
+        let a = std::f64::consts::TAU * k as f64 / corners as f64;
+        circle.push_str(&format!("v {} {} 0.6\n", 0.1 * a.cos(), 0.1 * a.sin()));
+    }
+    circle.push('f');
+    for k in 1..=corners {
+        circle.push_str(&format!(" {k}"));
+    }
+    circle.push('\n');
+    let scene = scene_edit(|t| format!("{t}\n[shading]\nshadows = false\n\n[[meshes]]\npath = \"circle.obj\"\n"));
+    let text = tiny().replace(
+        &format!("\"{}/sphere.toml\"", common::repo("experiments/scenes").display()),
+        "\"s.toml\"",
+    );
+    let s = Scratch::new(&text, "tiny");
+    std::fs::write(s.work.join("s.toml"), scene).unwrap();
+    std::fs::write(s.work.join("circle.obj"), circle).unwrap();
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("backend auto: the f64 CPU backend")
+            && stderr.contains("s.toml")
+            && stderr.contains("shading.shadows"),
+        "{stderr}"
+    );
+    let manifest = std::fs::read_to_string(s.work.join("results/tiny/manifest.toml")).unwrap();
+    let adapter = manifest.split("[adapter]").nth(1).expect("an [adapter] table");
+    assert!(adapter.contains("backend = \"cpu\""), "{manifest}");
+    assert!(manifest.contains("circle.obj"), "the mesh is an input: {manifest}");
+}
+
+/// Under an address-space limit (`ulimit -v`) a structure that would pass the free-memory check
+/// but not the limit is refused before it is built, naming the limit; nothing is written.
+#[test]
+fn an_address_space_limit_refuses_a_build_past_it() {
+    let scene = scene_edit(|t| {
+        format!("accelerator = \"vlf\"\n{t}\n[accel.vlf]\nlevel = 64\ntiles = 512\n\n[[meshes]]\npath = \"tri.obj\"\n")
+    });
+    let text = tiny().replace(
+        &format!("\"{}/sphere.toml\"", common::repo("experiments/scenes").display()),
+        "\"s.toml\"",
+    );
+    let s = Scratch::new(&text, "tiny");
+    std::fs::write(s.work.join("s.toml"), scene).unwrap();
+    std::fs::write(s.work.join("tri.obj"), "v 0 0 0.5\nv 0.1 0 0.5\nv 0 0.1 0.5\nf 1 2 3\n").unwrap();
+    let before = snapshot(&s.root);
+    // 8 GB of address space, in KiB; the field needs 17.2 GB.
+    let out = Command::new("sh")
+        .current_dir(&s.work)
+        .args(["-c", "ulimit -v 8000000 && exec \"$0\" exp.toml"])
+        .arg(env!("CARGO_BIN_EXE_sweep"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("s.toml") && stderr.contains("needs at least 17.2 GB") && stderr.contains("RLIMIT_AS"),
+        "{stderr}"
+    );
+    assert_eq!(snapshot(&s.root), before, "wrote something");
 }

@@ -303,7 +303,7 @@ impl AoSpec {
         if meshes.is_empty() {
             return Err(err(&key_path!["meshes"], "list at least one mesh".into()));
         }
-        let available = crate::accel::memory::available_bytes();
+        let available = crate::accel::memory::available();
         for (i, (name, candidates)) in structures.iter().enumerate() {
             for m in &meshes {
                 for c in candidates {

@@ -36,6 +36,14 @@ impl Experiment for FpsSpec {
         v
     }
 
+    fn scenes(&self) -> Vec<(&std::path::Path, &crate::scene::Scene)> {
+        self.scene_paths
+            .iter()
+            .map(PathBuf::as_path)
+            .zip(self.scenes.iter().map(|s| &s.scene))
+            .collect()
+    }
+
     fn dry_run(&self, _cli: &Cli) -> anyhow::Result<String> {
         runner::dry_run(self)
     }

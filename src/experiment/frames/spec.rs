@@ -308,6 +308,12 @@ impl FramesSpec {
                             format!("unknown viewpoint `{v}`; known: {}", random::VIEWPOINTS.join(", ")),
                         ));
                     }
+                    if f.path.viewpoints[..i].contains(v) {
+                        return Err(err(
+                            &key_path!["path", "viewpoints", i],
+                            format!("`{v}` is listed twice"),
+                        ));
+                    }
                 }
                 f.path.viewpoints.clone()
             }
@@ -451,7 +457,7 @@ impl FramesSpec {
             Generator::Classroom => vec![classroom::TRIANGLES],
             Generator::RandomTriangles { counts, .. } => counts.clone(),
         };
-        let available = crate::accel::memory::available_bytes();
+        let available = crate::accel::memory::available();
         // One scene is held at a time, with its triangle list, a copy per structure and every
         // structure built over it.
         for (k, &n) in counts.iter().enumerate() {
@@ -461,7 +467,7 @@ impl FramesSpec {
                 .iter()
                 .map(|s| crate::accel::memory::estimate(s, n))
                 .sum();
-            if let Some(free) = available.filter(|&free| scene + structures > free) {
+            if let Some(budget) = available.filter(|b| scene + structures > b.bytes) {
                 let at: Vec<Seg> = match self.generator {
                     Generator::Classroom => key_path!["structures"].to_vec(),
                     Generator::RandomTriangles { .. } => key_path!["scene", "triangles", k].to_vec(),
@@ -469,11 +475,11 @@ impl FramesSpec {
                 return Err(source.error(
                     &at,
                     format!(
-                        "{n} triangles with every structure built over them need at least {:.1} GB ({:.1} GB of scene copies, {:.1} GB of structures), more than the {:.1} GB this machine has available",
+                        "{n} triangles with every structure built over them need at least {:.1} GB ({:.1} GB of scene copies, {:.1} GB of structures), more than {}",
                         (scene + structures) as f64 / 1e9,
                         scene as f64 / 1e9,
                         structures as f64 / 1e9,
-                        free as f64 / 1e9
+                        budget.describe()
                     ),
                 ));
             }

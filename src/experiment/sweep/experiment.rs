@@ -43,6 +43,10 @@ impl Experiment for Spec {
         v
     }
 
+    fn scenes(&self) -> Vec<(&Path, &crate::scene::Scene)> {
+        vec![(self.scene_path.as_path(), &self.scene)]
+    }
+
     fn dry_run(&self, cli: &Cli) -> anyhow::Result<String> {
         let spec = self.for_cli(cli)?;
         Ok(match cli.shard {

@@ -119,11 +119,12 @@ pub fn write(dir: &Path, page: &Page) -> anyhow::Result<()> {
     }
     let mut tables = Vec::new();
     for t in files_in(dir, "", ".csv")? {
-        if std::fs::metadata(dir.join(&t))?.len() > TABLE_BYTES {
+        if std::fs::symlink_metadata(dir.join(&t))?.len() > TABLE_BYTES {
             tables.push(data::linked(&t));
             continue;
         }
-        let text = std::fs::read_to_string(dir.join(&t)).with_context(|| format!("reading {t} for the page"))?;
+        let text =
+            crate::files::read_regular_text(&dir.join(&t)).with_context(|| format!("reading {t} for the page"))?;
         tables.push(data::table(&t, &text)?);
     }
     let plots = plots_in(dir)?;
@@ -153,18 +154,25 @@ fn flip_maps(g: &Gallery) -> anyhow::Result<Vec<Option<Vec<f32>>>> {
         .collect()
 }
 
-/// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`.
+/// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`; such a name
+/// that is not a regular file (a link, pipe or folder) is refused with its path.
 fn files_in(dir: &Path, sub: &str, suffix: &str) -> anyhow::Result<Vec<String>> {
+    crate::files::check_plain_folder(&dir.join(sub))?;
     let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
         return Ok(vec![]);
     };
-    let mut names: Vec<String> = entries
-        .filter_map(Result::ok)
-        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
-        .filter_map(|e| e.file_name().into_string().ok())
-        .filter(|n| n.ends_with(suffix))
-        .map(|n| if sub.is_empty() { n } else { format!("{sub}/{n}") })
-        .collect();
+    let mut names = Vec::new();
+    for e in entries.filter_map(Result::ok) {
+        let Ok(n) = e.file_name().into_string() else { continue };
+        if !n.ends_with(suffix) {
+            continue;
+        }
+        if !e.file_type().is_ok_and(|t| t.is_file()) {
+            // Opening it says what it is, without following or blocking.
+            crate::files::open_regular(&e.path())?;
+        }
+        names.push(if sub.is_empty() { n } else { format!("{sub}/{n}") });
+    }
     names.sort();
     Ok(names)
 }

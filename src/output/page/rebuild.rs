@@ -8,14 +8,27 @@
 //! beside an EXR is drawn from it.
 
 use super::{files_in, write, Gallery, Page, Shot, Tone};
+use crate::files::{read_regular, read_regular_text, Refused};
 use crate::output::images::{exposure, write_png};
 use anyhow::Context;
 use std::path::Path;
 
 /// Rebuilds `dir`/index.html and page_data.js from the folder's files.
 pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
-    let report = std::fs::read_to_string(dir.join("report.md"))
-        .with_context(|| format!("{}: no report.md (is this a results folder?)", dir.display()))?;
+    if std::fs::symlink_metadata(dir.join("report.md")).is_err() {
+        return Err(Refused(format!("{}: no report.md (is this a results folder?)", dir.display())).into());
+    }
+    // Everything the page will read is checked before anything is written.
+    for (sub, suffix) in [
+        ("", ".csv"),
+        ("images", ".exr"),
+        ("images", ".png"),
+        ("plots", ".png"),
+        ("plots", ".svg"),
+    ] {
+        files_in(dir, sub, suffix)?;
+    }
+    let report = read_regular_text(&dir.join("report.md"))?;
     let mut galleries: Vec<Gallery> = Vec::new();
     // Each gallery's family: a strip's frames (`strip_SHADING_FRAME`) are one gallery per strip,
     // since each strip's PNGs were drawn at its own exposure; every other image is grouped by
@@ -93,8 +106,16 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
 
 /// A one-channel EXR's values, width and height.
 fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
-    let img =
-        exr::prelude::read_first_flat_layer_from_file(path).with_context(|| format!("reading {}", path.display()))?;
+    use exr::prelude::*;
+    let bytes = read_regular(path)?;
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
     let size = img.layer_data.size;
     let channel = img
         .layer_data

@@ -295,25 +295,59 @@ impl GpuBackend {
     }
 }
 
-/// The passes the GPU kernels cover: primary, shadow and ambient, over diffuse materials.
-/// OpenGL-like direct light, Whitted's mirror chains and mirror materials (whose diffuse part is
-/// scaled by 1 - mirror) are the CPU backend's only, and a scene asking for them is refused by
-/// name.
-fn refuse_unsupported(scene: &crate::scene::Scene, plan: &RenderPlan) -> anyhow::Result<()> {
-    if let Some(p) = plan
-        .passes
-        .iter()
-        .find(|p| matches!(p, Pass::Direct { .. } | Pass::Mirror { .. }))
-    {
-        bail!(
-            "the GPU backend has no kernel for the {} pass (the scene's [shading]); render this scene with backend = \"cpu\"",
-            p.name()
-        );
+/// A part of a scene the GPU kernels cannot render: the pass (or material) and the scene-file
+/// key that asks for it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GpuGap {
+    /// The pass or material, in the words of the render plan.
+    pub what: &'static str,
+    /// The scene-file key that asks for it.
+    pub key: String,
+}
+
+impl std::fmt::Display for GpuGap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "key `{}` asks for {}, which the GPU backend has no kernel for",
+            self.key, self.what
+        )
     }
-    if scene.has_mirrors() {
-        bail!("the GPU backend has no mirror materials (a mesh's `mirror` weight); render this scene with backend = \"cpu\"");
+}
+
+/// What of `scene` the GPU has no kernel for, if anything. The GPU kernels cover the primary,
+/// shadow and ambient passes over diffuse materials; OpenGL-like direct light (the `direct`
+/// pass, where `[shading] shadows = false`), Whitted's mirror chains (the `mirror` pass) and
+/// mirror materials (whose diffuse part is scaled by 1 - mirror) are the CPU backend's only. The
+/// conditions are [`RenderPlan::new`]'s, read from the scene alone, so a run can choose its
+/// backend before any frame.
+pub fn gpu_gap(scene: &crate::scene::Scene) -> Option<GpuGap> {
+    if !scene.shading.shadows && !scene.lights.is_empty() {
+        return Some(GpuGap {
+            what: "the direct pass (OpenGL-like shading without shadow rays)",
+            key: "shading.shadows".into(),
+        });
     }
-    Ok(())
+    let mirror = scene.meshes().position(|m| m.mirror > 0.0)?;
+    Some(if scene.shading.mirror_depth > 0 {
+        GpuGap {
+            what: "the mirror pass (Whitted's mirror chains)",
+            key: "shading.mirror_depth".into(),
+        }
+    } else {
+        GpuGap {
+            what: "mirror materials",
+            key: format!("meshes[{mirror}].mirror"),
+        }
+    })
+}
+
+/// Refuses a scene the GPU kernels cannot render ([`gpu_gap`]), never skipping what it asks for.
+fn refuse_unsupported(scene: &crate::scene::Scene) -> anyhow::Result<()> {
+    match gpu_gap(scene) {
+        Some(gap) => bail!("{gap}; render this scene with backend = \"cpu\""),
+        None => Ok(()),
+    }
 }
 
 impl Backend for GpuBackend {
@@ -327,7 +361,7 @@ impl Backend for GpuBackend {
 
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(scene, &plan)?;
+        refuse_unsupported(scene)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
@@ -399,7 +433,7 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(scene, &plan)?;
+        refuse_unsupported(scene)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         loop {
