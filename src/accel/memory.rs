@@ -28,15 +28,14 @@ impl Budget {
 
 /// The smallest of the limits a build runs into: the memory the system has free
 /// (`MemAvailable` in /proc/meminfo), what the process's address-space limit (`RLIMIT_AS`, as
-/// `ulimit -v` sets it) leaves above what it already maps, what its control group's
-/// `memory.max` leaves above its `memory.current` (cgroup v2: a container's or a batch job's
-/// share), and the environment's `PENUMBRA_MEMORY_BYTES` (a share stated by hand); `None` where
+/// `ulimit -v` sets it) leaves above what it already maps, what its control group's memory
+/// limit leaves above its usage (a container's or a batch job's share), and the environment's `PENUMBRA_MEMORY_BYTES` (a share stated by hand); `None` where
 /// none says. A build past any of them aborts the process, so each is checked before one starts.
 pub fn available() -> Option<Budget> {
     smallest([
         mem_available().map(|b| Budget::new(b, "the memory the system has available (MemAvailable)")),
         address_space_left().map(|b| Budget::new(b, "the address-space limit (RLIMIT_AS, ulimit -v)")),
-        cgroup_left().map(|b| Budget::new(b, "the control group's memory.max")),
+        cgroup_left().map(|b| Budget::new(b, "the control group's memory limit")),
         std::env::var("PENUMBRA_MEMORY_BYTES")
             .ok()
             .and_then(|v| v.trim().parse::<u64>().ok())
@@ -70,18 +69,33 @@ fn address_space_left() -> Option<u64> {
     Some(limit.rlim_cur.saturating_sub(mapped))
 }
 
-/// The process's cgroup v2 `memory.max` less its `memory.current`; `None` where it has no
-/// limit ("max") or no cgroup v2.
+/// The process's control-group memory limit less its usage: cgroup v2's `memory.max` and
+/// `memory.current`, or v1's `memory.limit_in_bytes` and `memory.usage_in_bytes`; `None` where
+/// there is no limit ("max") or no such file.
 fn cgroup_left() -> Option<u64> {
     let own = std::fs::read_to_string("/proc/self/cgroup").ok()?;
-    let path = own.lines().find_map(|l| l.strip_prefix("0::"))?;
-    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
-    let read = |f: &str| std::fs::read_to_string(dir.join(f)).ok();
-    let max = read("memory.max")?.trim().parse::<u64>().ok()?;
-    let current = read("memory.current")
-        .and_then(|c| c.trim().parse::<u64>().ok())
-        .unwrap_or(0);
-    Some(max.saturating_sub(current))
+    let number = |p: std::path::PathBuf| std::fs::read_to_string(p).ok()?.trim().parse::<u64>().ok();
+    let left = |dir: std::path::PathBuf, max: &str, used: &str| {
+        let limit = number(dir.join(max))?;
+        Some(limit.saturating_sub(number(dir.join(used)).unwrap_or(0)))
+    };
+    let root = std::path::Path::new("/sys/fs/cgroup");
+    own.lines().find_map(|l| {
+        let (_, rest) = l.split_once(':')?;
+        let (controllers, path) = rest.split_once(':')?;
+        let path = path.trim_start_matches('/');
+        if controllers.is_empty() {
+            left(root.join(path), "memory.max", "memory.current")
+        } else if controllers.split(',').any(|c| c == "memory") {
+            left(
+                root.join("memory").join(path),
+                "memory.limit_in_bytes",
+                "memory.usage_in_bytes",
+            )
+        } else {
+            None
+        }
+    })
 }
 
 /// The number of kilobytes on the line of `text` starting with `key`, in bytes.

@@ -165,6 +165,13 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
     /// The GPU form in `frame`'s local coordinates, or an error naming the limit it exceeds.
     fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure>;
 
+    /// Why [`Accelerator::gpu`] would fail, where that is known without packing anything (no
+    /// GPU traversal; a tree deeper than the GPU's stack): a run checks it before it chooses a
+    /// backend.
+    fn gpu_refusal(&self) -> Option<String> {
+        None
+    }
+
     /// The ways it can follow triangles that moved, its own first (a field's update in place,
     /// paper Section 8; a BVH's refit; a rebuild): the names [`Accelerator::update`] takes.
     fn updates(&self) -> &'static [&'static str] {
@@ -308,7 +315,11 @@ pub const REGISTRY: &[Registered] = &[
         gpu_buffers: kdtree::GPU_BUFFERS,
         params: settings::validate::<kdtree::KdSettings>,
         tuning: <kdtree::KdSettings as settings::Params>::tuning,
-        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()))),
+        build: |t, s| {
+            Ok(Arc::new(
+                kdtree::KdTree::within(t, s.typed(), kdtree_entries()).map_err(anyhow::Error::msg)?,
+            ))
+        },
         // A leaf entry per triangle at least, and the f64 copy.
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
@@ -320,7 +331,13 @@ pub const REGISTRY: &[Registered] = &[
         gpu_buffers: kdtree::GPU_BUFFERS,
         params: kdtree::sah_params,
         tuning: kdtree::sah_tuning,
-        build: |t, s| Ok(Arc::new(kdtree::KdTree::build(t, s.typed()).named("kdtree-sah"))),
+        build: |t, s| {
+            Ok(Arc::new(
+                kdtree::KdTree::within(t, s.typed(), kdtree_entries())
+                    .map_err(anyhow::Error::msg)?
+                    .named("kdtree-sah"),
+            ))
+        },
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
     },
@@ -386,6 +403,12 @@ pub fn build(triangles: &Triangles, settings: &AccelSettings) -> anyhow::Result<
     let _ = watch.join();
     tracing::info!("built {} in {:.1} s", r.name, started.elapsed().as_secs_f64());
     built.map(Some)
+}
+
+/// Leaf entries a kd-tree build may make: a quarter of the memory budget at 4 bytes each (the
+/// build holds its triangle lists besides), where a budget is known.
+fn kdtree_entries() -> usize {
+    memory::available().map_or(kdtree::MAX_ENTRIES, |b| (b.bytes / 16) as usize)
 }
 
 /// Triangle count from which a build says when it starts, how it goes and what it took.

@@ -9,7 +9,6 @@ use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
 use super::sweep::merge::MergeRefused;
 use super::{load, Experiment, Finished, Run};
-use crate::render::gpu::gpu_gap;
 use crate::render::{cpu::CpuBackend, open_backend, Backend, BackendChoice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -147,19 +146,14 @@ fn run_into(
 /// asks for something the GPU has no kernel for (and says so), and `gpu` for such a scene is
 /// refused before any work, naming the scene file and key.
 fn backend_for(experiment: &dyn Experiment, choice: BackendChoice) -> Result<BackendChoice, BadInput> {
-    let gap = experiment
-        .scenes()
-        .into_iter()
-        .find_map(|(path, scene)| gpu_gap(scene).map(|gap| (path, gap)));
-    Ok(match (choice, gap) {
-        (BackendChoice::Gpu, Some((path, gap))) => {
+    Ok(match (choice, experiment.gpu_gap()) {
+        (BackendChoice::Gpu, Some(gap)) => {
             return Err(BadInput(format!(
-                "{}: {gap}; --backend gpu (or backend = \"gpu\") cannot render this scene: use backend = \"cpu\" or \"auto\"",
-                path.display()
-            )))
+            "{gap}; --backend gpu (or backend = \"gpu\") cannot run this experiment: use backend = \"cpu\" or \"auto\""
+        )))
         }
-        (BackendChoice::Auto, Some((path, gap))) => {
-            info!("backend auto: the f64 CPU backend, because {}: {gap}", path.display());
+        (BackendChoice::Auto, Some(gap)) => {
+            info!("backend auto: the f64 CPU backend, because {gap}");
             BackendChoice::Cpu
         }
         (choice, _) => choice,

@@ -86,11 +86,11 @@ pub trait Experiment {
     /// Every file it read (experiment, scenes, meshes), hashed into the manifest.
     fn inputs(&self) -> Vec<PathBuf>;
 
-    /// The scenes it renders, each with the file it was read from: the driver checks them
-    /// against the GPU's kernels before it chooses a backend. Kinds that render on the CPU
-    /// only list none.
-    fn scenes(&self) -> Vec<(&Path, &crate::scene::Scene)> {
-        Vec::new()
+    /// What of it the GPU cannot run (a pass or material it has no kernel for, a structure
+    /// without a GPU form), located at its file and key; the driver asks before it chooses a
+    /// backend. Kinds that render on the CPU only say nothing.
+    fn gpu_gap(&self) -> Option<String> {
+        None
     }
 
     /// What `--dry-run` prints: every unit and its render plan.
@@ -103,6 +103,16 @@ pub trait Experiment {
 
     /// Runs and writes the outputs into `run.out`.
     fn run(&self, run: &mut Run) -> anyhow::Result<Finished>;
+}
+
+/// What of `scene`, read from `path`, the GPU cannot run: a pass or material without a kernel
+/// ([`crate::render::gpu::gpu_gap`]) or its structure without a GPU form, at the scene's key.
+pub(crate) fn scene_gpu_gap(path: &Path, scene: &crate::scene::Scene) -> Option<String> {
+    if let Some(gap) = crate::render::gpu::gpu_gap(scene) {
+        return Some(format!("{}: {gap}", path.display()));
+    }
+    let refusal = scene.accel.as_ref()?.gpu_refusal()?;
+    Some(format!("{}: key `accelerator`: {refusal}", path.display()))
 }
 
 /// Reads an experiment file of any kind: the shared header first, then the kind's own keys.

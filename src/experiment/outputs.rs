@@ -60,6 +60,13 @@ pub fn resolve_home(out: &Path) -> Result<PathBuf, String> {
     Ok(home)
 }
 
+/// Checks that kept state at `path`, if any, is a folder (not a link or a file) holding only
+/// folders and regular files.
+fn check_kept(path: &Path) -> anyhow::Result<()> {
+    check_plain_folder(path)?;
+    check_plain_tree(path)
+}
+
 /// Takes an exclusive lock on the results folder for this run, or says another run holds it.
 fn lock(home: &Path) -> anyhow::Result<File> {
     use std::os::fd::AsRawFd;
@@ -104,7 +111,7 @@ impl Outputs {
         // Links and special files among the kept state would lead writes (the journal, a
         // cached ground truth) or reads outside the folder: refused before anything moves.
         for kept in KEPT {
-            check_plain_tree(&home.join(kept))?;
+            check_kept(&home.join(kept))?;
         }
         let mut dead = Vec::new();
         if let Ok(entries) = std::fs::read_dir(parent) {
@@ -119,7 +126,7 @@ impl Outputs {
                     // kept state plain), or the cleanup would follow a planted link.
                     check_plain_folder(&e.path())?;
                     for kept in KEPT {
-                        check_plain_tree(&e.path().join(kept))?;
+                        check_kept(&e.path().join(kept))?;
                     }
                     dead.push(e.path());
                 }
@@ -264,10 +271,13 @@ pub fn check_home(home: &Path, kind: &str, name: &str, experiment: &Path, fresh:
         return Ok(());
     }
     let manifest = home.join("manifest.toml");
-    let Some(table) = crate::files::read_regular_text(&manifest)
-        .ok()
-        .and_then(|t| t.parse::<toml::Table>().ok())
-    else {
+    let text = match crate::files::read_regular_text(&manifest) {
+        Ok(text) => Some(text),
+        // A link, pipe or folder by that name: say so.
+        Err(e) if std::fs::symlink_metadata(&manifest).is_ok() => return Err(format!("{e:#}")),
+        Err(_) => None,
+    };
+    let Some(table) = text.and_then(|t| t.parse::<toml::Table>().ok()) else {
         return Err(format!(
             "{} holds files but no readable manifest.toml: not a results folder; choose another --out",
             home.display()
@@ -438,5 +448,13 @@ mod tests {
             "an older manifest of the same file"
         );
         assert!(check_home(&home, "ao", "r", Path::new("f.toml"), false).is_err());
+        // A manifest that is a pipe is refused as one, at once.
+        std::fs::remove_file(home.join("manifest.toml")).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(home.join("manifest.toml"))
+            .status();
+        assert!(made.unwrap().success());
+        let e = check_home(&home, "ao", "r", e, true).unwrap_err();
+        assert!(e.contains("manifest.toml") && e.contains("named pipe"), "{e}");
     }
 }

@@ -147,28 +147,36 @@ pub fn face_fits(stored: usize, corners: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// Most corners of a face that is not a convex polygon listed in order: such a face is fanned
+/// from its first corner, as the formats' readers do (right where every corner sees the first),
+/// and a fan of more would be slivers crossing one another, whose boxes no tree separates.
+pub const MAX_FAN_CORNERS: usize = 64;
+
 impl MeshFile {
-    /// Appends the triangles of the planar convex polygon `face` (3 corners or more, in order),
-    /// in group `group`. Triangles and quads are fanned from the first corner, as every format
-    /// reader does. A larger polygon is split by diagonals halving its corner range, so its
-    /// triangles stay compact (a fan's are slivers all meeting at one corner, whose overlapping
-    /// boxes no tree separates), and a triangle the face already gave with the same corners
-    /// (a polygon that lists its corners over and over) is kept once.
-    pub fn push_face(&mut self, face: &[[f64; 3]], group: u32) {
+    /// Appends the triangles of the polygon `face` (3 corners or more, in order), in group
+    /// `group`. Triangles and quads are fanned from the first corner, as the formats' readers
+    /// do. A larger polygon that is convex with its corners listed once around in order is split
+    /// by diagonals halving its corner range, so its triangles stay compact (a fan's are slivers
+    /// all meeting at one corner, whose overlapping boxes no tree separates); any other is
+    /// fanned up to [`MAX_FAN_CORNERS`] corners and refused beyond.
+    pub fn push_face(&mut self, face: &[[f64; 3]], group: u32) -> Result<(), String> {
         let n = face.len();
-        if n <= 4 {
-            for k in 1..n.saturating_sub(1) {
-                self.triangles.push([face[0], face[k], face[k + 1]]);
-                self.group_of.push(group);
-            }
-            return;
-        }
-        let key = |t: &[[f64; 3]; 3]| {
-            let mut k = t.map(|p| p.map(f64::to_bits));
-            k.sort_unstable();
-            k
+        let mut push = |t: [[f64; 3]; 3]| {
+            self.triangles.push(t);
+            self.group_of.push(group);
         };
-        let mut seen = std::collections::HashSet::new();
+        if n <= 4 || !convex_in_order(face) {
+            if n > MAX_FAN_CORNERS {
+                return Err(format!(
+                    "a face of {n} corners that is not a convex polygon listing its corners once around: \
+                     only faces of up to {MAX_FAN_CORNERS} such corners are fanned; split it into convex polygons or triangles"
+                ));
+            }
+            for k in 1..n.saturating_sub(1) {
+                push([face[0], face[k], face[k + 1]]);
+            }
+            return Ok(());
+        }
         // Each range (a, b) is the sub-polygon a, a + 1, .., b closed by the diagonal b -> a.
         let mut ranges = vec![(0, n - 1)];
         while let Some((a, b)) = ranges.pop() {
@@ -176,15 +184,41 @@ impl MeshFile {
                 continue;
             }
             let m = (a + b) / 2;
-            let t = [face[a], face[m], face[b]];
-            if seen.insert(key(&t)) {
-                self.triangles.push(t);
-                self.group_of.push(group);
-            }
+            push([face[a], face[m], face[b]]);
             ranges.push((m, b));
             ranges.push((a, m));
         }
+        Ok(())
     }
+}
+
+/// Whether `face` is a convex polygon listing its corners once around in order: about its
+/// normal (Newell's), every turn goes the same way and the turns add up to one revolution.
+/// Repeated corners (edges of no length) are passed over; straight corners are convex.
+fn convex_in_order(face: &[[f64; 3]]) -> bool {
+    use glam::DVec3;
+    let p: Vec<DVec3> = face.iter().map(|&c| DVec3::from_array(c)).collect();
+    let centre = p.iter().copied().sum::<DVec3>() / p.len() as f64;
+    let normal: DVec3 = (0..p.len())
+        .map(|i| (p[i] - centre).cross(p[(i + 1) % p.len()] - centre))
+        .sum();
+    let Some(normal) = normal.try_normalize() else {
+        return false;
+    };
+    let edges: Vec<DVec3> = (0..p.len())
+        .map(|i| p[(i + 1) % p.len()] - p[i])
+        .filter(|e| *e != DVec3::ZERO)
+        .collect();
+    let mut turned = 0.0;
+    for (i, e) in edges.iter().enumerate() {
+        let next = edges[(i + 1) % edges.len()];
+        let (sin, cos) = (e.cross(next).dot(normal), e.dot(next));
+        if sin < -1e-12 * e.length() * next.length() {
+            return false;
+        }
+        turned += sin.atan2(cos);
+    }
+    (turned - std::f64::consts::TAU).abs() < 1e-6
 }
 
 #[cfg(test)]
@@ -210,8 +244,8 @@ mod tests {
     fn triangles_and_quads_are_fanned_from_the_first_corner() {
         let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
         let mut m = MeshFile::default();
-        m.push_face(&quad[..3], 7);
-        m.push_face(&quad, 7);
+        m.push_face(&quad[..3], 7).unwrap();
+        m.push_face(&quad, 7).unwrap();
         assert_eq!(
             m.triangles,
             vec![
@@ -228,7 +262,7 @@ mod tests {
         for n in [5, 6, 7, 64, 1000, MAX_FACE_CORNERS] {
             let face = circle(n);
             let mut m = MeshFile::default();
-            m.push_face(&face, 0);
+            m.push_face(&face, 0).unwrap();
             assert_eq!(m.triangles.len(), n - 2, "n = {n}");
             // Every triangle counter-clockwise (no fold) and the areas add up to the polygon's.
             let exact = 0.5 * n as f64 * (std::f64::consts::TAU / n as f64).sin();
@@ -254,13 +288,64 @@ mod tests {
     }
 
     #[test]
-    fn a_polygon_repeating_its_corners_gives_each_triangle_once() {
-        let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
-        let face: Vec<[f64; 3]> = (0..MAX_FACE_CORNERS).map(|k| quad[k % 4]).collect();
+    fn other_polygons_are_fanned_as_before_or_refused_when_large() {
+        // A concave pentagon: the fan from its first corner covers it exactly (area 14), where a
+        // split across the notch would not.
+        let notch = [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [4.0, 4.0, 0.0],
+            [2.0, 3.0, 0.0],
+            [0.0, 4.0, 0.0],
+        ];
         let mut m = MeshFile::default();
-        m.push_face(&face, 0);
-        // At most one triangle per multiset of 3 of the 4 points: C(4 + 2, 3) = 20.
-        assert!(m.triangles.len() <= 20, "{} triangles", m.triangles.len());
+        m.push_face(&notch, 0).unwrap();
+        assert_eq!(m.triangles.len(), 3);
+        assert!(m.triangles.iter().all(|t| t[0] == notch[0]), "fanned");
+        assert!((m.triangles.iter().map(area).sum::<f64>() - 14.0).abs() < 1e-12);
+        // Corners of a convex polygon listed out of order (a star), or around twice.
+        let star = |n: usize, step: usize| -> Vec<[f64; 3]> {
+            let c = circle(n);
+            (0..n).map(|k| c[k * step % n]).collect()
+        };
+        let twice: Vec<[f64; 3]> = circle(32).into_iter().cycle().take(64).collect();
+        for (what, face) in [("star", star(63, 2)), ("twice around", twice)] {
+            let mut m = MeshFile::default();
+            m.push_face(&face, 0).unwrap();
+            assert!(m.triangles.iter().all(|t| t[0] == face[0]), "{what}: fanned");
+        }
+        for (what, face) in [
+            ("a star of 4096 corners", star(4096, 2047)),
+            ("a notch in 65 corners", {
+                let mut c = circle(65);
+                c[30] = [0.0, 0.0, 0.0];
+                c
+            }),
+            (
+                "a quad listed 1000 times",
+                (0..4000).map(|k| circle(4)[k % 4]).collect(),
+            ),
+        ] {
+            let e = MeshFile::default().push_face(&face, 0).unwrap_err();
+            assert!(
+                e.contains("not a convex polygon") && e.contains("up to 64"),
+                "{what}: {e}"
+            );
+        }
+        // Repeated and straight corners keep a convex polygon convex.
+        let mut ring = circle(100);
+        ring.insert(10, ring[10]);
+        ring.insert(
+            50,
+            [
+                (ring[49][0] + ring[50][0]) / 2.0,
+                (ring[49][1] + ring[50][1]) / 2.0,
+                0.0,
+            ],
+        );
+        let mut m = MeshFile::default();
+        m.push_face(&ring, 0).unwrap();
+        assert!(!m.triangles.iter().all(|t| t[0] == ring[0]), "split, not fanned");
     }
 
     #[test]

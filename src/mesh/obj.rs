@@ -70,7 +70,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                     Some(g) => g,
                     None => *group.insert(id_of(&mut mesh, &mut group_ids, "default".into())),
                 };
-                mesh.push_face(&corners, g);
+                mesh.push_face(&corners, g).map_err(|e| err(line_no, e))?;
             }
             Some("g") | Some("o") => {
                 let name = words.collect::<Vec<_>>().join(" ");

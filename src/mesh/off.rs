@@ -96,7 +96,7 @@ pub fn parse(text: &str, file: &Path) -> Result<MeshFile, MeshFileError> {
                 .ok_or_else(|| err(n, format!("face index {i} refers to no vertex ({n_vertices} defined)")))?;
             face.push(*p);
         }
-        mesh.push_face(&face, 0);
+        mesh.push_face(&face, 0).map_err(|e| err(n, e))?;
     }
     Ok(mesh)
 }

@@ -2,7 +2,7 @@
 //! image keeps.
 //!
 //! - RMSE = sqrt(mean_p (x_p - ref_p)^2)
-//! - relMSE = mean_p (x_p - ref_p)^2 / (ref_p^2 + 0.01)   (known-facts.md, "Error metrics in use")
+//! - relMSE = mean_p (x_p - ref_p)^2 / (ref_p^2 + 0.01)   (FACTS.md, "Error metrics in use")
 //! - bias = mean_p (x_p - ref_p), signed
 //!
 //! where p runs over a [`PenumbraMask`]: the measured receiver's pixels whose reference visibility

@@ -1,5 +1,5 @@
 //! The per-pixel error of one configuration split over its seeds into squared bias and variance
-//! (known-facts.md, "Bias vs variance"): MSE = bias^2 + variance.
+//! (FACTS.md, "Bias vs variance"): MSE = bias^2 + variance.
 //!
 //! With d_ip = x_ip - ref_p the error of seed i at pixel p and K seeds:
 //!

@@ -1,4 +1,4 @@
-//! Exact ambient occlusion next to a sphere (known-facts.md): a receiver on a plane with normal
+//! Exact ambient occlusion next to a sphere (FACTS.md): a receiver on a plane with normal
 //! n, a sphere of radius R whose centre lies at distance d and wholly above the receiver's
 //! horizon subtends a cone of half-angle alpha = asin(R / d). Its unoccluded fraction is
 //! cos(alpha) by solid angle and 1 - (R / d)^2 cos(theta) cosine-weighted, theta the angle

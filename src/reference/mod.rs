@@ -2,7 +2,7 @@
 //!
 //! [`visibility::visible_fraction`] integrates the unoccluded part of a disk light seen from a
 //! receiver point to ~1e-10; [`on_axis`] gives the closed-form umbra and penumbra radii of a
-//! sphere above a plane under a coaxial disk light (../shared/papers/known-facts.md).
+//! sphere above a plane under a coaxial disk light (FACTS.md).
 
 pub mod ambient;
 pub mod on_axis;

@@ -1,5 +1,5 @@
 //! Closed-form umbra and penumbra radii for a sphere above a plane under a coaxial disk light
-//! (known-facts.md): with phi = atan(a / (H - h)) and beta = asin(R / sqrt(a^2 + (H - h)^2)),
+//! (FACTS.md): with phi = atan(a / (H - h)) and beta = asin(R / sqrt(a^2 + (H - h)^2)),
 //! r_u = a + H tan(beta - phi) and r_p = -a + H tan(beta + phi).
 
 use crate::scene::{DiskLight, Light, Plane, Scene, Sphere};

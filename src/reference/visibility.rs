@@ -7,7 +7,7 @@
 //! the centre lies on the segment and within R"). Between consecutive roots the predicate is
 //! constant, so the inner integral of rho d rho is exact; the outer integral over theta is
 //! adaptive Gauss-Kronrod. This is the "adaptive 1-D quadrature of the chord overlap" of
-//! known-facts.md, generalised to any number of spheres and planes and to lights that touch or
+//! FACTS.md, generalised to any number of spheres and planes and to lights that touch or
 //! enter an occluder.
 
 use super::quadrature::{integrate_panels, Estimate};

@@ -186,7 +186,7 @@ impl DiskScheme {
     }
 
     /// Whether each sample is area-uniform on the disk, making the equal-weight estimator of
-    /// visibility unbiased. The paper's schemes are not: they weight the rim more (known-facts.md).
+    /// visibility unbiased. The paper's schemes are not: they weight the rim more (FACTS.md).
     pub fn is_area_uniform(self) -> bool {
         !matches!(
             self,

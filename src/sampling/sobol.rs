@@ -1,6 +1,6 @@
 //! Owen-scrambled Sobol' points in two dimensions, after Burley, "Practical Hash-based Owen
 //! Scrambling", JCGT 9(4), 2020: at 16 samples it reports about 12x lower RMSE than independent
-//! random sampling for direct lighting (../shared/papers/known-facts.md).
+//! random sampling for direct lighting (FACTS.md).
 
 /// First Sobol' dimension: the van der Corput radical inverse in base 2.
 #[inline]

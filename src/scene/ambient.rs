@@ -13,7 +13,7 @@ use std::sync::Arc;
 #[serde(rename_all = "kebab-case")]
 pub enum Weighting {
     /// The fraction of unoccluded directions, uniform by solid angle: the paper's AO. Next to
-    /// a sphere it is cos(alpha) (known-facts.md).
+    /// a sphere it is cos(alpha) (FACTS.md).
     #[default]
     Plain,
     /// The cosine-weighted unoccluded fraction, (1/pi) of the integral of V cos: the diffuse

@@ -1,5 +1,5 @@
 //! The ambient-occlusion pass (CPU): next to a sphere, disk schemes lifted to the hemisphere
-//! converge on the exact answers of known-facts.md (plain: cos(alpha); cosine-weighted:
+//! converge on the exact answers of FACTS.md (plain: cos(alpha); cosine-weighted:
 //! 1 - (R/d)^2 cos(theta)); the 513-line grid's own quadrature error is measured against them;
 //! every structure gives the same image on a triangulated sphere; the maximum distance bounds
 //! what occludes; the pass runs only where the scene asks; bad values are located errors; the

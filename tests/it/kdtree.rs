@@ -266,3 +266,43 @@ fn a_mesh_far_from_the_origin_keeps_its_tree() {
         assert_eq!(n, 0, "offset {offset}: {examples:#?}");
     }
 }
+
+/// Slivers crossing one another straddle every plane, so each leaf of a deep tree holds nearly
+/// all of them: a build over a budget of leaf entries stops and says so (instead of taking
+/// 2^depth copies of the triangles), and a build within its budget is the unbudgeted tree.
+#[test]
+fn a_tree_whose_leaves_outgrow_their_budget_is_refused() {
+    // Near-diameters of a circle of 1024 points, one from each point: every plane across the
+    // disc cuts most of them.
+    let n = 1024;
+    let at = |k: usize| {
+        let a = std::f64::consts::TAU * (k % n) as f64 / n as f64;
+        DVec3::new(a.cos(), a.sin(), 0.0)
+    };
+    let mut slivers: Vec<[DVec3; 3]> = (0..n).map(|k| [at(k), at(k + n / 2 - 1), at(k + n / 2)]).collect();
+    // One small triangle off to the side moves the median planes off the centre.
+    let off = DVec3::new(1.6, 1.3, 0.0);
+    slivers.push([off, off + DVec3::X * 0.01, off + DVec3::Y * 0.01]);
+    let crossing = tris(slivers);
+    let deep = KdSettings {
+        max_depth: 20,
+        ..KdSettings::default()
+    };
+    let Err(e) = KdTree::within(&crossing, deep, 1_000_000) else {
+        panic!("a tree over crossing slivers within a million entries");
+    };
+    assert!(
+        e.contains("more than 1000000 triangle entries") && e.contains("max_depth"),
+        "{e}"
+    );
+    let mesh = common::off_mesh("cow");
+    let settings = KdSettings::default();
+    let unbounded = KdTree::build(&mesh, settings);
+    let within = KdTree::within(&mesh, settings, 10 * mesh.positions.len() * 64).unwrap();
+    let rays = random_segments(&mesh, 2000, &mut Rng(5));
+    for &ray in &rays {
+        let (o, d, tmax, skip) = ray;
+        assert_eq!(unbounded.closest(o, d, tmax, skip), within.closest(o, d, tmax, skip));
+    }
+    assert_eq!(unbounded.stats().memory_bytes, within.stats().memory_bytes);
+}

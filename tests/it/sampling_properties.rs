@@ -124,7 +124,7 @@ fn independent_and_scrambled_samples_are_each_uniform() {
 }
 
 /// The paper's non-centre points have radius 0.3 + 0.7 sqrt(a): P(r <= x) = ((x - 0.3) / 0.7)^2 on
-/// [0.3, 1]. Kolmogorov-Smirnov against that CDF, and the known-facts numbers at 16 samples:
+/// [0.3, 1]. Kolmogorov-Smirnov against that CDF, and the FACTS.md numbers at 16 samples:
 /// 13.9 % of points inside r < 0.5 (1 + 15 (0.2/0.7)^2 of 16) and E[r^2] = 0.577.
 #[test]
 fn paper_scheme_matches_its_documented_density() {

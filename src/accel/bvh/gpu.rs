@@ -26,16 +26,23 @@ pub struct GpuNode {
 
 const _: () = assert!(std::mem::size_of::<GpuNode>() == 32);
 
+/// Why a tree `depth` levels deep has no GPU form: its walk would overflow the traversal stack.
+pub(super) fn too_deep(depth: usize) -> Option<String> {
+    let most = 2 * (STACK_SIZE / 2 - 1);
+    (depth > most).then(|| {
+        format!(
+            "the BVH is {depth} levels deep; the GPU traversal stack holds {STACK_SIZE} entries (depth {most} at most)"
+        )
+    })
+}
+
 /// Node bounds converted through f64 and widened by a few f32 ulps so that no triangle pokes out
 /// of its node after rounding; triangles laid out in leaf order (obvhs' `primitive_indices`), so
 /// leaves index them directly. Fails where the tree is deeper than the traversal stack.
 pub(super) fn structure(bvh: &Bvh, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
-    anyhow::ensure!(
-        bvh.depth <= 2 * (STACK_SIZE / 2 - 1),
-        "the BVH is {} levels deep; the GPU traversal stack holds {STACK_SIZE} entries (depth {} at most)",
-        bvh.depth,
-        2 * (STACK_SIZE / 2 - 1)
-    );
+    if let Some(refusal) = too_deep(bvh.depth) {
+        anyhow::bail!("{refusal}");
+    }
     let to_local = |p: glam::Vec3A| frame.point_f64(glam::Vec3::from(p).as_dvec3() + bvh.centre);
     let nodes: Vec<GpuNode> = bvh
         .tree

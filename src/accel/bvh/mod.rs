@@ -434,6 +434,10 @@ impl Accelerator for Bvh {
         gpu::structure(self, frame)
     }
 
+    fn gpu_refusal(&self) -> Option<String> {
+        gpu::too_deep(self.depth)
+    }
+
     /// A refit keeps the tree's topology (cheap; the tree decays as things move); a rebuild
     /// with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
     /// frame (the fastest tree to build, slower to walk).

@@ -210,6 +210,10 @@ impl Cwbvh {
     }
 }
 
+/// Why the compressed wide BVH has no GPU form.
+const NO_GPU: &str = "the acceleration structure `cwbvh` has no GPU traversal (obvhs' compressed wide BVH is \
+                      walked on the CPU only): render it with the CPU backend (--backend cpu)";
+
 impl Accelerator for Cwbvh {
     fn name(&self) -> &'static str {
         "cwbvh"
@@ -245,10 +249,11 @@ impl Accelerator for Cwbvh {
     }
 
     fn gpu(&self, _frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
-        anyhow::bail!(
-            "the acceleration structure `cwbvh` has no GPU traversal (obvhs' compressed wide BVH is \
-             walked on the CPU only): render it with the CPU backend (--backend cpu)"
-        )
+        anyhow::bail!("{}", NO_GPU)
+    }
+
+    fn gpu_refusal(&self) -> Option<String> {
+        Some(NO_GPU.into())
     }
 
     fn update(

@@ -23,6 +23,9 @@ fn node(
     bounds: (DVec3, DVec3),
     depth: u32,
 ) {
+    if layout.overflowed {
+        return layout.leaf(at, &[], depth);
+    }
     let split = (tris.len() > settings.leaf_size as usize && depth < settings.max_depth)
         .then(|| split(layout, boxes, &tris, bounds))
         .flatten();

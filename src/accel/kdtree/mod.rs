@@ -47,6 +47,9 @@ pub const GPU_BUFFERS: u32 = 4;
 /// Deepest tree the walk's stack (64 entries on the CPU and the GPU) allows.
 pub const MAX_DEPTH: u32 = 60;
 
+/// Most leaf entries a tree may hold: a leaf starts at a u32 index into them.
+pub const MAX_ENTRIES: usize = u32::MAX as usize;
+
 /// One node, 8 bytes (see the module doc).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -116,15 +119,23 @@ struct Layout {
     nodes: Vec<KdNode>,
     items: Vec<u32>,
     depth: u32,
+    /// Most leaf entries the tree may hold; past it the build stops ([`Layout::overflowed`]).
+    budget: usize,
+    /// Whether a leaf would have taken the entries past `budget`: triangles that straddle every
+    /// plane (slivers crossing one another) are copied into every leaf, and a deep tree over
+    /// them would hold 2^depth copies.
+    overflowed: bool,
 }
 
 impl Layout {
-    fn new(origin: DVec3) -> Layout {
+    fn new(origin: DVec3, budget: usize) -> Layout {
         Layout {
             origin,
             nodes: vec![KdNode::zeroed()],
             items: Vec::new(),
             depth: 0,
+            budget,
+            overflowed: false,
         }
     }
 
@@ -138,6 +149,11 @@ impl Layout {
     /// Makes node `at` a leaf holding `tris`.
     fn leaf(&mut self, at: usize, tris: &[u32], depth: u32) {
         self.depth = self.depth.max(depth);
+        if self.overflowed || self.items.len() + tris.len() > self.budget {
+            self.overflowed = true;
+            self.nodes[at] = KdNode::leaf(self.items.len(), 0);
+            return;
+        }
         self.nodes[at] = KdNode::leaf(self.items.len(), tris.len());
         self.items.extend_from_slice(tris);
     }
@@ -169,6 +185,12 @@ impl KdTree {
     /// the planes `settings.split` chooses, no deeper than [`MAX_DEPTH`] whatever `settings` ask
     /// (the walks' stacks hold that much).
     pub fn build(triangles: &Triangles, settings: KdSettings) -> KdTree {
+        Self::within(triangles, settings, MAX_ENTRIES).expect("a tree within the entries a leaf can index")
+    }
+
+    /// [`KdTree::build`], refused once its leaves would hold more than `budget` entries (4 bytes
+    /// each), as triangles straddling every plane make them: the build stops there and says so.
+    pub fn within(triangles: &Triangles, settings: KdSettings, budget: usize) -> Result<KdTree, String> {
         let started = Instant::now();
         let settings = KdSettings {
             max_depth: settings.max_depth.min(MAX_DEPTH),
@@ -180,12 +202,22 @@ impl KdTree {
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| {
                 (lo.min(*a), hi.max(*b))
             });
-        let mut layout = Layout::new(bounds.0);
+        let budget = budget.min(MAX_ENTRIES);
+        let mut layout = Layout::new(bounds.0, budget);
         match settings.split {
             Split::Median => median::build(&mut layout, &boxes, bounds, &settings),
             Split::Sah => sah::build(&mut layout, &triangles.positions, &boxes, bounds, &settings),
         }
-        KdTree {
+        if layout.overflowed {
+            return Err(format!(
+                "the kd-tree ({}) over {} triangles would hold more than {budget} triangle entries ({:.1} GB) in its leaves: \
+                 its triangles straddle the planes at every depth (slivers crossing one another); lower `max_depth`",
+                settings.describe(),
+                triangles.positions.len(),
+                budget as f64 * 4.0 / 1e9
+            ));
+        }
+        Ok(KdTree {
             nodes: layout.nodes,
             items: layout.items,
             bounds,
@@ -194,7 +226,7 @@ impl KdTree {
             settings,
             build_time: started.elapsed(),
             name: "kdtree",
-        }
+        })
     }
 
     /// The same tree under another registry name (`kdtree-sah`, the SAH tree registered beside

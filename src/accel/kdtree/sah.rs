@@ -84,6 +84,9 @@ pub(super) fn build(
 impl Builder<'_> {
     /// Fills node `at` (already allocated) for `tris`, each with its bounds clipped to `bounds`.
     fn node(&mut self, at: usize, tris: Vec<(u32, Aabb)>, bounds: Aabb, depth: u32) {
+        if self.layout.overflowed {
+            return self.layout.leaf(at, &[], depth);
+        }
         let n = tris.len();
         let plane = (n > self.settings.leaf_size as usize && depth < self.settings.max_depth)
             .then(|| self.best_plane(&tris, bounds))

@@ -1,5 +1,5 @@
-//! A visibility field (VLF-RT: Mortensen, Khanna, Yu, Slater 2007; summary in
-//! `shared/papers/visibility-field-ray-tracing.md`): for each of a fixed set of directions
+//! A visibility field (VLF-RT: Mortensen, Khanna, Yu, Slater, "A Visibility Field for Ray
+//! Tracing", 2007): for each of a fixed set of directions
 //! (lines), the scene seen along that direction through `n x n` parallel beams (a parallel
 //! subfield), each beam listing the triangles it meets, partitioned along the beam by a 1-D tile
 //! BSP. A query picks the nearest stored direction in constant time, walks the few tiles its

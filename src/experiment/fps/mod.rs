@@ -36,12 +36,11 @@ impl Experiment for FpsSpec {
         v
     }
 
-    fn scenes(&self) -> Vec<(&std::path::Path, &crate::scene::Scene)> {
+    fn gpu_gap(&self) -> Option<String> {
         self.scene_paths
             .iter()
-            .map(PathBuf::as_path)
-            .zip(self.scenes.iter().map(|s| &s.scene))
-            .collect()
+            .zip(&self.scenes)
+            .find_map(|(path, s)| crate::experiment::scene_gpu_gap(path, &s.scene))
     }
 
     fn dry_run(&self, _cli: &Cli) -> anyhow::Result<String> {

@@ -43,8 +43,18 @@ impl Experiment for Spec {
         v
     }
 
-    fn scenes(&self) -> Vec<(&Path, &crate::scene::Scene)> {
-        vec![(self.scene_path.as_path(), &self.scene)]
+    fn gpu_gap(&self) -> Option<String> {
+        if let Some(gap) = crate::experiment::scene_gpu_gap(&self.scene_path, &self.scene) {
+            return Some(gap);
+        }
+        self.axes.accelerators.iter().enumerate().find_map(|(i, name)| {
+            let refusal = self.structures.get(name)?.as_ref()?.gpu_refusal()?;
+            Some(if *name == self.scene.accel_settings.name {
+                format!("{}: key `accelerator`: {refusal}", self.scene_path.display())
+            } else {
+                format!("{}: key `sweep.accelerators[{i}]`: {refusal}", self.path.display())
+            })
+        })
     }
 
     fn dry_run(&self, cli: &Cli) -> anyhow::Result<String> {

@@ -55,11 +55,14 @@ fn differing_fields(a: &str, b: &str) -> Vec<String> {
     out
 }
 
-/// Reads the shard in `dir`, or says why it cannot be taken.
+/// Reads the shard in `dir` (a folder of folders and regular files only), or says why it cannot
+/// be taken.
 fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<ShardFiles, String> {
     if !dir.is_dir() {
         return Err(format!("{}: no such shard folder", dir.display()));
     }
+    // A shard is read back whole: a link or pipe in it would read outside it or block.
+    crate::files::check_plain_tree(dir).map_err(|e| e.to_string())?;
     let manifest_path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&manifest_path)
         .map_err(|_| format!("{}: no {MANIFEST}: the shard has not finished", dir.display()))?;

@@ -28,6 +28,15 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
     ] {
         files_in(dir, sub, suffix)?;
     }
+    for written in ["index.html", "page_data.js"] {
+        if std::fs::symlink_metadata(dir.join(written)).is_ok_and(|m| m.is_dir()) {
+            return Err(Refused(format!(
+                "{}: a folder where the page is written; refused",
+                dir.join(written).display()
+            ))
+            .into());
+        }
+    }
     let report = read_regular_text(&dir.join("report.md"))?;
     let mut galleries: Vec<Gallery> = Vec::new();
     // Each gallery's family: a strip's frames (`strip_SHADING_FRAME`) are one gallery per strip,
