@@ -173,15 +173,41 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
     }
 
     /// The ways it can follow triangles that moved, its own first (a field's update in place,
-    /// paper Section 8; a BVH's refit; a rebuild): the names [`Accelerator::update`] takes.
-    fn updates(&self) -> &'static [&'static str] {
-        &["rebuild"]
+    /// paper Section 8; a BVH's refit; a rebuild): what [`Accelerator::update`] takes.
+    fn updates(&self) -> &'static [UpdateMethod] {
+        &[UpdateMethod::Rebuild]
     }
 
     /// Brings it up to date after the triangles of `object` moved by `step` (the scene's
     /// triangles are now `moved`, same count and order), by `method`, one of
     /// [`Accelerator::updates`]; says what it did.
-    fn update(&mut self, method: &str, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<Updated>;
+    fn update(&mut self, method: UpdateMethod, moved: &Triangles, object: u32, step: DVec3) -> anyhow::Result<Updated>;
+}
+
+/// A way a structure follows triangles that moved ([`Accelerator::updates`] lists a
+/// structure's); its name is the `update` column of the frames kind's tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpdateMethod {
+    /// The structure's own change in place (the visibility field's, paper Section 8).
+    InPlace,
+    /// New bounds over the same topology (a BVH's refit).
+    Refit,
+    /// Built again with its own parameters.
+    Rebuild,
+    /// Built again with obvhs' fastest preset: what an engine would do every frame.
+    RebuildFastest,
+}
+
+impl UpdateMethod {
+    /// `update`, `refit`, `rebuild`, `rebuild-fastest`.
+    pub fn name(self) -> &'static str {
+        match self {
+            UpdateMethod::InPlace => "update",
+            UpdateMethod::Refit => "refit",
+            UpdateMethod::Rebuild => "rebuild",
+            UpdateMethod::RebuildFastest => "rebuild-fastest",
+        }
+    }
 }
 
 /// What an update of moved triangles did to a structure.
@@ -207,11 +233,13 @@ impl Updated {
 }
 
 /// Refuses an update method a structure does not offer.
-pub(crate) fn unknown_update(structure: &dyn Accelerator, method: &str) -> anyhow::Error {
+pub(crate) fn unknown_update(structure: &dyn Accelerator, method: UpdateMethod) -> anyhow::Error {
+    let offered: Vec<&str> = structure.updates().iter().map(|m| m.name()).collect();
     anyhow::anyhow!(
-        "{} cannot update by `{method}`; it offers {}",
+        "{} cannot update by `{}`; it offers {}",
         structure.name(),
-        structure.updates().join(", ")
+        method.name(),
+        offered.join(", ")
     )
 }
 

@@ -11,6 +11,7 @@
 
 pub mod ao;
 pub mod cli;
+pub mod comparison;
 pub mod driver;
 pub mod fps;
 pub mod frames;
@@ -125,30 +126,4 @@ pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
         Kind::Ao => Box::new(ao::AoSpec::from_source(&source, header)?),
         Kind::Frames => Box::new(frames::FramesSpec::from_source(&source, header)?),
     })
-}
-
-/// The registered structures an experiment's `structures` list names, each once; an unknown or
-/// repeated name is an error at its place in the list.
-pub(crate) fn structure_names(source: &Source, names: &[String]) -> Result<Vec<&'static str>, ConfigError> {
-    if names.is_empty() {
-        return Err(source.error(&crate::key_path!["structures"], "name at least one structure"));
-    }
-    let mut out = Vec::new();
-    for (i, s) in names.iter().enumerate() {
-        let at = crate::key_path!["structures", i];
-        let r = crate::accel::registered(s).ok_or_else(|| {
-            source.error(
-                &at,
-                format!(
-                    "unknown acceleration structure `{s}`; known: {}",
-                    crate::accel::names().join(", ")
-                ),
-            )
-        })?;
-        if out.contains(&r.name) {
-            return Err(source.error(&at, format!("`{s}` is listed twice")));
-        }
-        out.push(r.name);
-    }
-    Ok(out)
 }

@@ -349,7 +349,7 @@ impl penumbra::accel::Accelerator for Renamed {
     }
     fn update(
         &mut self,
-        _: &str,
+        _: penumbra::accel::UpdateMethod,
         _: &penumbra::mesh::Triangles,
         _: u32,
         _: DVec3,

@@ -97,13 +97,13 @@ impl Accelerator for Brute {
 
     fn update(
         &mut self,
-        method: &str,
+        method: super::UpdateMethod,
         moved: &Triangles,
         _object: u32,
         _step: DVec3,
     ) -> anyhow::Result<super::Updated> {
         match method {
-            "rebuild" => *self = Brute::build(moved),
+            super::UpdateMethod::Rebuild => *self = Brute::build(moved),
             m => return Err(super::unknown_update(self, m)),
         }
         Ok(super::Updated::Rebuilt)

@@ -441,27 +441,29 @@ impl Accelerator for Bvh {
     /// A refit keeps the tree's topology (cheap; the tree decays as things move); a rebuild
     /// with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
     /// frame (the fastest tree to build, slower to walk).
-    fn updates(&self) -> &'static [&'static str] {
-        &["refit", "rebuild", "rebuild-fastest"]
+    fn updates(&self) -> &'static [super::UpdateMethod] {
+        use super::UpdateMethod::*;
+        &[Refit, Rebuild, RebuildFastest]
     }
 
     fn update(
         &mut self,
-        method: &str,
+        method: super::UpdateMethod,
         moved: &Triangles,
         _object: u32,
         _step: DVec3,
     ) -> anyhow::Result<super::Updated> {
+        use super::UpdateMethod::*;
         Ok(match method {
-            "refit" => {
+            Refit => {
                 self.refit(moved);
                 super::Updated::Refit
             }
-            "rebuild" => {
+            Rebuild => {
                 *self = Bvh::build(moved, self.preset);
                 super::Updated::Rebuilt
             }
-            "rebuild-fastest" => {
+            RebuildFastest => {
                 *self = Bvh::build(moved, Preset::Fastest);
                 super::Updated::Rebuilt
             }

@@ -258,13 +258,13 @@ impl Accelerator for Cwbvh {
 
     fn update(
         &mut self,
-        method: &str,
+        method: super::UpdateMethod,
         moved: &Triangles,
         _object: u32,
         _step: DVec3,
     ) -> anyhow::Result<super::Updated> {
         match method {
-            "rebuild" => *self = Cwbvh::build(moved, self.preset),
+            super::UpdateMethod::Rebuild => *self = Cwbvh::build(moved, self.preset),
             m => return Err(super::unknown_update(self, m)),
         }
         Ok(super::Updated::Rebuilt)

@@ -305,13 +305,13 @@ impl Accelerator for KdTree {
 
     fn update(
         &mut self,
-        method: &str,
+        method: crate::accel::UpdateMethod,
         moved: &Triangles,
         _object: u32,
         _step: DVec3,
     ) -> anyhow::Result<crate::accel::Updated> {
         match method {
-            "rebuild" => *self = KdTree::build(moved, self.settings).named(self.name),
+            crate::accel::UpdateMethod::Rebuild => *self = KdTree::build(moved, self.settings).named(self.name),
             m => return Err(crate::accel::unknown_update(self, m)),
         }
         Ok(crate::accel::Updated::Rebuilt)

@@ -352,20 +352,20 @@ impl Accelerator for VisibilityField {
 
     /// Its own update (paper Section 8): the object's ids removed from every tile it covered
     /// and inserted again where it now is.
-    fn updates(&self) -> &'static [&'static str] {
-        &["update"]
+    fn updates(&self) -> &'static [crate::accel::UpdateMethod] {
+        &[crate::accel::UpdateMethod::InPlace]
     }
 
     /// The field moves its own copy of the object; the scene's moved triangles must be that
     /// copy, bit for bit, or the field would answer for triangles the scene no longer has.
     fn update(
         &mut self,
-        method: &str,
+        method: crate::accel::UpdateMethod,
         moved: &Triangles,
         object: u32,
         step: DVec3,
     ) -> anyhow::Result<crate::accel::Updated> {
-        if method != "update" {
+        if method != crate::accel::UpdateMethod::InPlace {
             return Err(crate::accel::unknown_update(self, method));
         }
         self.move_object(object, |p| p + step)?;

@@ -2,9 +2,10 @@
 //! into the unit ball and seen by a camera that frames the ball, AO along the visibility field's
 //! grid lines from every camera hit (the visibility-field paper's Table 1 set-up).
 
-use crate::accel::settings::{candidates, read_tables};
+use crate::accel::settings::candidates;
 use crate::accel::{AccelSettings, Issue};
 use crate::config::{ConfigError, Source};
+use crate::experiment::comparison::{Claim, Comparison};
 use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
 use crate::mesh::file::MAX_FILE_TRIANGLES;
@@ -37,17 +38,6 @@ crate::experiment_file! {
 
 fn single() -> Vec<Issue> {
     vec![Issue::Single]
-}
-
-/// The paper's claim the verdict answers: `subject` renders faster than `baseline` (both among
-/// `structures`); every other structure is set against `subject` too.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Claim {
-    /// The structure the paper proposes.
-    pub subject: String,
-    /// The paper's baseline.
-    pub baseline: String,
 }
 
 /// The small tuning sweep run per mesh before the timed frames, as the paper tuned each method
@@ -222,25 +212,10 @@ impl AoSpec {
                 ),
             ));
         }
-        let mut given = read_tables(source, &key_path!["accel"], &f.accel, true)?;
-        let names = crate::experiment::structure_names(source, &f.structures)?;
-        if let Some(extra) = given.keys().find(|k| !names.contains(k)) {
-            return Err(err(
-                &key_path!["accel", *extra],
-                format!("`{extra}` is not among `structures`"),
-            ));
-        }
-        for (k, v) in [("subject", &f.claim.subject), ("baseline", &f.claim.baseline)] {
-            if !names.contains(&v.as_str()) {
-                return Err(err(&key_path!["claim", k], format!("`{v}` is not among `structures`")));
-            }
-        }
-        if f.claim.subject == f.claim.baseline {
-            return Err(err(
-                &key_path!["claim", "baseline"],
-                "must differ from `subject`".into(),
-            ));
-        }
+        let Comparison {
+            names,
+            tables: mut given,
+        } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
         let structures: Vec<(&'static str, Vec<AccelSettings>)> = names
             .into_iter()
             .map(|name| {

@@ -12,7 +12,7 @@
 
 use super::spec::{FramesSpec, ShadingName};
 use crate::accel::work::Work;
-use crate::accel::{AccelSettings, Updated};
+use crate::accel::{AccelSettings, UpdateMethod, Updated};
 use crate::experiment::progress::Progress;
 use crate::mesh::Triangles;
 use crate::metrics::stats::median;
@@ -105,8 +105,8 @@ pub struct FramesOutcome {
 /// One structure's scene, and how it follows motion.
 struct Variant {
     structure: &'static str,
-    /// An update method of the structure, or `none` for static scenes.
-    update: &'static str,
+    /// How the structure follows motion (none for static scenes).
+    update: Option<UpdateMethod>,
     scene: Scene,
 }
 
@@ -119,7 +119,12 @@ impl Variant {
         let start = Instant::now();
         let did = Arc::get_mut(&mut accel)
             .expect("a variant's structure is its own")
-            .update(self.update, moved, object, step)?;
+            .update(
+                self.update.expect("only variants of a moving scene are updated"),
+                moved,
+                object,
+                step,
+            )?;
         let took = start.elapsed();
         self.scene.accel = Some(accel);
         self.scene.triangles.positions.clone_from(&moved.positions);
@@ -146,13 +151,13 @@ fn variants(spec: &FramesSpec, generated: &Generated) -> anyhow::Result<(Vec<Var
         if spec.motion.is_none() {
             out.push(Variant {
                 structure: settings.name,
-                update: "none",
+                update: None,
                 scene,
             });
             continue;
         }
         let methods = accel.updates();
-        for (k, &update) in methods.iter().enumerate() {
+        for (k, &method) in methods.iter().enumerate() {
             let scene = if k + 1 == methods.len() {
                 scene.clone()
             } else {
@@ -160,7 +165,7 @@ fn variants(spec: &FramesSpec, generated: &Generated) -> anyhow::Result<(Vec<Var
             };
             out.push(Variant {
                 structure: settings.name,
-                update,
+                update: Some(method),
                 scene,
             });
         }
@@ -264,7 +269,7 @@ pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progr
                         outcome.frames.push(FrameRow {
                             triangles,
                             structure: v.structure,
-                            update: v.update,
+                            update: v.update.map_or("none", UpdateMethod::name),
                             shading: name,
                             viewpoint: viewpoint.clone(),
                             frame,

@@ -5,9 +5,9 @@
 //! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part
 //! moves every frame and each structure is updated before rendering it).
 
-use crate::accel::settings::read_tables;
 use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
+use crate::experiment::comparison::{Claim, Comparison};
 use crate::experiment::header::Header;
 use crate::key_path;
 use crate::scene::load::MAX_EXTENT;
@@ -36,17 +36,6 @@ crate::experiment_file! {
         #[serde(default = "six")]
         strip: u32,
     }
-}
-
-/// The paper's claim the verdict answers: `subject` renders (or, with motion, updates) faster
-/// than `baseline`; every other structure is set against `subject` too.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Claim {
-    /// The structure the paper proposes.
-    pub subject: String,
-    /// The paper's baseline.
-    pub baseline: String,
 }
 
 /// Most frames per viewpoint a path may have.
@@ -191,25 +180,7 @@ impl FramesSpec {
                 format!("must be in 1..={}, got {}", Shading::MAX_MIRROR_DEPTH, f.mirror_depth),
             ));
         }
-        let given = read_tables(source, &key_path!["accel"], &f.accel, false)?;
-        let names = crate::experiment::structure_names(source, &f.structures)?;
-        if let Some(extra) = given.keys().find(|k| !names.contains(k)) {
-            return Err(err(
-                &key_path!["accel", *extra],
-                format!("`{extra}` is not among `structures`"),
-            ));
-        }
-        for (k, v) in [("subject", &f.claim.subject), ("baseline", &f.claim.baseline)] {
-            if !names.contains(&v.as_str()) {
-                return Err(err(&key_path!["claim", k], format!("`{v}` is not among `structures`")));
-            }
-        }
-        if f.claim.subject == f.claim.baseline {
-            return Err(err(
-                &key_path!["claim", "baseline"],
-                "must differ from `subject`".into(),
-            ));
-        }
+        let Comparison { names, tables: given } = Comparison::read(source, &f.structures, &f.accel, &f.claim, false)?;
         let structures: Vec<AccelSettings> = names
             .into_iter()
             .map(|name| match given.get(name) {

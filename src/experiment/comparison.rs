@@ -1,0 +1,88 @@
+//! The part of an experiment that sets acceleration structures against one another, read the
+//! same way by every kind that has one (ao, frames): the `structures` list, each structure's
+//! `[accel.NAME]` table and the paper's `[claim]`.
+
+use crate::accel::settings::read_tables;
+use crate::accel::AccelSettings;
+use crate::config::{ConfigError, Source};
+use crate::key_path;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// The paper's claim the verdict answers: `subject` is faster than `baseline` (both among
+/// `structures`); every other structure is set against `subject` too.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Claim {
+    /// The structure the paper proposes.
+    pub subject: String,
+    /// The paper's baseline.
+    pub baseline: String,
+}
+
+/// The structures an experiment compares, read and checked together.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    /// The registered structures, in the order listed.
+    pub names: Vec<&'static str>,
+    /// The `[accel.NAME]` tables given, each a listed structure's settings (with `lists`, every
+    /// candidate its lists spell out).
+    pub tables: BTreeMap<&'static str, Vec<AccelSettings>>,
+}
+
+impl Comparison {
+    /// Reads `structures` (registered names, each once), the `[accel]` tables (each naming a
+    /// listed structure; with `lists`, values may be lists of candidates to tune over) and checks
+    /// that `claim` names two different listed structures; every error at its key.
+    pub fn read(
+        source: &Source,
+        structures: &[String],
+        accel: &BTreeMap<String, toml::Table>,
+        claim: &Claim,
+        lists: bool,
+    ) -> Result<Comparison, ConfigError> {
+        let tables = read_tables(source, &key_path!["accel"], accel, lists)?;
+        let names = structure_names(source, structures)?;
+        if let Some(extra) = tables.keys().find(|k| !names.contains(k)) {
+            return Err(source.error(
+                &key_path!["accel", *extra],
+                format!("`{extra}` is not among `structures`"),
+            ));
+        }
+        for (k, v) in [("subject", &claim.subject), ("baseline", &claim.baseline)] {
+            if !names.contains(&v.as_str()) {
+                return Err(source.error(&key_path!["claim", k], format!("`{v}` is not among `structures`")));
+            }
+        }
+        if claim.subject == claim.baseline {
+            return Err(source.error(&key_path!["claim", "baseline"], "must differ from `subject`"));
+        }
+        Ok(Comparison { names, tables })
+    }
+}
+
+/// The registered structures a `structures` list names, each once; an unknown or repeated name
+/// is an error at its place in the list.
+fn structure_names(source: &Source, names: &[String]) -> Result<Vec<&'static str>, ConfigError> {
+    if names.is_empty() {
+        return Err(source.error(&key_path!["structures"], "name at least one structure"));
+    }
+    let mut out = Vec::new();
+    for (i, s) in names.iter().enumerate() {
+        let at = key_path!["structures", i];
+        let r = crate::accel::registered(s).ok_or_else(|| {
+            source.error(
+                &at,
+                format!(
+                    "unknown acceleration structure `{s}`; known: {}",
+                    crate::accel::names().join(", ")
+                ),
+            )
+        })?;
+        if out.contains(&r.name) {
+            return Err(source.error(&at, format!("`{s}` is listed twice")));
+        }
+        out.push(r.name);
+    }
+    Ok(out)
+}
