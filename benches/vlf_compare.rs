@@ -413,11 +413,6 @@ fn bytes(m: &Mesh) -> [usize; 7] {
 
 const MESHES: [&str; 4] = ["cow", "bull", "man", "body"];
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The values of `--flag a,b,c`, or `all` where the flag is absent.
 fn listed<'a>(flag: &str, all: &[&'a str]) -> Vec<&'a str> {
     let args: Vec<String> = std::env::args().collect();
@@ -685,7 +680,7 @@ fn tune_kdtree() {
                     t.elapsed().as_secs_f64()
                 })
                 .collect();
-            let rate = rays.len() as f64 / median(times) / 1e6;
+            let rate = rays.len() as f64 / penumbra::metrics::stats::median(&times) / 1e6;
             let tree = if sah { &m.kd_sah } else { &m.kd };
             let stats = penumbra::accel::Accelerator::stats(tree);
             println!(
