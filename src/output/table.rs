@@ -5,11 +5,13 @@
 //! the same.
 
 use crate::files::write_atomic;
+use anyhow::Context;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::fmt::Display;
-use std::fs::{self, OpenOptions};
+use std::fs::OpenOptions;
 use std::io::Write;
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -22,15 +24,21 @@ pub fn write_rows<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T>) 
     write_atomic(path, &w.into_inner()?)
 }
 
-/// Appends `rows` to the CSV file at `path` (a new file gets the header first) and flushes them
-/// to disk.
+/// Appends `rows` to the CSV file at `path` (a new file gets the header first; a symbolic link
+/// there is refused) and flushes them to disk.
 pub fn append_rows<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T>) -> anyhow::Result<()> {
     let new = !path.exists();
     let mut w = csv::WriterBuilder::new().has_headers(new).from_writer(Vec::new());
     for r in rows {
         w.serialize(r)?;
     }
-    let mut f = OpenOptions::new().create(true).append(true).open(path)?;
+    // Never through a link planted at the journal's path while the run goes on.
+    let mut f = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(path)
+        .with_context(|| format!("appending to {}", path.display()))?;
     f.write_all(&w.into_inner()?)?;
     f.sync_data()?;
     Ok(())
@@ -40,7 +48,7 @@ pub fn append_rows<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T>)
 /// file or another header gives none; a torn last line (from a crash) and rows that do not read
 /// as a `T` are dropped. Rows are read by position, so that rows made of parts read back.
 pub fn read_rows<T: Serialize + DeserializeOwned>(path: &Path) -> Vec<T> {
-    let Ok(text) = fs::read_to_string(path) else {
+    let Ok(text) = crate::files::read_regular_text(path) else {
         return vec![];
     };
     let complete = &text[..text.rfind('\n').map_or(0, |i| i + 1)];
@@ -144,6 +152,7 @@ pub mod text {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
     struct Head {
@@ -202,5 +211,24 @@ mod tests {
         fs::write(&path, "key,z\na,1\n").unwrap();
         assert!(read_rows::<Head>(&path).is_empty());
         assert!(read_rows::<Head>(&dir.path().join("missing.csv")).is_empty());
+    }
+
+    #[test]
+    fn an_append_through_a_planted_link_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (outside, path) = (dir.path().join("outside.csv"), dir.path().join("t.csv"));
+        fs::write(&outside, "theirs\n").unwrap();
+        std::os::unix::fs::symlink(&outside, &path).unwrap();
+        let e = append_rows(
+            &path,
+            [Head {
+                key: "a".into(),
+                x: 1.0,
+            }],
+        )
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("t.csv"), "{e:#}");
+        assert_eq!(fs::read_to_string(&outside).unwrap(), "theirs\n");
+        assert!(read_rows::<Head>(&path).is_empty(), "nothing read through the link");
     }
 }
