@@ -148,9 +148,10 @@ fn run_into(
 fn backend_for(experiment: &dyn Experiment, choice: BackendChoice) -> Result<BackendChoice, BadInput> {
     Ok(match (choice, experiment.gpu_gap()) {
         (BackendChoice::Gpu, Some(gap)) => {
+            let instead = "use backend = \"cpu\" or \"auto\"";
             return Err(BadInput(format!(
-            "{gap}; --backend gpu (or backend = \"gpu\") cannot run this experiment: use backend = \"cpu\" or \"auto\""
-        )))
+                "{gap}; --backend gpu (or backend = \"gpu\") cannot run this experiment: {instead}"
+            )));
         }
         (BackendChoice::Auto, Some(gap)) => {
             info!("backend auto: the f64 CPU backend, because {gap}");
