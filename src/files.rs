@@ -147,8 +147,8 @@ fn describe(kind: std::fs::FileType) -> &'static str {
 }
 
 /// A word from an input file as an error message may show it: quoted when it reads as a number
-/// (digits, sign, point, exponent, or `nan` and `inf`), else only described. Naming the wrong file (a points path
-/// that reaches a system file) then never prints what that file holds.
+/// (digits, sign, point, exponent, or `nan` and `inf`), else only described. Naming the wrong
+/// file (a points path that reaches a system file) then never prints what that file holds.
 pub fn shown(word: &str) -> String {
     let numeric = !word.is_empty()
         && word.len() <= 32

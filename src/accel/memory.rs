@@ -29,8 +29,8 @@ impl Budget {
 /// The smallest of the limits a build runs into: the memory the system has free
 /// (`MemAvailable` in /proc/meminfo), what the process's address-space limit (`RLIMIT_AS`, as
 /// `ulimit -v` sets it) leaves above what it already maps, what its control group's memory
-/// limit leaves above its usage (a container's or a batch job's share), and the environment's `PENUMBRA_MEMORY_BYTES` (a share stated by hand); `None` where
-/// none says. A build past any of them aborts the process, so each is checked before one starts.
+/// limit leaves above its usage (a container's or a batch job's share), and the environment's
+/// `PENUMBRA_MEMORY_BYTES` (a share stated by hand); `None` where none says. A build past any of them aborts the process, so each is checked before one starts.
 pub fn available() -> Option<Budget> {
     smallest([
         mem_available().map(|b| Budget::new(b, "the memory the system has available (MemAvailable)")),

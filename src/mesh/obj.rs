@@ -1,7 +1,7 @@
 //! A Wavefront OBJ reader for triangle meshes: `v` positions, `f` faces (any of the `v`,
 //! `v/vt`, `v//vn`, `v/vt/vn` forms, negative indices relative to the end), `g`/`o` groups.
-//! Polygons are split into triangles ([`MeshFile::push_face`]). Everything else (normals, texture coordinates,
-//! materials) is ignored. Errors name the file and line.
+//! Polygons are split into triangles ([`MeshFile::push_face`]). Everything else (normals,
+//! texture coordinates, materials) is ignored. Errors name the file and line.
 
 use super::file::{coordinate, face_fits, MeshFile, MeshFileError, MAX_FACE_CORNERS};
 use std::collections::HashMap;

@@ -1,8 +1,8 @@
 //! An Object File Format (OFF) reader: the `OFF` header, `vertices faces edges`, then vertex
 //! positions and faces as `n i0 .. i(n-1)` with zero-based indices. Colours after a vertex's
 //! three coordinates or a face's indices are ignored; `#` starts a comment. Polygons are split
-//! into triangles ([`MeshFile::push_face`]). OFF has no groups: every face is in group `default`. Errors name the file
-//! and line.
+//! into triangles ([`MeshFile::push_face`]). OFF has no groups: every face is in group
+//! `default`. Errors name the file and line.
 
 use super::file::{coordinate, face_fits, MeshFile, MeshFileError};
 use std::path::Path;
