@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# A sweep as N shards run by GNU parallel, on this machine or over ssh hosts, then merged here:
+# An experiment (any kind) as N shards run by GNU parallel, on this machine or over ssh hosts,
+# then merged here:
 #
 #   scripts/parallel.sh EXPERIMENT N [SWEEP OPTIONS...]
 #

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Submits a sweep to Slurm as a job array of N shards and a merge that runs after all of them:
+# Submits an experiment (any kind) to Slurm as a job array of N shards and a merge that runs
+# after all of them:
 #
 #   scripts/slurm/submit.sh EXPERIMENT N [SWEEP OPTIONS...]
 #

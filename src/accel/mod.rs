@@ -199,6 +199,14 @@ pub enum UpdateMethod {
 }
 
 impl UpdateMethod {
+    /// Every way, in the order structures list theirs.
+    pub const ALL: [UpdateMethod; 4] = [
+        UpdateMethod::InPlace,
+        UpdateMethod::Refit,
+        UpdateMethod::Rebuild,
+        UpdateMethod::RebuildFastest,
+    ];
+
     /// `update`, `refit`, `rebuild`, `rebuild-fastest`.
     pub fn name(self) -> &'static str {
         match self {
@@ -211,7 +219,7 @@ impl UpdateMethod {
 }
 
 /// What an update of moved triangles did to a structure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Updated {
     /// Kept its topology and refitted its bounds (a BVH refit).
     Refit,

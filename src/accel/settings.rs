@@ -48,6 +48,50 @@ pub struct AccelSettings {
     params: toml::Table,
 }
 
+/// Settings journaled with a unit's outcome: the name and the parameters, validated again when
+/// read back.
+impl serde::Serialize for AccelSettings {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("AccelSettings", 2)?;
+        st.serialize_field("name", self.name)?;
+        st.serialize_field("params", &self.params)?;
+        st.end()
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for AccelSettings {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<AccelSettings, D::Error> {
+        #[derive(serde::Deserialize)]
+        struct Raw {
+            name: String,
+            params: toml::Table,
+        }
+        let raw = Raw::deserialize(d)?;
+        AccelSettings::with(&raw.name, &raw.params).map_err(serde::de::Error::custom)
+    }
+}
+
+/// A structure's registry name, as rows carry it (one of the registry's own strings).
+pub type RegistryName = &'static str;
+
+/// Serde for a structure's registry name held as `&'static str` (rows journaled by the
+/// experiment core): read back as the registry's own name, or refused.
+pub mod registry_name {
+    /// Writes the name.
+    pub fn serialize<S: serde::Serializer>(name: &&'static str, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(name)
+    }
+
+    /// Reads a registered name.
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
+        let name = <String as serde::Deserialize>::deserialize(d)?;
+        super::registered(&name)
+            .map(|r| r.name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown acceleration structure `{name}`")))
+    }
+}
+
 impl AccelSettings {
     /// `r`'s defaults.
     pub fn default_for(r: &Registered) -> AccelSettings {

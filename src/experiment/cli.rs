@@ -1,7 +1,7 @@
 //! The `sweep` command line, shared by every kind, and the errors that choose its exit status.
 
-use super::sweep::filter::{self, Filter};
-use super::sweep::shard::Shard;
+use super::core::filter::{self, Filter};
+use super::core::shard::Shard;
 use crate::render::BackendChoice;
 use std::path::PathBuf;
 
@@ -16,9 +16,9 @@ a staging folder beside the results folder and swapped in only when the run fini
 killed run leaves the earlier results whole. Logging: -v and -q raise and lower the level; RUST_LOG \
 (e.g. RUST_LOG=penumbra=debug) overrides both; off a terminal, log lines and progress carry timestamps.
 
-A sweep too big for one machine: run `--shard K/N` for K = 1..N (anywhere that shares the results \
-folder, or copy the shard folders and cache/ back), then `--merge RESULTS/shards/*-of-N` on the same \
-kind of device with the same binary; scripts/slurm/sweep.sbatch and scripts/parallel.sh do both.";
+An experiment too big for one machine (any kind): run `--shard K/N` for K = 1..N (anywhere that shares \
+the results folder, or copy the shard folders and cache/ back), then `--merge RESULTS/shards/*-of-N` on \
+the same kind of device with the same binary; scripts/slurm/sweep.sbatch and scripts/parallel.sh do both.";
 
 /// Runs an experiment file of any kind (sweep, fps, ao, frames) and writes its results folder.
 #[derive(clap::Parser, Debug, Clone)]
@@ -50,7 +50,7 @@ pub struct Cli {
     #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
     pub merge: Vec<PathBuf>,
     /// Subset filters; the help text names the axes from the axis list.
-    #[arg(long, value_name = "AXIS=VALUE", help = filter::help())]
+    #[arg(long, value_name = "AXIS=VALUE", help = filter::HELP)]
     pub filter: Vec<Filter>,
     /// More log output (repeatable).
     #[arg(short, long, action = clap::ArgAction::Count)]
@@ -75,11 +75,6 @@ impl Cli {
             verbose: 0,
             quiet: 0,
         }
-    }
-
-    /// Whether it asks for a subset (`--filter`, `--shard`, `--merge`).
-    pub fn asks_subsets(&self) -> bool {
-        !self.filter.is_empty() || self.shard.is_some() || !self.merge.is_empty()
     }
 }
 

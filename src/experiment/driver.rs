@@ -4,10 +4,10 @@
 //! outcome to the exit status stated in `--help`.
 
 use super::cli::{BadInput, Cli, RunsFailed};
+use super::core::MergeRefused;
 use super::manifest::{peak_rss, utc, Build, Input, Machine, Manifest, RunInfo, SCHEMA};
 use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
-use super::sweep::merge::MergeRefused;
 use super::{load, Experiment, Finished, Run};
 use crate::render::{cpu::CpuBackend, open_backend, Backend, BackendChoice};
 use std::io::IsTerminal;
@@ -23,12 +23,6 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
     let header = experiment.header().clone();
     let kind = header.kind.name();
     let accepts = experiment.accepts();
-    if cli.asks_subsets() && !accepts.subsets {
-        return Err(BadInput(format!(
-            "--filter, --shard and --merge apply to sweeps, not to `{kind}` experiments"
-        ))
-        .into());
-    }
     let choice = cli.backend.or(header.backend).unwrap_or(BackendChoice::Auto);
     if !accepts.gpu && choice == BackendChoice::Gpu {
         return Err(BadInput(format!(

@@ -12,6 +12,7 @@
 pub mod ao;
 pub mod cli;
 pub mod comparison;
+pub mod core;
 pub mod driver;
 pub mod fps;
 pub mod frames;
@@ -32,11 +33,10 @@ use outputs::Outputs;
 use progress::Progress;
 use std::path::{Path, PathBuf};
 
-/// What a kind accepts beyond the shared command line.
+/// What a kind accepts beyond the shared command line (every kind takes `--filter`, `--shard`
+/// and `--merge`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Accepts {
-    /// `--filter`, `--shard` and `--merge` (sweeps).
-    pub subsets: bool,
     /// Whether it runs on the GPU; a kind that does not times the f64 CPU backend, where every
     /// structure is exact, and refuses `--backend gpu`.
     pub gpu: bool,
@@ -69,7 +69,7 @@ pub enum Finished {
         /// Failed runs and the file whose rows say why.
         failed: Option<(usize, String)>,
     },
-    /// A share of a sweep, written into its own folder; no result set to swap in.
+    /// A share of an experiment, written into its own folder; no result set to swap in.
     Shard {
         /// Failed runs and the file whose rows say why.
         failed: Option<(usize, String)>,
@@ -122,8 +122,8 @@ pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
     let header = Header::read(&source)?;
     Ok(match header.kind {
         Kind::Sweep => Box::new(sweep::Spec::from_source(&source, header)?),
-        Kind::Fps => Box::new(fps::FpsSpec::from_source(&source, header)?),
-        Kind::Ao => Box::new(ao::AoSpec::from_source(&source, header)?),
-        Kind::Frames => Box::new(frames::FramesSpec::from_source(&source, header)?),
+        Kind::Fps => Box::new(core::Declared(fps::FpsSpec::from_source(&source, header)?)),
+        Kind::Ao => Box::new(core::Declared(ao::AoSpec::from_source(&source, header)?)),
+        Kind::Frames => Box::new(core::Declared(frames::FramesSpec::from_source(&source, header)?)),
     })
 }

@@ -53,7 +53,7 @@ impl View<'_> {
 }
 
 /// Rays a frame actually traced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct RayCounts {
     /// Camera rays (one per pixel).
     pub primary: u64,
@@ -110,7 +110,7 @@ impl Frame {
 }
 
 /// How a frame time was measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Clock {
     /// GPU timestamp queries around the passes.

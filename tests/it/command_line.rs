@@ -73,8 +73,11 @@ fn a_filter_runs_a_subset_into_its_own_folder() {
     assert!(s.contains("tiny: 4 runs in 2 configurations"), "{s}");
     assert!(!s.contains("scheme=uniform"), "{s}");
     for (bad, why) in [
-        ("scheme=halton", "not a valid scheme"),
-        ("samples=64", "does not sweep"),
+        (
+            "scheme=halton",
+            "not among the experiment's scheme values: uniform, paper",
+        ),
+        ("samples=64", "not among the experiment's samples values: 4, 16"),
         ("colour=red", "unknown axis"),
     ] {
         let o = dry(&[bad]);

@@ -23,6 +23,7 @@ mod hard_cases;
 mod hostile_input;
 mod kdtree;
 mod kdtree_sah;
+mod kinds_on_the_core;
 mod mesh_scene;
 mod pages;
 mod points_file;

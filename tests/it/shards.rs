@@ -17,43 +17,6 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Columns whose values come from the clock (the timing phase, build times).
-const CLOCK_COLUMNS: [&str; 6] = [
-    "timed_frames",
-    "rays_per_s",
-    "primary_rays_per_s",
-    "shadow_rays_per_s",
-    "clock",
-    "build_s",
-];
-
-fn is_clock_column(name: &str) -> bool {
-    CLOCK_COLUMNS.contains(&name) || name.starts_with("frame_s")
-}
-
-/// The rows of a CSV file with the clock's columns blanked.
-fn without_clock(path: &Path) -> Vec<Vec<String>> {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let header = r.headers().unwrap().clone();
-    let mut rows = vec![header.iter().map(String::from).collect::<Vec<_>>()];
-    for rec in r.records() {
-        let rec = rec.unwrap();
-        rows.push(
-            rec.iter()
-                .zip(header.iter())
-                .map(|(v, h)| {
-                    if is_clock_column(h) {
-                        String::new()
-                    } else {
-                        v.to_string()
-                    }
-                })
-                .collect(),
-        );
-    }
-    rows
-}
-
 fn sweep(args: &[&OsStr]) -> (i32, String) {
     common::sweep(args)
 }
@@ -242,18 +205,21 @@ fn three_shards_merged_give_the_unsharded_tables_and_figures() {
     let dir = tempfile::tempdir().unwrap();
     let (full, sharded) = full_and_sharded(dir.path());
     for table in ["runs.csv", "summary.csv"] {
-        let (a, b) = (without_clock(&full.join(table)), without_clock(&sharded.join(table)));
+        let (a, b) = (
+            common::without_clock(&full.join(table)),
+            common::without_clock(&sharded.join(table)),
+        );
         assert!(a.len() > 1);
         assert_eq!(a, b, "{table} differs");
     }
     // Every run was rendered by exactly one shard, each shard a real share.
     let mut shard_runs = 0;
     for k in 1..=3 {
-        let n = without_clock(&sharded.join(format!("shards/{k}-of-3/records.csv"))).len() - 1;
+        let n = common::without_clock(&sharded.join(format!("shards/{k}-of-3/records.csv"))).len() - 1;
         assert!(n > 0, "shard {k} ran nothing");
         shard_runs += n;
     }
-    assert_eq!(shard_runs, without_clock(&full.join("runs.csv")).len() - 1);
+    assert_eq!(shard_runs, common::without_clock(&full.join("runs.csv")).len() - 1);
     same_files(
         &full,
         &sharded,
@@ -267,7 +233,7 @@ fn three_shards_merged_give_the_unsharded_tables_and_figures() {
         ],
     );
     // The merge timed every configuration itself, in one phase.
-    let timed = without_clock(&sharded.join("timings.csv")).len();
+    let timed = common::without_clock(&sharded.join("timings.csv")).len();
     assert!(timed > 1, "the merge timed nothing");
 }
 
@@ -507,7 +473,7 @@ fn a_shard_killed_midway_resumes_from_its_journal() {
     };
     let status = Command::new(env!("CARGO_BIN_EXE_sweep"))
         .args(args(&killed))
-        .env("PENUMBRA_TEST_DIE_AFTER_GROUPS", "5")
+        .env("PENUMBRA_TEST_DIE_AFTER", "5")
         .output()
         .unwrap()
         .status;
@@ -584,8 +550,8 @@ fn a_slurm_job_array_of_four_shards_and_its_merge_give_the_unsharded_tables() {
     run_ok(&[ci().as_os_str(), os("--out"), full.as_os_str()]);
     for table in ["runs.csv", "summary.csv"] {
         assert_eq!(
-            without_clock(&full.join(table)),
-            without_clock(&out.join(table)),
+            common::without_clock(&full.join(table)),
+            common::without_clock(&out.join(table)),
             "{table} differs\n{log}"
         );
     }

@@ -6,6 +6,7 @@
 //! in the experiment's interleaved rounds.
 
 use super::spec::{AoMesh, AoSpec};
+use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, Issue};
 use crate::experiment::progress::Progress;
@@ -16,17 +17,19 @@ use crate::scene::ambient::AmbientOcclusion;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Mesh, Scene};
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// One mesh and structure, measured.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AoRow {
     /// Mesh label.
     pub mesh: String,
     /// Its triangles.
     pub triangles: usize,
     /// Structure name.
-    pub structure: &'static str,
+    #[serde(with = "registry_name")]
+    pub structure: RegistryName,
     /// How the AO rays were issued.
     pub issue: Issue,
     /// Its build parameters.
@@ -80,12 +83,13 @@ pub fn camera() -> Camera {
 }
 
 /// One candidate of the tuning sweep, timed.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TuningRow {
     /// Mesh label.
     pub mesh: String,
     /// Structure name.
-    pub structure: &'static str,
+    #[serde(with = "registry_name")]
+    pub structure: RegistryName,
     /// Its parameters.
     pub settings: AccelSettings,
     /// Median frame seconds at the tuning size, with its interval.
@@ -232,59 +236,76 @@ fn measure(
     })
 }
 
-/// Every mesh x structure of the experiment, in file order, each structure tuned per mesh
-/// first.
+/// What one mesh's unit measured: a row per structure and way of issuing rays, and the tuning
+/// candidates timed.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct MeshOutcome {
+    /// One row per structure and issue, in the experiment's order.
+    pub rows: Vec<AoRow>,
+    /// Every tuning candidate timed.
+    pub tuning: Vec<TuningRow>,
+}
+
+/// Every structure of the experiment on `mesh`, each tuned first, then all of them timed in
+/// one schedule's interleaved rounds (a mesh is one unit of work: its times compare only with
+/// each other).
+pub fn run_mesh(
+    spec: &AoSpec,
+    mesh: &AoMesh,
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<MeshOutcome> {
+    let schedule = spec.header.schedule;
+    let bar = progress.bar(&format!("{}: structures", mesh.name), spec.structures.len() as u64);
+    let mut out = MeshOutcome::default();
+    let mut first: Option<Vec<f32>> = None;
+    let mut scenes = Vec::new();
+    for (structure, candidates) in &spec.structures {
+        bar.message(structure.to_string());
+        let (settings, tried) = tune(spec, mesh, (structure, candidates), backend)?;
+        out.tuning.extend(tried);
+        // One build per structure: each way of issuing the rays shares it.
+        let built = ao_scene(spec, mesh, settings.clone())?;
+        let bundles = built.accel.as_ref().is_some_and(|a| a.bundles());
+        for &issue in spec.issues.iter().filter(|&&i| i == Issue::Single || bundles) {
+            let scene = built.clone().with_ambient(Some(AmbientOcclusion {
+                issue,
+                ..spec.ao.clone()
+            }));
+            out.rows.push(measure(
+                spec,
+                mesh,
+                (structure, &settings, issue),
+                &scene,
+                backend,
+                &mut first,
+            )?);
+            scenes.push(scene);
+        }
+        bar.inc(1);
+    }
+    bar.message(format!("timing {} rounds", schedule.repeats));
+    let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {})?;
+    for (row, t) in out.rows.iter_mut().zip(times) {
+        row.frame = median_interval(&t);
+        row.frame_seconds = t;
+    }
+    bar.finish();
+    Ok(out)
+}
+
+/// Every mesh of the experiment in file order, as an unsharded run measures them: the rows and
+/// the tuning candidates.
 pub fn run_ao(
     spec: &AoSpec,
     backend: &mut dyn Backend,
     progress: &Progress,
 ) -> anyhow::Result<(Vec<AoRow>, Vec<TuningRow>)> {
-    let schedule = spec.header.schedule;
-    let bar = progress.bar(
-        "meshes x structures",
-        (spec.meshes.len() * spec.structures.len()) as u64,
-    );
-    let mut rows = Vec::new();
-    let mut tuning = Vec::new();
+    let (mut rows, mut tuning) = (Vec::new(), Vec::new());
     for mesh in &spec.meshes {
-        let mut first: Option<Vec<f32>> = None;
-        let mut scenes = Vec::new();
-        for (structure, candidates) in &spec.structures {
-            bar.message(format!("{}: {structure}", mesh.name));
-            let (settings, tried) = tune(spec, mesh, (structure, candidates), backend)?;
-            tuning.extend(tried);
-            // One build per structure: each way of issuing the rays shares it.
-            let built = ao_scene(spec, mesh, settings.clone())?;
-            let bundles = built.accel.as_ref().is_some_and(|a| a.bundles());
-            for &issue in spec.issues.iter().filter(|&&i| i == Issue::Single || bundles) {
-                let scene = built.clone().with_ambient(Some(AmbientOcclusion {
-                    issue,
-                    ..spec.ao.clone()
-                }));
-                rows.push(measure(
-                    spec,
-                    mesh,
-                    (structure, &settings, issue),
-                    &scene,
-                    backend,
-                    &mut first,
-                )?);
-                scenes.push(scene);
-            }
-            bar.inc(1);
-        }
-        if schedule.repeats > 0 {
-            bar.message(format!("{}: timing {} rounds", mesh.name, schedule.repeats));
-            let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {
-                bar.message(format!("{}: timing", mesh.name))
-            })?;
-            let base = rows.len() - scenes.len();
-            for (row, t) in rows[base..].iter_mut().zip(times) {
-                row.frame = median_interval(&t);
-                row.frame_seconds = t;
-            }
-        }
+        let out = run_mesh(spec, mesh, backend, progress)?;
+        rows.extend(out.rows);
+        tuning.extend(out.tuning);
     }
-    bar.finish();
     Ok((rows, tuning))
 }

@@ -1,29 +1,44 @@
 //! Frame-rate experiments (`kind = "fps"`): the soft-shadow paper's Table 1 (frames per second,
 //! 16 shadow rays per pixel, sphere and dressed body, one and two lights) on today's adapter,
 //! with the paper's numbers beside ours.
+//!
+//! Declared on the experiment core: axes scene x lights x resolution; a unit is one scene with
+//! its light counts and resolutions, timed together in one schedule.
 
 pub mod report;
 pub mod runner;
 pub mod spec;
 
-pub use runner::{run_fps, FpsRow};
+pub use runner::{run_fps, run_scenes, FpsRow};
 pub use spec::{timed_scene, FpsScene, FpsSpec};
 
-use crate::experiment::cli::Cli;
+use crate::experiment::core::filter::{keep_at, Axis};
+use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
-use crate::experiment::{Accepts, Experiment, Finished, Run};
+use crate::experiment::progress::Progress;
+use crate::experiment::Run;
+use crate::render::Backend;
 use std::path::PathBuf;
 
-impl Experiment for FpsSpec {
+impl FpsSpec {
+    /// Every light count some scene times, ascending.
+    fn light_counts(&self) -> Vec<u32> {
+        let mut all: Vec<u32> = self.scenes.iter().flat_map(|s| s.lights.iter().copied()).collect();
+        all.sort_unstable();
+        all.dedup();
+        all
+    }
+}
+
+impl Declaration for FpsSpec {
+    type Outcome = Vec<FpsRow>;
+
     fn header(&self) -> &Header {
         &self.header
     }
 
-    fn accepts(&self) -> Accepts {
-        Accepts {
-            subsets: false,
-            gpu: true,
-        }
+    fn gpu(&self) -> bool {
+        true
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
@@ -43,23 +58,89 @@ impl Experiment for FpsSpec {
             .find_map(|(path, s)| crate::experiment::scene_gpu_gap(path, &s.scene))
     }
 
-    fn dry_run(&self, _cli: &Cli) -> anyhow::Result<String> {
-        runner::dry_run(self)
+    fn axes(&self) -> Vec<Axis> {
+        vec![
+            Axis {
+                name: "scene",
+                values: self.scenes.iter().map(|s| s.name.clone()).collect(),
+            },
+            Axis {
+                name: "lights",
+                values: self.light_counts().iter().map(u32::to_string).collect(),
+            },
+            Axis {
+                name: "resolution",
+                values: self.resolutions.iter().map(|[w, h]| format!("{w}x{h}")).collect(),
+            },
+        ]
     }
 
-    fn run(&self, run: &mut Run) -> anyhow::Result<Finished> {
-        let rows = run_fps(self, run.backend, run.progress)?;
-        let adapter = run.backend.adapter().clone();
+    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+        match axis {
+            0 => {
+                keep_at(&mut self.scenes, keep);
+                keep_at(&mut self.scene_paths, keep);
+            }
+            1 => {
+                let counts = self.light_counts();
+                let kept: Vec<u32> = keep.iter().map(|&i| counts[i]).collect();
+                for s in &mut self.scenes {
+                    let at: Vec<usize> = (0..s.lights.len()).filter(|&i| kept.contains(&s.lights[i])).collect();
+                    keep_at(&mut s.lights, &at);
+                    keep_at(&mut s.paper_fps, &at);
+                }
+                let with: Vec<usize> = (0..self.scenes.len())
+                    .filter(|&i| !self.scenes[i].lights.is_empty())
+                    .collect();
+                keep_at(&mut self.scenes, &with);
+                keep_at(&mut self.scene_paths, &with);
+            }
+            _ => keep_at(&mut self.resolutions, keep),
+        }
+    }
+
+    fn units(&self) -> Vec<Unit> {
+        self.scenes
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let label = format!("scene={}", s.name);
+                let pixels: f64 = self.resolutions.iter().map(|[w, h]| (w * h) as f64).sum();
+                let lights: u32 = s.lights.iter().sum();
+                Unit {
+                    at: vec![i],
+                    cost: Cost {
+                        work: pixels * (1 + lights * self.samples) as f64,
+                        setup: None,
+                        tie: label.clone(),
+                    },
+                    label,
+                }
+            })
+            .collect()
+    }
+
+    fn plan(&self, units: &[Unit]) -> anyhow::Result<String> {
+        let which: Vec<usize> = units.iter().map(|u| u.at[0]).collect();
+        runner::dry_run(self, &which)
+    }
+
+    fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<Vec<FpsRow>> {
+        run_scenes(self, &unit.at, backend, progress)
+    }
+
+    fn report(&self, outcomes: Vec<Vec<FpsRow>>, run: &Run) -> anyhow::Result<toml::Table> {
+        let rows: Vec<FpsRow> = outcomes.into_iter().flatten().collect();
         report::write_fps(
             self,
             &rows,
-            &adapter,
+            &run.backend.adapter().clone(),
             run.started.elapsed().as_secs_f64(),
             run.out.dir(),
         )?;
         tracing::info!("{} configurations timed", rows.len());
         let mut details = toml::Table::new();
         details.insert("configurations".into(), (rows.len() as i64).into());
-        Ok(Finished::Results { details, failed: None })
+        Ok(details)
     }
 }

@@ -10,7 +10,7 @@ use crate::scene::Scene;
 use anyhow::Context;
 
 /// One timed configuration: a row of fps.csv.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FpsRow {
     /// Scene label.
     pub scene: String,
@@ -56,11 +56,23 @@ struct Unit {
     height: u32,
 }
 
-/// Renders every configuration once, then times them all in the schedule's interleaved rounds.
+/// Every configuration of every scene, all timed in one schedule.
 pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<Vec<FpsRow>> {
+    let all: Vec<usize> = (0..spec.scenes.len()).collect();
+    run_scenes(spec, &all, backend, progress)
+}
+
+/// Renders every configuration of the scenes at `which` once, then times them all in the
+/// schedule's interleaved rounds.
+pub fn run_scenes(
+    spec: &FpsSpec,
+    which: &[usize],
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<Vec<FpsRow>> {
     let mut units = Vec::new();
     let mut rows = Vec::new();
-    for s in &spec.scenes {
+    for s in which.iter().map(|&i| &spec.scenes[i]) {
         for (&lights, &paper_fps) in s.lights.iter().zip(&s.paper_fps) {
             let scene = timed_scene(spec, s, lights);
             for &[width, height] in &spec.resolutions {
@@ -118,10 +130,10 @@ pub fn run_fps(spec: &FpsSpec, backend: &mut dyn Backend, progress: &Progress) -
     Ok(rows)
 }
 
-/// What `--dry-run` prints: the render plan of every configuration.
-pub fn dry_run(spec: &FpsSpec) -> anyhow::Result<String> {
+/// What `--dry-run` prints: the render plan of every configuration of the scenes at `which`.
+pub fn dry_run(spec: &FpsSpec, which: &[usize]) -> anyhow::Result<String> {
     let mut out = String::new();
-    for s in &spec.scenes {
+    for s in which.iter().map(|&i| &spec.scenes[i]) {
         for &lights in &s.lights {
             let scene = timed_scene(spec, s, lights);
             for &[width, height] in &spec.resolutions {

@@ -1,38 +1,123 @@
 //! Frame-time experiments (`kind = "frames"`): the visibility-field paper's scaling (Fig. 5),
 //! walkthrough (Fig. 6) and dynamic-scene claims, measured per acceleration structure.
+//!
+//! Declared on the experiment core: axes scene x shading x viewpoint; a unit is a block of
+//! frames of one scene ([`runner::Block`]), every structure timed in the same interleaved rounds
+//! on one machine, so per-frame ratios stay paired.
 
 pub mod report;
 pub mod runner;
 pub mod spec;
 pub mod verdict;
 
-pub use runner::run_frames;
-pub use spec::FramesSpec;
+pub use runner::{run_block, run_frames, Block, FramesOutcome};
+pub use spec::{FramesSpec, Generator};
 
-use crate::experiment::cli::Cli;
+use crate::experiment::core::filter::{keep_at, Axis};
+use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
-use crate::experiment::{Accepts, Experiment, Finished, Run};
+use crate::experiment::progress::Progress;
+use crate::experiment::Run;
+use crate::render::Backend;
 use std::path::PathBuf;
 
-impl Experiment for FramesSpec {
-    fn header(&self) -> &Header {
-        &self.header
+impl FramesSpec {
+    /// The scenes as the `scene` axis names them: `classroom`, or each triangle count.
+    fn scene_names(&self) -> Vec<String> {
+        match &self.generator {
+            Generator::Classroom => vec!["classroom".into()],
+            Generator::RandomTriangles { counts, .. } => counts.iter().map(usize::to_string).collect(),
+        }
     }
 
-    fn accepts(&self) -> Accepts {
-        Accepts {
-            subsets: false,
-            gpu: false,
+    /// Triangles of scene `i`, known before it is generated (random triangles; the classroom is
+    /// one scene, so its blocks compare by their frames alone).
+    fn triangles_of(&self, i: usize) -> Option<usize> {
+        match &self.generator {
+            Generator::Classroom => None,
+            Generator::RandomTriangles { counts, .. } => Some(counts[i]),
         }
+    }
+}
+
+impl Declaration for FramesSpec {
+    type Outcome = FramesOutcome;
+
+    fn header(&self) -> &Header {
+        &self.header
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
         vec![self.path.clone()]
     }
 
-    fn dry_run(&self, _cli: &Cli) -> anyhow::Result<String> {
+    fn axes(&self) -> Vec<Axis> {
+        vec![
+            Axis {
+                name: "scene",
+                values: self.scene_names(),
+            },
+            Axis {
+                name: "shading",
+                values: self.shadings.iter().map(|(n, _)| n.name().to_string()).collect(),
+            },
+            Axis {
+                name: "viewpoint",
+                values: self.viewpoints.clone(),
+            },
+        ]
+    }
+
+    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+        match axis {
+            0 => {
+                if let Generator::RandomTriangles { counts, .. } = &mut self.generator {
+                    keep_at(counts, keep);
+                }
+            }
+            1 => keep_at(&mut self.shadings, keep),
+            _ => keep_at(&mut self.viewpoints, keep),
+        }
+    }
+
+    fn units(&self) -> Vec<Unit> {
+        let names = self.scene_names();
+        let pixels = (self.width * self.height) as f64;
+        runner::blocks(self)
+            .into_iter()
+            .map(|b| {
+                let mut label = format!("scene={}", names[b.scene]);
+                if self.motion.is_none() {
+                    label += &format!(
+                        " shading={} viewpoint={}",
+                        self.shadings[b.shadings.start].0.name(),
+                        self.viewpoints[b.viewpoints.start]
+                    );
+                }
+                label += &format!(" frames={}..{}", b.frames.start, b.frames.end);
+                let frames = (b.shadings.len() * b.viewpoints.len()) as f64 * b.frames.len() as f64;
+                let n = self.triangles_of(b.scene).map_or(1.0, |n| n as f64);
+                let repeats = self.header.schedule.repeats.max(1) as f64;
+                let structures = self.structures.len() as f64;
+                Unit {
+                    at: b.at(),
+                    cost: Cost {
+                        // Renders (rays times a logarithmic walk) and builds (n log n).
+                        work: structures * (frames * repeats * pixels + n) * n.ln().max(1.0),
+                        setup: None,
+                        tie: label.clone(),
+                    },
+                    label,
+                }
+            })
+            .collect()
+    }
+
+    fn plan(&self, units: &[Unit]) -> anyhow::Result<String> {
         let mut out = String::new();
-        for g in self.scenes() {
+        let mut scenes: Vec<usize> = units.iter().map(|u| Block::of(&u.at).scene).collect();
+        scenes.dedup();
+        for (_, g) in self.scenes().enumerate().filter(|(i, _)| scenes.contains(i)) {
             out += &format!(
                 "{}: [{}] x {} shadings x {} viewpoints x {} frames at {}x{}, {} timed renders each{}\n",
                 g.description,
@@ -51,8 +136,18 @@ impl Experiment for FramesSpec {
         Ok(out)
     }
 
-    fn run(&self, run: &mut Run) -> anyhow::Result<Finished> {
-        let outcome = run_frames(self, run.backend, run.progress)?;
+    fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<FramesOutcome> {
+        run_block(self, &Block::of(&unit.at), backend, progress)
+    }
+
+    fn report(&self, outcomes: Vec<FramesOutcome>, run: &Run) -> anyhow::Result<toml::Table> {
+        let mut outcome = FramesOutcome::default();
+        for o in outcomes {
+            outcome.frames.extend(o.frames);
+            outcome.builds.extend(o.builds);
+            outcome.pictures.extend(o.pictures);
+            outcome.scenes.extend(o.scenes);
+        }
         let threads = rayon::current_num_threads();
         report::write_frames(
             self,
@@ -68,6 +163,6 @@ impl Experiment for FramesSpec {
             "scenes".into(),
             toml::Value::Array(outcome.scenes.iter().map(|s| s.clone().into()).collect()),
         );
-        Ok(Finished::Results { details, failed: None })
+        Ok(details)
     }
 }

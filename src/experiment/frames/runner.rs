@@ -11,6 +11,7 @@
 //! frame `warmup` times, untimed (warm caches).
 
 use super::spec::{FramesSpec, ShadingName};
+use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, UpdateMethod, Updated};
 use crate::experiment::progress::Progress;
@@ -21,6 +22,7 @@ use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::procedural::Generated;
 use crate::scene::Scene;
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -33,14 +35,16 @@ const SAMPLING: Sampling = Sampling {
 };
 
 /// One frame of one structure, timed.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FrameRow {
     /// Triangles in the scene.
     pub triangles: usize,
     /// Structure name.
-    pub structure: &'static str,
+    #[serde(with = "registry_name")]
+    pub structure: RegistryName,
     /// How it follows a moving part (`none` for static scenes).
-    pub update: &'static str,
+    #[serde(with = "update_name")]
+    pub update: UpdateName,
     /// Shading.
     pub shading: ShadingName,
     /// Viewpoint.
@@ -64,12 +68,13 @@ pub struct FrameRow {
 }
 
 /// One structure built over one scene.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BuildRow {
     /// Triangles indexed.
     pub triangles: usize,
     /// Structure name.
-    pub structure: &'static str,
+    #[serde(with = "registry_name")]
+    pub structure: RegistryName,
     /// Its parameters.
     pub settings: AccelSettings,
     /// Build seconds.
@@ -79,7 +84,7 @@ pub struct BuildRow {
 }
 
 /// A frame kept as a picture.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Picture {
     /// Shading.
     pub shading: ShadingName,
@@ -89,8 +94,8 @@ pub struct Picture {
     pub radiance: Vec<f32>,
 }
 
-/// Everything a run measured.
-#[derive(Clone, Debug, Default)]
+/// Everything a run (or one block of it) measured.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct FramesOutcome {
     /// Every frame of every structure.
     pub frames: Vec<FrameRow>,
@@ -100,6 +105,28 @@ pub struct FramesOutcome {
     pub pictures: Vec<Picture>,
     /// The scenes, as their generators describe them.
     pub scenes: Vec<String>,
+}
+
+/// How a row names the way its structure follows motion: an [`UpdateMethod`]'s name, or `none`.
+pub type UpdateName = &'static str;
+
+/// Serde for [`UpdateName`]: read back as one of the names, or refused.
+mod update_name {
+    use super::{UpdateMethod, UpdateName};
+
+    pub fn serialize<S: serde::Serializer>(name: &UpdateName, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(name)
+    }
+
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<UpdateName, D::Error> {
+        let name = <String as serde::Deserialize>::deserialize(d)?;
+        UpdateMethod::ALL
+            .iter()
+            .map(|m| m.name())
+            .chain(["none"])
+            .find(|n| *n == name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown update `{name}`")))
+    }
 }
 
 /// One structure's scene, and how it follows motion.
@@ -186,111 +213,203 @@ pub fn strip_frames(count: u32, frames: u32) -> Vec<u32> {
     (0..count).map(|k| k * frames / count.max(1)).collect()
 }
 
-/// Runs the experiment.
+/// A unit of a frame-time experiment: frames `frames` of the viewpoints and shadings in their
+/// ranges (indices into the spec's lists), on scene `scene`. A static scene's block is one
+/// shading and viewpoint and `[path] block` frames; a moving part carries its state through
+/// every frame, shading and viewpoint, so a moving scene is one block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Scene index.
+    pub scene: usize,
+    /// Shading indices.
+    pub shadings: std::ops::Range<usize>,
+    /// Viewpoint indices.
+    pub viewpoints: std::ops::Range<usize>,
+    /// Frames of the path.
+    pub frames: std::ops::Range<u32>,
+}
+
+impl Block {
+    /// Whether it is its scene's first block (which records the builds and the scene).
+    fn first(&self) -> bool {
+        self.shadings.start == 0 && self.viewpoints.start == 0 && self.frames.start == 0
+    }
+
+    /// As a unit's coordinates.
+    pub fn at(&self) -> Vec<usize> {
+        vec![
+            self.scene,
+            self.shadings.start,
+            self.shadings.end,
+            self.viewpoints.start,
+            self.viewpoints.end,
+            self.frames.start as usize,
+            self.frames.end as usize,
+        ]
+    }
+
+    /// From a unit's coordinates ([`Block::at`]).
+    pub fn of(at: &[usize]) -> Block {
+        Block {
+            scene: at[0],
+            shadings: at[1]..at[2],
+            viewpoints: at[3]..at[4],
+            frames: at[5] as u32..at[6] as u32,
+        }
+    }
+}
+
+/// Every block of the experiment, in the order an unsharded run lists its rows: scene, shading,
+/// viewpoint, frame.
+pub fn blocks(spec: &FramesSpec) -> Vec<Block> {
+    let mut out = Vec::new();
+    for scene in 0..spec.scene_count() {
+        if spec.motion.is_some() {
+            out.push(Block {
+                scene,
+                shadings: 0..spec.shadings.len(),
+                viewpoints: 0..spec.viewpoints.len(),
+                frames: 0..spec.frames,
+            });
+            continue;
+        }
+        for h in 0..spec.shadings.len() {
+            for v in 0..spec.viewpoints.len() {
+                for start in (0..spec.frames).step_by(spec.block.max(1) as usize) {
+                    out.push(Block {
+                        scene,
+                        shadings: h..h + 1,
+                        viewpoints: v..v + 1,
+                        frames: start..(start + spec.block).min(spec.frames),
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs the whole experiment, block after block.
 pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<FramesOutcome> {
+    let mut outcome = FramesOutcome::default();
+    for block in blocks(spec) {
+        let o = run_block(spec, &block, backend, progress)?;
+        outcome.frames.extend(o.frames);
+        outcome.builds.extend(o.builds);
+        outcome.pictures.extend(o.pictures);
+        outcome.scenes.extend(o.scenes);
+    }
+    Ok(outcome)
+}
+
+/// Runs one block: builds every structure over its scene, then renders and times its frames.
+pub fn run_block(
+    spec: &FramesSpec,
+    block: &Block,
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<FramesOutcome> {
     let schedule = spec.header.schedule;
     let mut outcome = FramesOutcome::default();
     let strip = strip_frames(spec.strip, spec.frames);
+    let s = block.scene;
+    let generated = spec.scenes().nth(s).expect("a block's scene is the experiment's");
     let bar = progress.bar(
-        "frames",
-        (spec.scene_count() * spec.shadings.len() * spec.viewpoints.len()) as u64 * spec.frames as u64,
+        &generated.description,
+        (block.shadings.len() * block.viewpoints.len()) as u64 * block.frames.len() as u64,
     );
-    for (s, generated) in spec.scenes().enumerate() {
-        let generated = &generated;
-        bar.message(format!(
-            "{}: building {} structures",
-            generated.description,
-            spec.structures.len()
-        ));
+    bar.message(format!("building {} structures", spec.structures.len()));
+    let (mut variants, builds) = variants(spec, &generated)?;
+    if block.first() {
         outcome.scenes.push(generated.description.clone());
-        let (mut variants, builds) = variants(spec, generated)?;
         outcome.builds.extend(builds);
-        let triangles = generated.triangle_count();
-        // A moving part keeps moving through every shading and viewpoint: the structures it
-        // updates carry their state along.
-        let mut current = generated.triangles();
-        let moving = spec.motion.as_ref().map(|m| {
-            let (index, _) = generated.part(&m.part).expect("validated part");
-            (index as u32, m.step)
-        });
-        for &(name, shading) in &spec.shadings {
-            bar.message(format!("{}, {} shading", generated.description, name.name()));
-            for v in &mut variants {
-                v.scene.shading = shading;
+    }
+    let triangles = generated.triangle_count();
+    // A moving part keeps moving through every shading and viewpoint: the structures it
+    // updates carry their state along.
+    let mut current = generated.triangles();
+    let moving = spec.motion.as_ref().map(|m| {
+        let (index, _) = generated.part(&m.part).expect("validated part");
+        (index as u32, m.step)
+    });
+    for &(name, shading) in &spec.shadings[block.shadings.clone()] {
+        bar.message(format!("{} shading", name.name()));
+        for v in &mut variants {
+            v.scene.shading = shading;
+        }
+        for vp in block.viewpoints.clone() {
+            let viewpoint = &spec.viewpoints[vp];
+            let first_camera = spec.camera(viewpoint, block.frames.start);
+            let first_view = View {
+                camera: &first_camera,
+                width: spec.width,
+                height: spec.height,
+            };
+            for v in &variants {
+                for _ in 0..schedule.warmup {
+                    backend.render(&v.scene, first_view, SAMPLING)?;
+                }
             }
-            for (vp, viewpoint) in spec.viewpoints.iter().enumerate() {
-                let first_camera = spec.camera(viewpoint, 0);
-                let first_view = View {
-                    camera: &first_camera,
+            for frame in block.frames.clone() {
+                let camera = spec.camera(viewpoint, frame);
+                let view = View {
+                    camera: &camera,
                     width: spec.width,
                     height: spec.height,
                 };
-                for v in &variants {
-                    for _ in 0..schedule.warmup {
-                        backend.render(&v.scene, first_view, SAMPLING)?;
-                    }
-                }
-                for frame in 0..spec.frames {
-                    let camera = spec.camera(viewpoint, frame);
-                    let view = View {
-                        camera: &camera,
-                        width: spec.width,
-                        height: spec.height,
-                    };
-                    let mut updates = vec![None; variants.len()];
-                    if let Some((object, step)) = moving {
-                        for (t, &o) in current.positions.iter_mut().zip(&current.object_of) {
-                            if o == object {
-                                *t = t.map(|p| p + step);
-                            }
-                        }
-                        for (v, u) in variants.iter_mut().zip(&mut updates) {
-                            let (took, did) = v.update(&current, object, step)?;
-                            *u = Some((took.as_secs_f64(), did));
+                let mut updates = vec![None; variants.len()];
+                if let Some((object, step)) = moving {
+                    for (t, &o) in current.positions.iter_mut().zip(&current.object_of) {
+                        if o == object {
+                            *t = t.map(|p| p + step);
                         }
                     }
-                    // Every round renders each variant once, in the round's own order; the
-                    // first render of each gives the frame compared and counted.
-                    let mut frames: Vec<Option<Frame>> = vec![None; variants.len()];
-                    let rounds = frame_rounds(&schedule, (s, vp, frame));
-                    let times = rounds.run(variants.len(), |i| -> anyhow::Result<f64> {
-                        let start = Instant::now();
-                        let f = backend.render(&variants[i].scene, view, SAMPLING)?;
-                        let took = start.elapsed().as_secs_f64();
-                        frames[i].get_or_insert(f);
-                        Ok(took)
-                    })?;
-                    let frames: Vec<Frame> = frames
-                        .into_iter()
-                        .map(|f| f.expect("a frame experiment times every frame at least once"))
-                        .collect();
-                    let first = &frames[0];
-                    for (i, v) in variants.iter().enumerate() {
-                        outcome.frames.push(FrameRow {
-                            triangles,
-                            structure: v.structure,
-                            update: v.update.map_or("none", UpdateMethod::name),
-                            shading: name,
-                            viewpoint: viewpoint.clone(),
-                            frame,
-                            seconds: median(&times[i]),
-                            renders: times[i].clone(),
-                            update_seconds: updates[i].map(|u| u.0),
-                            updated: updates[i].map(|u| u.1),
-                            rays: frames[i].rays,
-                            work: frames[i].work,
-                            differing_pixels: differing(first, &frames[i]),
-                        });
+                    for (v, u) in variants.iter_mut().zip(&mut updates) {
+                        let (took, did) = v.update(&current, object, step)?;
+                        *u = Some((took.as_secs_f64(), did));
                     }
-                    if s + 1 == spec.scene_count() && vp == 0 && strip.contains(&frame) {
-                        outcome.pictures.push(Picture {
-                            shading: name,
-                            frame,
-                            radiance: first.radiance.clone(),
-                        });
-                    }
-                    bar.inc(1);
                 }
+                // Every round renders each variant once, in the round's own order; the
+                // first render of each gives the frame compared and counted.
+                let mut frames: Vec<Option<Frame>> = vec![None; variants.len()];
+                let rounds = frame_rounds(&schedule, (s, vp, frame));
+                let times = rounds.run(variants.len(), |i| -> anyhow::Result<f64> {
+                    let start = Instant::now();
+                    let f = backend.render(&variants[i].scene, view, SAMPLING)?;
+                    let took = start.elapsed().as_secs_f64();
+                    frames[i].get_or_insert(f);
+                    Ok(took)
+                })?;
+                let frames: Vec<Frame> = frames
+                    .into_iter()
+                    .map(|f| f.expect("a frame experiment times every frame at least once"))
+                    .collect();
+                let first = &frames[0];
+                for (i, v) in variants.iter().enumerate() {
+                    outcome.frames.push(FrameRow {
+                        triangles,
+                        structure: v.structure,
+                        update: v.update.map_or("none", UpdateMethod::name),
+                        shading: name,
+                        viewpoint: viewpoint.clone(),
+                        frame,
+                        seconds: median(&times[i]),
+                        renders: times[i].clone(),
+                        update_seconds: updates[i].map(|u| u.0),
+                        updated: updates[i].map(|u| u.1),
+                        rays: frames[i].rays,
+                        work: frames[i].work,
+                        differing_pixels: differing(first, &frames[i]),
+                    });
+                }
+                if s + 1 == spec.scene_count() && vp == 0 && strip.contains(&frame) {
+                    outcome.pictures.push(Picture {
+                        shading: name,
+                        frame,
+                        radiance: first.radiance.clone(),
+                    });
+                }
+                bar.inc(1);
             }
         }
     }

@@ -59,7 +59,7 @@ fn six() -> u32 {
 }
 
 /// A shading as the experiment names it.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, serde::Serialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum ShadingName {
     /// Primary rays, unoccluded local diffuse light.
@@ -92,6 +92,7 @@ struct SceneEntry {
 #[serde(deny_unknown_fields)]
 struct PathEntry {
     frames: u32,
+    block: Option<u32>,
     #[serde(default)]
     viewpoints: Vec<String>,
     look_at: Option<[f64; 3]>,
@@ -149,6 +150,10 @@ pub struct FramesSpec {
     pub claim: Claim,
     /// The scene generator.
     pub generator: Generator,
+    /// Frames per unit of work (`[path] block`, default all): a static scene's path is cut
+    /// into blocks of this many frames, each shading and viewpoint apart, so shards can share
+    /// one long path; every structure of a block is timed in the same interleaved rounds.
+    pub block: u32,
     /// Frames per viewpoint.
     pub frames: u32,
     /// Viewpoints (random triangles: each a short path; the classroom: its one walk).
@@ -255,6 +260,22 @@ impl FramesSpec {
                 format!("must be in 1..={MAX_FRAMES}"),
             ));
         }
+        if let Some(block) = f.path.block {
+            if !(1..=f.path.frames).contains(&block) {
+                return Err(err(
+                    &key_path!["path", "block"],
+                    format!("frames per unit of work: must be in 1..={} (`frames`)", f.path.frames),
+                ));
+            }
+            if f.motion.is_some() && block != f.path.frames {
+                return Err(err(
+                    &key_path!["path", "block"],
+                    "a moving part carries its state from frame to frame, so a moving scene's path is one \
+                     unit of work: remove `block`"
+                        .into(),
+                ));
+            }
+        }
         let viewpoints = match generator {
             Generator::Classroom => {
                 if !f.path.viewpoints.is_empty() {
@@ -338,6 +359,7 @@ impl FramesSpec {
             frames: f.path.frames,
             viewpoints,
             look_at,
+            block: f.path.block.unwrap_or(f.path.frames),
             motion,
             strip: f.strip,
         };

@@ -13,6 +13,7 @@
 //! ([`super::measure`], [`super::timing`], [`super::pictures`]); checks on its values beyond
 //! "listed, and listed once" go in [`super::spec`] beside the others.
 
+use crate::experiment::core::filter::keep_at;
 use crate::output::table::text;
 use crate::sampling::{DiskScheme, Pattern};
 use serde::{Deserialize, Serialize};
@@ -157,12 +158,11 @@ macro_rules! axes {
                 ]
             }
 
-            /// Keeps, on `axis`, only the values named in `values` (by their text), in the
-            /// experiment's order; a value that is not one, or is not swept, is an error.
-            pub fn restrict(&mut self, axis: Axis, values: &[&str]) -> Result<(), String> {
+            /// Keeps, on `axis`, only the values at `keep` (indices into its list, sorted).
+            pub fn restrict(&mut self, axis: Axis, keep: &[usize]) {
                 match axis {
-                    $(Axis::$var => keep(&mut self.$list, axis, values),)*
-                    Axis::$seed_var => keep(&mut self.$seeds, axis, values),
+                    $(Axis::$var => keep_at(&mut self.$list, keep),)*
+                    Axis::$seed_var => keep_at(&mut self.$seeds, keep),
                 }
             }
         }
@@ -191,13 +191,6 @@ axes! {
     }
 }
 
-impl Axis {
-    /// The axis named `name`.
-    pub fn named(name: &str) -> Option<Axis> {
-        Axis::ALL.iter().copied().find(|a| a.name() == name)
-    }
-}
-
 impl Display for Config {
     /// `scheme=uniform pattern=per-pixel ...`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -208,22 +201,6 @@ impl Display for Config {
 
 fn texts<T: Display>(values: &[T]) -> Vec<String> {
     values.iter().map(|v| v.to_string()).collect()
-}
-
-fn keep<T: AxisValue>(list: &mut Vec<T>, axis: Axis, values: &[&str]) -> Result<(), String> {
-    let name = axis.name();
-    let mut wanted = Vec::new();
-    for v in values {
-        let x: T = v
-            .parse()
-            .map_err(|_| format!("--filter {name}={v}: not a valid {name}"))?;
-        if !list.contains(&x) {
-            return Err(format!("--filter {name}={v}: the experiment does not sweep this value"));
-        }
-        wanted.push(x);
-    }
-    list.retain(|x| wanted.contains(x));
-    Ok(())
 }
 
 /// Every index tuple into lists of lengths `lens`, the lists nested by `levels` (lower levels

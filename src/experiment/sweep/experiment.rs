@@ -1,20 +1,20 @@
 //! The sweep as an experiment kind: a whole sweep, a shard's share of it (`--shard`), or the
 //! merge of finished shards (`--merge`), then the figures and the outputs.
 
-use super::filter;
 use super::merge::{merge_shards, MergePlan};
 use super::pictures::render_pictures;
 use super::report::{write_all, Results};
 use super::run::expand;
 use super::runner::{dry_run, run_sweep, verdict_radius};
-use super::shard::{self, run_shard, Shard};
+use super::shard::{self, run_shard};
 use super::Spec;
 use crate::experiment::cli::{BadInput, Cli};
+use crate::experiment::core::filter;
+use crate::experiment::core::merge::{rerun_command, shard_dirs};
 use crate::experiment::header::Header;
 use crate::experiment::{Accepts, Experiment, Finished, Run};
 use anyhow::Context;
-use clap::ValueEnum;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use tracing::info;
 
 impl Spec {
@@ -30,10 +30,7 @@ impl Experiment for Spec {
     }
 
     fn accepts(&self) -> Accepts {
-        Accepts {
-            subsets: true,
-            gpu: true,
-        }
+        Accepts { gpu: true }
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
@@ -135,51 +132,4 @@ impl Experiment for Spec {
             failed: Some((outcome.failures, run.home.join("runs.csv").display().to_string())),
         })
     }
-}
-
-/// The shard folders `--merge` names, and N where it was given: a number alone stands for
-/// every shard of an N-way split under the results folder `out`.
-fn shard_dirs(merge: &[PathBuf], out: &Path) -> anyhow::Result<(Vec<PathBuf>, Option<u32>)> {
-    let count = match merge {
-        [one] => one.to_str().and_then(|s| s.parse::<u32>().ok()),
-        _ => None,
-    };
-    match count {
-        Some(0) => Err(BadInput("--merge N needs N >= 1".into()).into()),
-        Some(n) if n > shard::MAX_SHARDS => {
-            Err(BadInput(format!("--merge N: at most {} shards", shard::MAX_SHARDS)).into())
-        }
-        Some(n) => Ok((
-            (1..=n).map(|index| Shard { index, count: n }.dir(out)).collect(),
-            Some(n),
-        )),
-        None => Ok((merge.to_vec(), None)),
-    }
-}
-
-/// `text` as one shell word.
-fn shell_word(text: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-=,:+@%".contains(c);
-    if !text.is_empty() && text.chars().all(plain) {
-        text.to_string()
-    } else {
-        format!("'{}'", text.replace('\'', r"'\''"))
-    }
-}
-
-/// How to rerun one shard of this sweep, for the merge's refusal.
-fn rerun_command(cli: &Cli) -> String {
-    let mut words = vec!["sweep".to_string(), cli.experiment.display().to_string()];
-    if let Some(out) = &cli.out {
-        words.extend(["--out".into(), out.display().to_string()]);
-    }
-    if let Some(b) = cli.backend {
-        let name = b.to_possible_value().expect("a named value").get_name().to_string();
-        words.extend(["--backend".into(), name]);
-    }
-    for f in &cli.filter {
-        words.extend(["--filter".into(), format!("{}={}", f.axis.name(), f.value)]);
-    }
-    words.push("--shard".into());
-    words.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" ")
 }

@@ -12,18 +12,14 @@ use super::run::{context_key, expand, GroupStats};
 use super::runner::{by_reference, empty_outcome, figure_samples, keep_figure, time_phase, Outcome};
 use super::shard::{assign, sweep_identity, Shard, ShardManifest, GROUPS, MANIFEST, RECORDS};
 use super::spec::Spec;
+pub use crate::experiment::core::merge::MergeRefused;
+use crate::experiment::core::merge::{differing_fields, list_lines, split_count};
 use crate::fingerprint::fnv1a;
 use crate::output::table::read_rows;
 use crate::render::Backend;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The shards given cannot make the sweep: the message lists what is missing, duplicated or
-/// mismatched, and the shards to rerun.
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct MergeRefused(pub String);
 
 /// One finished shard, read back.
 struct ShardFiles {
@@ -33,26 +29,6 @@ struct ShardFiles {
     records: Vec<Record>,
     groups: HashMap<String, GroupRow>,
     journal: Journal,
-}
-
-/// Context fields whose values differ between `a` and `b` (`name=value;...` texts).
-fn differing_fields(a: &str, b: &str) -> Vec<String> {
-    let fields = |s: &str| -> Vec<(String, String)> {
-        s.split(';')
-            .map(|f| f.split_once('=').unwrap_or((f, "")))
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect()
-    };
-    let (fa, fb) = (fields(a), fields(b));
-    let mut out: Vec<String> = fa
-        .iter()
-        .filter(|(k, v)| fb.iter().find(|(kb, _)| kb == k).is_none_or(|(_, vb)| vb != v))
-        .map(|(k, _)| k.clone())
-        .collect();
-    if out.is_empty() && a != b {
-        out.push("context".into());
-    }
-    out
 }
 
 /// Reads the shard in `dir` (a folder of folders and regular files only), or says why it cannot
@@ -123,18 +99,6 @@ fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<ShardFiles, S
     })
 }
 
-/// Lines of a refusal listing groups of runs: at most this many, then a count of the rest.
-const LISTED: usize = 40;
-
-fn list_runs(out: &mut String, runs: &[String]) {
-    for r in runs.iter().take(LISTED) {
-        let _ = writeln!(out, "    {r}");
-    }
-    if runs.len() > LISTED {
-        let _ = writeln!(out, "    ... and {} more", runs.len() - LISTED);
-    }
-}
-
 /// What to merge: the shard folders, and the split they are expected to form.
 pub struct MergePlan<'a> {
     /// Shard folders (`RESULTS/shards/K-of-N`).
@@ -146,12 +110,6 @@ pub struct MergePlan<'a> {
     pub rerun: &'a str,
     /// Discard the merge's own timing journal first.
     pub fresh: bool,
-}
-
-/// N of a folder named `K-of-N`.
-fn split_of_name(dir: &Path) -> Option<u32> {
-    let name = dir.file_name()?.to_str()?;
-    name.split_once("-of-")?.1.parse().ok()
 }
 
 /// Merges the finished shards of `plan` into the outcome of the whole sweep; `results` is the
@@ -177,11 +135,7 @@ pub fn merge_shards(
         }
     }
     let counts: Vec<u32> = shards.iter().map(|s| s.shard.count).collect();
-    let count = plan
-        .split
-        .or(counts.first().copied())
-        .or_else(|| dirs.iter().find_map(|d| split_of_name(d)))
-        .unwrap_or(1);
+    let count = split_count(plan.split, &counts, dirs);
     if counts.iter().any(|&n| n != count) {
         let listed: Vec<String> = shards
             .iter()
@@ -280,12 +234,12 @@ pub fn merge_shards(
                 problems,
                 "shard {shard} is incomplete ({what}); rerun it: {rerun} {shard}"
             );
-            list_runs(&mut problems, &lines);
+            list_lines(&mut problems, &lines);
         }
     }
     if !duplicated.is_empty() {
         let _ = writeln!(problems, "{} runs are in more than one shard:", duplicated.len());
-        list_runs(&mut problems, &duplicated);
+        list_lines(&mut problems, &duplicated);
     }
     if !problems.is_empty() {
         return Err(MergeRefused(format!("cannot merge the shards:\n{}", problems.trim_end())).into());

@@ -167,7 +167,7 @@ pub(super) fn render_groups(
             if failed == 0 {
                 journal.append(&group_key, &records, &stats)?;
                 #[cfg(feature = "test-hooks")]
-                die_after_journaled_groups();
+                crate::experiment::core::declared::die_after_journaled();
             }
             out.records.extend(records);
             out.groups.push(stats);
@@ -176,22 +176,6 @@ pub(super) fn render_groups(
     }
     bar.finish();
     Ok(out)
-}
-
-/// Test hook: with `PENUMBRA_TEST_DIE_AFTER_GROUPS=n` set, the process aborts (no cleanup, as
-/// when a node kills a job) right after its n-th journaled group, so tests interrupt a sweep at a
-/// known point.
-#[cfg(feature = "test-hooks")]
-fn die_after_journaled_groups() {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static JOURNALED: AtomicUsize = AtomicUsize::new(0);
-    let n = JOURNALED.fetch_add(1, Ordering::SeqCst) + 1;
-    let limit = std::env::var("PENUMBRA_TEST_DIE_AFTER_GROUPS")
-        .ok()
-        .and_then(|v| v.parse().ok());
-    if limit == Some(n) {
-        std::process::abort();
-    }
 }
 
 /// `groups` by the reference they are judged against, (lights on, light radius) pairs in order

@@ -24,17 +24,14 @@ use super::run::{context_key, expand, Group};
 use super::runner;
 use super::runner::render_groups;
 use super::spec::Spec;
+pub use crate::experiment::core::shard::Shard;
+use crate::experiment::core::shard::{deal as deal_costs, share_line, Cost};
 use crate::fingerprint::fnv1a;
 use crate::output::table::write_rows;
 use crate::render::{Backend, RenderPlan, View};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::fmt;
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
-
-/// Most shards a sweep splits into.
-pub const MAX_SHARDS: u32 = 10_000;
 
 /// A finished shard's manifest, written last.
 pub const MANIFEST: &str = "shard.toml";
@@ -42,42 +39,6 @@ pub const MANIFEST: &str = "shard.toml";
 pub const RECORDS: &str = "records.csv";
 /// A finished shard's bias/variance splits, one per group of its share.
 pub const GROUPS: &str = "groups.csv";
-
-/// The K-th of N shares of a sweep (1 <= K <= N), as `--shard K/N` and Slurm's array index give it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Shard {
-    /// K, from 1.
-    pub index: u32,
-    /// N.
-    pub count: u32,
-}
-
-impl FromStr for Shard {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Shard, String> {
-        let bad = || format!("expected K/N with 1 <= K <= N <= {MAX_SHARDS} (e.g. 2/8), got `{s}`");
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count) = (k.trim().parse::<u32>(), n.trim().parse::<u32>());
-        match (index, count) {
-            (Ok(index), Ok(count)) if (1..=count).contains(&index) && count <= MAX_SHARDS => Ok(Shard { index, count }),
-            _ => Err(bad()),
-        }
-    }
-}
-
-impl fmt::Display for Shard {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-impl Shard {
-    /// The shard's folder under a results folder: `shards/K-of-N`.
-    pub fn dir(&self, results: &Path) -> PathBuf {
-        results.join("shards").join(format!("{}-of-{}", self.index, self.count))
-    }
-}
 
 /// Rays one frame of `lights` lights at `samples` rays each traces at most: the unit of
 /// expected cost.
@@ -97,7 +58,8 @@ pub fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
     deal(spec, groups, count).0
 }
 
-/// [`assign`]'s shares, and each share's expected rays (ground truths it renders included).
+/// [`assign`]'s shares, and each share's expected rays (ground truths it renders included):
+/// the core's deal ([`deal_costs`]), each group's setup its (lights, radius) ground truth.
 pub fn deal(spec: &Spec, groups: &[Group], count: u32) -> (Vec<u32>, Vec<f64>) {
     // Frame rays per (lights, samples): each asks for a scene, so each is computed once.
     let mut memo: HashMap<(u32, u32), f64> = HashMap::new();
@@ -106,34 +68,19 @@ pub fn deal(spec: &Spec, groups: &[Group], count: u32) -> (Vec<u32>, Vec<f64>) {
             .entry((lights, samples))
             .or_insert_with(|| frame_rays(spec, lights, samples))
     };
-    let cost: Vec<f64> = groups
+    let costs: Vec<Cost> = groups
         .iter()
-        .map(|g| g.runs.len() as f64 * rays(g.head().lights, g.head().samples))
+        .map(|g| {
+            let head = g.head();
+            let pair = fnv1a(format!("{};{}", head.lights, head.light_radius.to_bits()).as_bytes());
+            Cost {
+                work: g.runs.len() as f64 * rays(head.lights, head.samples),
+                setup: Some((pair, rays(head.lights, spec.ground_truth.samples))),
+                tie: head.key_text(),
+            }
+        })
         .collect();
-    let pair = |g: &Group| (g.head().lights, g.head().light_radius.to_bits());
-    let mut order: Vec<usize> = (0..groups.len()).collect();
-    order.sort_by(|&a, &b| {
-        cost[b]
-            .total_cmp(&cost[a])
-            .then_with(|| groups[a].head().key_text().cmp(&groups[b].head().key_text()))
-    });
-    let mut load = vec![0.0f64; count as usize];
-    let mut holds: Vec<Vec<(u32, u64)>> = vec![Vec::new(); count as usize];
-    let mut share = vec![0u32; groups.len()];
-    for i in order {
-        let p = pair(&groups[i]);
-        let reference = rays(p.0, spec.ground_truth.samples);
-        let finish = |s: usize| load[s] + cost[i] + if holds[s].contains(&p) { 0.0 } else { reference };
-        let best = (0..count as usize)
-            .min_by(|&a, &b| finish(a).total_cmp(&finish(b)))
-            .expect("at least one share");
-        load[best] = finish(best);
-        if !holds[best].contains(&p) {
-            holds[best].push(p);
-        }
-        share[i] = best as u32;
-    }
-    (share, load)
+    deal_costs(&costs, count)
 }
 
 /// The groups of the sweep that fall to `shard`, in canonical order.
@@ -261,18 +208,11 @@ pub fn dry_run(spec: &Spec, shard: Shard) -> String {
         .map(|(g, _)| g)
         .collect();
     let runs: usize = mine.iter().map(|g| g.runs.len()).sum();
-    let total: f64 = rays.iter().sum();
-    let mut out = format!(
-        "{}: shard {shard}: {runs} runs in {} configurations, {:.1} % of the rays the shards \
-         trace, ground truths included (shares: {})\n",
-        spec.name,
-        mine.len(),
-        100.0 * rays[shard.index as usize - 1] / total.max(1.0),
-        rays.iter()
-            .map(|r| format!("{:.1} %", 100.0 * r / total.max(1.0)))
-            .collect::<Vec<_>>()
-            .join(", ")
+    let what = format!(
+        "runs in {} configurations (units: a configuration with its seeds)",
+        mine.len()
     );
+    let mut out = share_line(&spec.name, shard, runs, &what, &rays);
     for g in mine {
         let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
         out += &format!("  {} seeds=[{}]\n", g.config(), seeds.join(", "));

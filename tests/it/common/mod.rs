@@ -250,3 +250,33 @@ impl penumbra::render::Backend for Flaky {
 pub fn hook_site(seed: u32, pixel: u32) -> penumbra::sampling::Site {
     penumbra::sampling::Site::pixel(seed, 0, [pixel % 64, pixel / 64], pixel)
 }
+
+/// Columns whose values come from the clock (timing phases, builds, updates).
+const CLOCK_COLUMNS: [&str; 8] = [
+    "timed_frames",
+    "rays_per_s",
+    "primary_rays_per_s",
+    "shadow_rays_per_s",
+    "frames_per_s",
+    "clock",
+    "build_s",
+    "update_s",
+];
+
+/// The rows of a CSV file with the clock's columns blanked: what must not differ between runs of
+/// one experiment, however its work was split, interrupted or resumed.
+pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
+    let clock = |name: &str| CLOCK_COLUMNS.contains(&name) || name.starts_with("frame_s");
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header = r.headers().unwrap().clone();
+    let mut rows = vec![header.iter().map(String::from).collect::<Vec<_>>()];
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        let row = rec.iter().zip(header.iter());
+        rows.push(
+            row.map(|(v, h)| if clock(h) { String::new() } else { v.to_string() })
+                .collect(),
+        );
+    }
+    rows
+}

@@ -1,0 +1,170 @@
+//! `--filter AXIS=VALUE`: runs a subset of any experiment. A kind declares its axes
+//! ([`Axis`]: a name and the values its file lists); each filter keeps, on its axis, only the
+//! values named (repeating an axis keeps each value named). An axis the kind does not have, or a
+//! value its file does not list, is an error naming what there is, so a typo never runs an empty
+//! or unintended experiment.
+
+/// One axis of a kind, as filters, dry runs and results-folder names see it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axis {
+    /// Its column and filter name.
+    pub name: &'static str,
+    /// Its values' texts, in the experiment file's order.
+    pub values: Vec<String>,
+}
+
+/// One `AXIS=VALUE` filter, as written; checked against a kind's axes by [`select`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Filter {
+    /// The axis name.
+    pub axis: String,
+    /// The value as written.
+    pub value: String,
+}
+
+impl std::str::FromStr for Filter {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Filter, String> {
+        let (axis, value) = s
+            .split_once('=')
+            .ok_or_else(|| format!("`{s}`: a filter is AXIS=VALUE (the axes are listed by --dry-run)"))?;
+        let (axis, value) = (axis.trim(), value.trim());
+        if axis.is_empty() || value.is_empty() {
+            return Err(format!("`{s}`: a filter is AXIS=VALUE, both non-empty"));
+        }
+        Ok(Filter {
+            axis: axis.into(),
+            value: value.into(),
+        })
+    }
+}
+
+impl std::fmt::Display for Filter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}={}", self.axis, self.value)
+    }
+}
+
+/// What `filters` keep of `axes`: per filtered axis (in declared order), its index and the
+/// indices of the values kept, in the file's order. `same` says whether two value texts name the
+/// same value (numbers written two ways, `0.02` and `2e-2`, are one).
+pub fn select(
+    axes: &[Axis],
+    filters: &[Filter],
+    same: impl Fn(&str, &str) -> bool,
+) -> Result<Vec<(usize, Vec<usize>)>, String> {
+    let names: Vec<&str> = axes.iter().map(|a| a.name).collect();
+    for f in filters {
+        if !names.contains(&f.axis.as_str()) {
+            return Err(format!(
+                "--filter {f}: unknown axis `{}`; this experiment's axes are {}",
+                f.axis,
+                names.join(", ")
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    for (i, axis) in axes.iter().enumerate() {
+        let named: Vec<&Filter> = filters.iter().filter(|f| f.axis == axis.name).collect();
+        if named.is_empty() {
+            continue;
+        }
+        let mut keep = Vec::new();
+        for f in named {
+            let at = axis.values.iter().position(|v| same(v, &f.value)).ok_or_else(|| {
+                format!(
+                    "--filter {f}: not among the experiment's {} values: {}",
+                    axis.name,
+                    axis.values.join(", ")
+                )
+            })?;
+            keep.push(at);
+        }
+        keep.sort_unstable();
+        keep.dedup();
+        out.push((i, keep));
+    }
+    Ok(out)
+}
+
+/// Value texts that name the same value: equal, or equal as numbers.
+pub fn same_text(a: &str, b: &str) -> bool {
+    a == b || matches!((a.parse::<f64>(), b.parse::<f64>()), (Ok(x), Ok(y)) if x == y)
+}
+
+/// `list` keeping only the entries at `keep` (sorted indices).
+pub fn keep_at<T>(list: &mut Vec<T>, keep: &[usize]) {
+    let mut i = 0;
+    list.retain(|_| {
+        i += 1;
+        keep.contains(&(i - 1))
+    });
+}
+
+/// A results-folder suffix naming the filters, e.g. `scheme=paper,samples=16`.
+pub fn label(filters: &[Filter]) -> String {
+    filters.iter().map(Filter::to_string).collect::<Vec<_>>().join(",")
+}
+
+/// `--filter`'s help.
+pub const HELP: &str = "Run only the work whose AXIS has VALUE (each kind's axes are listed by \
+--dry-run: a sweep's scheme, pattern, samples, light_radius, lights, accelerator, seed; ao's mesh, \
+structure, issue; frames' scene, shading, viewpoint; fps' scene, lights, resolution); repeat to keep \
+several values or restrict several axes";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axes() -> Vec<Axis> {
+        vec![
+            Axis {
+                name: "scheme",
+                values: vec!["uniform".into(), "paper".into(), "sobol".into()],
+            },
+            Axis {
+                name: "light_radius",
+                values: vec!["0.01".into(), "0.02".into()],
+            },
+        ]
+    }
+
+    fn filters(s: &[&str]) -> Vec<Filter> {
+        s.iter().map(|f| f.parse().unwrap()).collect()
+    }
+
+    #[test]
+    fn filters_keep_the_named_values_in_file_order() {
+        let got = select(
+            &axes(),
+            &filters(&["scheme=sobol", "scheme=uniform", "light_radius=2e-2"]),
+            same_text,
+        )
+        .unwrap();
+        assert_eq!(got, vec![(0, vec![0, 2]), (1, vec![1])]);
+        let mut list = vec!['a', 'b', 'c'];
+        keep_at(&mut list, &[0, 2]);
+        assert_eq!(list, ['a', 'c']);
+        assert_eq!(
+            label(&filters(&["scheme=paper", "samples=16"])),
+            "scheme=paper,samples=16"
+        );
+    }
+
+    #[test]
+    fn unknown_axes_and_unlisted_values_are_errors_naming_what_there_is() {
+        assert!("scheme".parse::<Filter>().unwrap_err().contains("AXIS=VALUE"));
+        assert!("=x".parse::<Filter>().is_err());
+        let e = select(&axes(), &filters(&["colour=red"]), same_text).unwrap_err();
+        assert!(
+            e.contains("unknown axis `colour`") && e.contains("scheme, light_radius"),
+            "{e}"
+        );
+        let e = select(&axes(), &filters(&["scheme=halton"]), same_text).unwrap_err();
+        assert!(
+            e.contains("not among the experiment's scheme values") && e.contains("uniform, paper, sobol"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,154 @@
+//! Every kind on the experiment core: the CI twins of ao, frames and fps run whole, as two shards
+//! merged, and killed after their first journaled unit then resumed, give the same tables but for
+//! the clock's columns; a merge missing a shard is refused with the command that reruns it and
+//! writes nothing; filters keep only the units and values named and refuse what a kind does not
+//! have.
+
+use crate::common;
+use std::ffi::{OsStr, OsString};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn run(args: &[&OsStr]) -> (i32, String) {
+    common::sweep(args)
+}
+
+fn run_ok(args: &[&OsStr]) -> String {
+    let (code, err) = run(args);
+    assert_eq!(code, 0, "sweep {args:?} failed:\n{err}");
+    err
+}
+
+/// `experiment` with `edit` applied, written into `dir` (mesh and scene paths made absolute).
+fn variant(dir: &Path, experiment: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(common::repo(experiment)).unwrap();
+    let assets = common::repo("assets").display().to_string();
+    let scenes = common::repo("experiments/scenes").display().to_string();
+    let text = text
+        .replace("\"../assets", &format!("\"{assets}"))
+        .replace("\"scenes/", &format!("\"{scenes}/"));
+    let path = dir.join(Path::new(experiment).file_name().unwrap());
+    std::fs::write(&path, edit(text)).unwrap();
+    path
+}
+
+/// Runs `experiment` whole, as two shards merged (after a refused merge missing one), and killed
+/// after one unit then resumed; every run's `tables` must equal the whole run's but for the clock,
+/// and the first table must have rows.
+fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = experiment.as_os_str();
+    let at = |name: &str| dir.path().join(name);
+    let (full, sharded, killed) = (at("full"), at("sharded"), at("killed"));
+    let out = |p: &Path| -> [OsString; 2] { ["--out".into(), p.into()] };
+    let [o, f] = out(&full);
+    run_ok(&[exp, &o, &f]);
+
+    let [o, s] = out(&sharded);
+    run_ok(&[exp, &o, &s, OsStr::new("--shard"), OsStr::new("1/2")]);
+    let (code, err) = run(&[exp, &o, &s, OsStr::new("--merge"), OsStr::new("2")]);
+    assert_eq!(code, 4, "{err}");
+    assert!(
+        err.contains("shard 2/2 is incomplete") && err.contains("rerun it: sweep") && err.contains("--shard 2/2"),
+        "{err}"
+    );
+    assert!(!sharded.join("manifest.toml").exists(), "a refused merge wrote results");
+    run_ok(&[exp, &o, &s, OsStr::new("--shard"), OsStr::new("2/2")]);
+    run_ok(&[exp, &o, &s, OsStr::new("--merge"), OsStr::new("2")]);
+
+    let [o, k] = out(&killed);
+    let status = Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .args([exp, &o, &k])
+        .env("PENUMBRA_TEST_DIE_AFTER", "1")
+        .output()
+        .unwrap()
+        .status;
+    assert!(!status.success() && status.code().is_none(), "not killed: {status:?}");
+    assert!(!killed.join("manifest.toml").exists());
+    let err = run_ok(&[exp, &o, &k]);
+    assert!(
+        err.contains("1 of") && err.contains("units taken from the journal"),
+        "{err}"
+    );
+
+    for (i, table) in tables.iter().enumerate() {
+        let whole = common::without_clock(&full.join(table));
+        assert!(i > 0 || whole.len() > 1, "{table}: no rows");
+        for other in [&sharded, &killed] {
+            assert!(
+                whole == common::without_clock(&other.join(table)),
+                "{table}: {} differs from the whole run",
+                other.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn ao_sharded_merged_and_resumed_gives_the_whole_runs_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    // One candidate per structure: tuning picks by time, so it would make the settings (and the
+    // work they cost) depend on the clock.
+    let exp = variant(dir.path(), "experiments/ao-ci.toml", |t| {
+        t.replace("max_depth = [8, 22]", "max_depth = 22")
+            .replace("depth = [2, 4]", "depth = 3")
+    });
+    whole_sharded_and_resumed_agree(&exp, &["ao.csv", "tuning.csv"]);
+}
+
+#[test]
+fn frames_in_blocks_sharded_merged_and_resumed_give_the_whole_runs_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = variant(dir.path(), "experiments/frames-ci.toml", |t| {
+        t.replace("[path]\nframes = 3", "[path]\nframes = 3\nblock = 2")
+    });
+    whole_sharded_and_resumed_agree(&exp, &["frames.csv", "builds.csv", "summary.csv"]);
+}
+
+#[test]
+fn fps_sharded_merged_and_resumed_gives_the_whole_runs_table() {
+    whole_sharded_and_resumed_agree(&common::repo("experiments/fps-ci.toml"), &["fps.csv"]);
+}
+
+#[test]
+fn filters_keep_the_units_and_values_named_and_refuse_what_a_kind_lacks() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::repo("experiments/ao-ci.toml");
+    let dry = |filters: &[&str]| {
+        let mut args: Vec<&OsStr> = vec![exp.as_os_str(), OsStr::new("--dry-run")];
+        for f in filters {
+            args.extend([OsStr::new("--filter"), OsStr::new(f)]);
+        }
+        run(&args)
+    };
+    let (code, err) = dry(&["colour=red"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("unknown axis `colour`") && err.contains("mesh, structure, issue"),
+        "{err}"
+    );
+    let (code, err) = dry(&["structure=octree"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("kdtree, kdtree-sah, vlf, bvh, cwbvh, brute"), "{err}");
+
+    let out = dir.path().join("cow");
+    run_ok(&[
+        exp.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+        OsStr::new("--filter"),
+        OsStr::new("mesh=cow"),
+        OsStr::new("--filter"),
+        OsStr::new("structure=bvh"),
+        OsStr::new("--filter"),
+        OsStr::new("structure=brute"),
+    ]);
+    let rows = common::without_clock(&out.join("ao.csv"));
+    let (mesh, structure) = (rows[0].iter().position(|h| h == "mesh").unwrap(), 2);
+    assert_eq!(rows[0][structure], "structure");
+    let kept: Vec<(&str, &str)> = rows[1..]
+        .iter()
+        .map(|r| (r[mesh].as_str(), r[structure].as_str()))
+        .collect();
+    assert_eq!(kept, [("cow", "bvh"), ("cow", "brute")]);
+}
