@@ -12,7 +12,9 @@
 //! one and an uninterrupted one write their non-timing outputs byte for byte alike.
 
 use super::filter::{self, Axis, Filter};
-use super::merge::{differing_fields, list_lines, rerun_command, shard_dirs, split_count, MergeRefused};
+use super::merge::{
+    differing_fields, list_lines, read_shard_manifest, rerun_command, shard_dirs, split_count, MergeRefused,
+};
 use super::shard::{deal, share_line, Cost, Shard};
 use crate::experiment::cli::{BadInput, Cli};
 use crate::experiment::header::Header;
@@ -424,19 +426,7 @@ impl<D: Declaration> Declared<D> {
 /// Reads the manifest of the shard in `dir` (a folder of folders and regular files only), or
 /// says why it cannot be taken.
 fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<(Shard, ShardManifest), String> {
-    if !dir.is_dir() {
-        return Err(format!("{}: no such shard folder", dir.display()));
-    }
-    // A shard is read back whole: a link or pipe in it would read outside it or block.
-    crate::files::check_plain_tree(dir).map_err(|e| e.to_string())?;
-    let path = dir.join(SHARD_MANIFEST);
-    let text = crate::files::read_regular_text(&path)
-        .map_err(|_| format!("{}: no {SHARD_MANIFEST}: the shard has not finished", dir.display()))?;
-    let m: ShardManifest = toml::from_str(&text).map_err(|e| format!("{}: unreadable: {e}", path.display()))?;
-    let shard: Shard = m
-        .shard
-        .parse()
-        .map_err(|e| format!("{}: key `shard`: {e}", path.display()))?;
+    let (shard, m) = read_shard_manifest(dir, SHARD_MANIFEST, |m: &ShardManifest| &m.shard)?;
     if m.context != context {
         return Err(format!(
             "{}: shard {shard} ran under another {} than this merge (same inputs, axes, device and build \

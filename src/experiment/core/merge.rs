@@ -4,6 +4,7 @@
 use super::shard::{Shard, MAX_SHARDS};
 use crate::experiment::cli::{BadInput, Cli};
 use clap::ValueEnum;
+use serde::de::DeserializeOwned;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -105,4 +106,26 @@ pub fn differing_fields(a: &str, b: &str) -> Vec<String> {
         out.push("context".into());
     }
     out
+}
+
+/// The manifest `name` a finished shard in `dir` wrote last (the folder holding only folders and
+/// regular files), and the shard its key `shard` names; or why the shard cannot be taken.
+pub fn read_shard_manifest<M: DeserializeOwned>(
+    dir: &Path,
+    name: &str,
+    shard_of: impl Fn(&M) -> &str,
+) -> Result<(Shard, M), String> {
+    if !dir.is_dir() {
+        return Err(format!("{}: no such shard folder", dir.display()));
+    }
+    // A shard is read back whole: a link or pipe in it would read outside it or block.
+    crate::files::check_plain_tree(dir).map_err(|e| e.to_string())?;
+    let path = dir.join(name);
+    let text = crate::files::read_regular_text(&path)
+        .map_err(|_| format!("{}: no {name}: the shard has not finished", dir.display()))?;
+    let m: M = toml::from_str(&text).map_err(|e| format!("{}: unreadable: {e}", path.display()))?;
+    let shard = shard_of(&m)
+        .parse()
+        .map_err(|e| format!("{}: key `shard`: {e}", path.display()))?;
+    Ok((shard, m))
 }

@@ -13,7 +13,7 @@ use super::runner::{by_reference, empty_outcome, figure_samples, keep_figure, ti
 use super::shard::{assign, sweep_identity, Shard, ShardManifest, GROUPS, MANIFEST, RECORDS};
 use super::spec::Spec;
 pub use crate::experiment::core::merge::MergeRefused;
-use crate::experiment::core::merge::{differing_fields, list_lines, split_count};
+use crate::experiment::core::merge::{differing_fields, list_lines, read_shard_manifest, split_count};
 use crate::fingerprint::fnv1a;
 use crate::output::table::read_rows;
 use crate::render::Backend;
@@ -34,20 +34,7 @@ struct ShardFiles {
 /// Reads the shard in `dir` (a folder of folders and regular files only), or says why it cannot
 /// be taken.
 fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<ShardFiles, String> {
-    if !dir.is_dir() {
-        return Err(format!("{}: no such shard folder", dir.display()));
-    }
-    // A shard is read back whole: a link or pipe in it would read outside it or block.
-    crate::files::check_plain_tree(dir).map_err(|e| e.to_string())?;
-    let manifest_path = dir.join(MANIFEST);
-    let text = std::fs::read_to_string(&manifest_path)
-        .map_err(|_| format!("{}: no {MANIFEST}: the shard has not finished", dir.display()))?;
-    let manifest: ShardManifest =
-        toml::from_str(&text).map_err(|e| format!("{}: unreadable: {e}", manifest_path.display()))?;
-    let shard: Shard = manifest
-        .shard
-        .parse()
-        .map_err(|e| format!("{}: key `shard`: {e}", manifest_path.display()))?;
+    let (shard, manifest) = read_shard_manifest(dir, MANIFEST, |m: &ShardManifest| &m.shard)?;
     if manifest.context != context {
         return Err(format!(
             "{}: shard {shard} ran under another {} than this merge (same inputs, device and build are \
