@@ -8,7 +8,7 @@ use super::core::MergeRefused;
 use super::manifest::{peak_rss, utc, Build, Input, Machine, Manifest, RunInfo, SCHEMA};
 use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
-use super::{load, Experiment, Finished, Run};
+use super::{load, Experiment, Finished, RunContext};
 use crate::render::{cpu::CpuBackend, open_backend, Backend, BackendChoice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -90,7 +90,7 @@ fn run_into(
         home.display()
     );
     let progress = Progress::new();
-    let finished = experiment.run(&mut Run {
+    let finished = experiment.run(&mut RunContext {
         backend: backend.as_mut(),
         cli,
         home,

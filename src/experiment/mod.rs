@@ -43,7 +43,7 @@ pub struct Accepts {
 }
 
 /// Everything a kind's run may use.
-pub struct Run<'a> {
+pub struct RunContext<'a> {
     /// The device.
     pub backend: &'a mut dyn Backend,
     /// The command line.
@@ -103,7 +103,7 @@ pub trait Experiment {
     }
 
     /// Runs and writes the outputs into `run.out`.
-    fn run(&self, run: &mut Run) -> anyhow::Result<Finished>;
+    fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished>;
 }
 
 /// What of `scene`, read from `path`, the GPU cannot run: a pass or material without a kernel

@@ -10,5 +10,5 @@ pub mod quadrature;
 pub mod visibility;
 
 pub use on_axis::OnAxis;
-pub use quadrature::Estimate;
+pub use quadrature::Integral;
 pub use visibility::{occluders, visible_fraction, visible_fraction_estimate};

@@ -54,7 +54,7 @@ pub const MAX_PANELS: u32 = 1 << 14;
 
 /// An integral with what the adaptive rule knows of its accuracy.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Estimate {
+pub struct Integral {
     /// The integral.
     pub value: f64,
     /// Sum of |Kronrod - Gauss| over the accepted panels: the rule's (usually pessimistic) bound
@@ -66,10 +66,10 @@ pub struct Estimate {
     pub depth_limited: u32,
 }
 
-impl std::ops::Add for Estimate {
-    type Output = Estimate;
-    fn add(self, o: Estimate) -> Estimate {
-        Estimate {
+impl std::ops::Add for Integral {
+    type Output = Integral;
+    fn add(self, o: Integral) -> Integral {
+        Integral {
             value: self.value + o.value,
             error: self.error + o.error,
             depth_limited: self.depth_limited + o.depth_limited,
@@ -81,19 +81,19 @@ impl std::ops::Add for Estimate {
 /// (a feature narrower than all 15 nodes of a panel can be missed by any adaptive rule; the
 /// initial grid bounds how narrow that is) and bisecting panels whose error estimate exceeds
 /// their share of `tol`, down to [`MAX_DEPTH`].
-pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels: u32) -> Estimate {
+pub fn integrate_panels(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, panels: u32) -> Integral {
     let h = (b - a) / panels as f64;
     (0..panels)
         .map(|i| {
             let (x0, x1) = (a + h * i as f64, a + h * (i + 1) as f64);
             integrate(&f, x0, x1, tol / panels as f64)
         })
-        .fold(Estimate::default(), |acc, e| acc + e)
+        .fold(Integral::default(), |acc, e| acc + e)
 }
 
 /// Integral of `f` over [a, b] to absolute tolerance `tol` (bisecting panels whose error
 /// estimate exceeds their share), stopping at [`MAX_DEPTH`] or when [`MAX_PANELS`] are spent.
-pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Estimate {
+pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Integral {
     struct Rule<'a, F> {
         f: &'a F,
         spent: std::cell::Cell<u32>,
@@ -103,9 +103,9 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> Estimate {
             self.spent.set(self.spent.get() + 1);
             panel(self.f, a, b)
         }
-        fn rec(&self, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> Estimate {
+        fn rec(&self, a: f64, b: f64, tol: f64, whole: (f64, f64), depth: u32) -> Integral {
             if whole.1 <= tol || depth >= MAX_DEPTH || self.spent.get() + 2 > MAX_PANELS {
-                return Estimate {
+                return Integral {
                     value: whole.0,
                     error: whole.1,
                     depth_limited: (whole.1 > tol) as u32,
@@ -130,7 +130,7 @@ mod tests {
 
     /// The estimate is within its own error bound of the known integral and the bound is within
     /// the tolerance asked for.
-    fn converges(e: Estimate, exact: f64, tol: f64) {
+    fn converges(e: Integral, exact: f64, tol: f64) {
         assert!(
             (e.value - exact).abs() <= e.error + 4.0 * f64::EPSILON * exact.abs(),
             "{e:?} vs {exact}"

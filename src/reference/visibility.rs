@@ -10,7 +10,7 @@
 //! FACTS.md, generalised to any number of spheres and planes and to lights that touch or
 //! enter an occluder.
 
-use super::quadrature::{integrate_panels, Estimate};
+use super::quadrature::{integrate_panels, Integral};
 use crate::scene::{DiskLight, Plane, Scene, Shape, Sphere};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
@@ -55,8 +55,8 @@ pub fn visible_fraction_estimate(
     light: &DiskLight,
     spheres: &[Sphere],
     planes: &[Plane],
-) -> Estimate {
-    let exactly = |value: f64| Estimate {
+) -> Integral {
+    let exactly = |value: f64| Integral {
         value,
         ..Default::default()
     };
@@ -92,7 +92,7 @@ pub fn visible_fraction_estimate(
     };
     let total = integrate_panels(chord, 0.0, TAU, TOLERANCE * PI * a * a, PANELS);
     let area = PI * a * a;
-    Estimate {
+    Integral {
         value: (total.value / area).clamp(0.0, 1.0),
         error: total.error / area,
         depth_limited: total.depth_limited,

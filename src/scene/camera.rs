@@ -42,7 +42,7 @@ pub struct Ray {
 
 /// The camera's orthonormal frame: right, up, forward.
 #[derive(Clone, Copy, Debug)]
-pub struct Frame {
+pub struct Basis {
     /// +x of the image.
     pub right: DVec3,
     /// +y of the image (rows grow downwards).
@@ -53,10 +53,10 @@ pub struct Frame {
 
 impl Camera {
     /// The camera's frame; `None` when `up` is parallel to the viewing direction.
-    pub fn frame(&self) -> Option<Frame> {
+    pub fn frame(&self) -> Option<Basis> {
         let forward = (self.look_at - self.position).try_normalize()?;
         let right = forward.cross(self.up).try_normalize()?;
-        Some(Frame {
+        Some(Basis {
             right,
             up: right.cross(forward),
             forward,
@@ -94,7 +94,7 @@ impl Camera {
     }
 
     /// Parameters the GPU needs to generate the same rays: frame, half extents, kind.
-    pub fn gpu_terms(&self, width: u32, height: u32) -> (Frame, (f64, f64), bool) {
+    pub fn gpu_terms(&self, width: u32, height: u32) -> (Basis, (f64, f64), bool) {
         let f = self.frame().expect("validated camera has a frame");
         (
             f,

@@ -27,7 +27,7 @@
 
 use super::bsp;
 use super::raster::{clipped_z_range, for_each_tile, sub_box};
-use super::{Frame, VlfSettings, EPS};
+use super::{UnitBall, VlfSettings, EPS};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -228,7 +228,12 @@ impl Layer {
     }
 
     /// Builds the layer over triangles `subset` of `world`.
-    pub fn build(world: &[[DVec3; 3]], subset: &[u32], frame: &Frame, settings: &VlfSettings) -> anyhow::Result<Layer> {
+    pub fn build(
+        world: &[[DVec3; 3]],
+        subset: &[u32],
+        frame: &UnitBall,
+        settings: &VlfSettings,
+    ) -> anyhow::Result<Layer> {
         let dirs = frame.directions.len();
         let wide = subset.iter().any(|&t| t >= NARROW_DEAD);
         let parts: Vec<Part> = (0..dirs as u32)
@@ -306,7 +311,7 @@ fn push_entry(words: &mut Vec<u32>, id: u32, b: u16, wide: bool) {
 
 /// Tile coordinates (x, y in tiles, z in ball units) of world point `p` for direction `k`.
 #[inline]
-pub fn to_tile(frame: &Frame, rot: &[DVec3; 3], p: DVec3) -> DVec3 {
+pub fn to_tile(frame: &UnitBall, rot: &[DVec3; 3], p: DVec3) -> DVec3 {
     let q = p - frame.centre;
     let s = frame.inv_radius * frame.half_tiles;
     DVec3::new(
@@ -320,7 +325,7 @@ fn direction_part(
     k: u32,
     world: &[[DVec3; 3]],
     subset: &[u32],
-    frame: &Frame,
+    frame: &UnitBall,
     settings: &VlfSettings,
     wide: bool,
 ) -> Part {

@@ -11,7 +11,7 @@
 //! is a superset.
 //!
 //! # Spaces
-//! The scene is normalised into the unit ball: `p_ball = (p - centre) / radius` ([`Frame`]; the
+//! The scene is normalised into the unit ball: `p_ball = (p - centre) / radius` ([`UnitBall`]; the
 //! ball's radius is the farthest vertex from the bounding-box centre). Direction `k`'s rotation
 //! rows `a, b, w` ([`directions::Directions::rows`]) take it to canonical space, where the beams
 //! run along `+z` and tile `(tx, ty)` of `n` covers `x_ball, y_ball` in
@@ -137,7 +137,7 @@ impl VlfSettings {
 
 /// The normalisation into the unit ball and the directions: what every layer shares.
 #[derive(Clone, Debug)]
-pub struct Frame {
+pub struct UnitBall {
     /// Ball centre in world space (the triangles' bounding-box centre).
     pub centre: DVec3,
     /// Ball radius in world units (farthest vertex from `centre`).
@@ -156,7 +156,7 @@ pub struct VisibilityField {
     /// Parameters built with.
     pub settings: VlfSettings,
     /// Ball and directions.
-    pub frame: Frame,
+    pub frame: UnitBall,
     /// Every triangle of the build.
     pub base: Layer,
     /// Triangles inserted or moved since ([`dynamic`]).
@@ -228,7 +228,7 @@ impl VisibilityField {
             world.len()
         );
         let (centre, radius) = ball(&world);
-        let frame = Frame {
+        let frame = UnitBall {
             centre,
             radius,
             inv_radius: 1.0 / radius,

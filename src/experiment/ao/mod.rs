@@ -17,7 +17,7 @@ use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::Run;
+use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 
@@ -109,7 +109,7 @@ impl Declaration for AoSpec {
         run_mesh(self, &self.meshes[unit.at[0]], backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<MeshOutcome>, run: &Run) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<MeshOutcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
         let (mut rows, mut tuning) = (Vec::new(), Vec::new());
         for o in outcomes {
             rows.extend(o.rows);

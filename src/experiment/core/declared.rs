@@ -19,7 +19,7 @@ use super::shard::{deal, share_line, Cost, Shard};
 use crate::experiment::cli::{BadInput, Cli};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::{Accepts, Experiment, Finished, Run};
+use crate::experiment::{Accepts, Experiment, Finished, RunContext};
 use crate::fingerprint::{build_id, fnv1a};
 use crate::render::{AdapterInfo, Backend};
 use serde::de::DeserializeOwned;
@@ -78,7 +78,7 @@ pub trait Declaration: Clone {
 
     /// Writes the outputs from every unit's outcome (canonical order) into `run.out`; returns
     /// the kind's table for the manifest.
-    fn report(&self, outcomes: Vec<Self::Outcome>, run: &Run) -> anyhow::Result<toml::Table>;
+    fn report(&self, outcomes: Vec<Self::Outcome>, run: &RunContext) -> anyhow::Result<toml::Table>;
 }
 
 /// A declared kind as an experiment.
@@ -287,7 +287,7 @@ impl<D: Declaration> Declared<D> {
     }
 
     /// Runs `shard`'s share into `shard.dir(home)`: its journal, then `shard.toml` last.
-    fn run_shard(&self, spec: &D, shard: Shard, run: &mut Run) -> anyhow::Result<Finished> {
+    fn run_shard(&self, spec: &D, shard: Shard, run: &mut RunContext) -> anyhow::Result<Finished> {
         let started = std::time::Instant::now();
         let dir = shard.dir(run.home);
         let manifest_path = dir.join(SHARD_MANIFEST);
@@ -322,7 +322,7 @@ impl<D: Declaration> Declared<D> {
 
     /// The outcomes of every unit, from the shards `run.cli.merge` names, or a refusal listing
     /// what is missing, duplicated or foreign and the shards to rerun.
-    fn merge(&self, spec: &D, run: &mut Run) -> anyhow::Result<(Vec<D::Outcome>, Vec<String>)> {
+    fn merge(&self, spec: &D, run: &mut RunContext) -> anyhow::Result<(Vec<D::Outcome>, Vec<String>)> {
         let (dirs, given) = shard_dirs(&run.cli.merge, run.home)?;
         let units = spec.units();
         let context = context(spec, run.backend.adapter())?;
@@ -495,7 +495,7 @@ impl<D: Declaration> Experiment for Declared<D> {
         })
     }
 
-    fn run(&self, run: &mut Run) -> anyhow::Result<Finished> {
+    fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
         let spec = self.filtered(&run.cli.filter)?;
         if let Some(shard) = run.cli.shard {
             return self.run_shard(&spec, shard, run);

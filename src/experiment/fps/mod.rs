@@ -16,7 +16,7 @@ use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::Run;
+use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 
@@ -129,7 +129,7 @@ impl Declaration for FpsSpec {
         run_scenes(self, &unit.at, backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<Vec<FpsRow>>, run: &Run) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<Vec<FpsRow>>, run: &RunContext) -> anyhow::Result<toml::Table> {
         let rows: Vec<FpsRow> = outcomes.into_iter().flatten().collect();
         report::write_fps(
             self,

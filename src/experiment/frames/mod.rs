@@ -17,7 +17,7 @@ use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::Run;
+use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 
@@ -140,7 +140,7 @@ impl Declaration for FramesSpec {
         run_block(self, &Block::of(&unit.at), backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<FramesOutcome>, run: &Run) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<FramesOutcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
         let mut outcome = FramesOutcome::default();
         for o in outcomes {
             outcome.frames.extend(o.frames);

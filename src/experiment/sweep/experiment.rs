@@ -12,7 +12,7 @@ use crate::experiment::cli::{BadInput, Cli};
 use crate::experiment::core::filter;
 use crate::experiment::core::merge::{rerun_command, shard_dirs};
 use crate::experiment::header::Header;
-use crate::experiment::{Accepts, Experiment, Finished, Run};
+use crate::experiment::{Accepts, Experiment, Finished, RunContext};
 use anyhow::Context;
 use std::path::PathBuf;
 use tracing::info;
@@ -70,7 +70,7 @@ impl Experiment for Spec {
         })
     }
 
-    fn run(&self, run: &mut Run) -> anyhow::Result<Finished> {
+    fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
         let spec = self.for_cli(run.cli)?;
         let cli = run.cli;
         info!("{} runs", expand(&spec).iter().map(|g| g.runs.len()).sum::<usize>());

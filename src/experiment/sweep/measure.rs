@@ -1,7 +1,9 @@
 //! One run measured: render it, compare it with its reference, and assemble its record (its frame
 //! time stays unmeasured until the timing phase fills it in).
 
-use super::record::{Device, FrameTime, Metrics, Radial, RayCounts, Record, SpectrumColumns, Status, StructureColumns};
+use super::record::{
+    Device, FrameTime, Metrics, Radial, Record, SpectrumColumns, Status, StructureColumns, WorkCounts,
+};
 use super::reference::{shadow_image, Reference};
 use super::run::Run;
 use super::spec::Spec;
@@ -20,7 +22,7 @@ fn unmeasured(spec: &Spec, backend: &dyn Backend, run: &Run, context: &str, stat
         radial: Radial::unmeasured(spec.measure.width, spec.measure.height),
         metrics: Metrics::NONE,
         spectrum: SpectrumColumns::NONE,
-        rays: RayCounts::default(),
+        rays: WorkCounts::default(),
         time: FrameTime::UNTIMED,
         structure: StructureColumns::NONE,
         parameters: ParameterColumns::none(),
@@ -73,7 +75,7 @@ pub fn measure_run(
     (m.rmse, m.relmse, m.bias, m.rmse_exact) = (vs_gt.rmse, vs_gt.relmse, vs_gt.bias, rmse_exact);
     (m.penumbra_area_ratio, m.penumbra_lost_share) = (area_ratio, lost);
     let work = frame.work();
-    r.rays = RayCounts {
+    r.rays = WorkCounts {
         primary_rays: Some(rays.primary),
         shadow_rays: Some(rays.shadow_total()),
         queries: work.map(|w| w.queries),

@@ -39,7 +39,7 @@ pub struct Record {
     /// The radial power spectrum of its error image.
     pub spectrum: SpectrumColumns,
     /// Rays traced.
-    pub rays: RayCounts,
+    pub rays: WorkCounts,
     /// Its configuration's frame time, from the timing phase.
     pub time: FrameTime,
     /// The scene's acceleration structure, on mesh scenes.
@@ -75,7 +75,7 @@ type Parts = (
     Radial,
     Metrics,
     SpectrumColumns,
-    RayCounts,
+    WorkCounts,
     FrameTime,
     StructureColumns,
     ParameterColumns,
@@ -300,7 +300,7 @@ spectrum_columns!(
 /// Rays one frame of the run traced, and what their queries cost where the backend counts it
 /// (the CPU; empty on the GPU): deterministic work that does not move between runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct RayCounts {
+pub struct WorkCounts {
     /// Camera rays.
     pub primary_rays: Option<u64>,
     /// Shadow rays, all lights.

@@ -4,7 +4,7 @@
 use super::spec::Spec;
 use crate::fingerprint::fnv1a;
 use crate::metrics::{ErrorMetrics, PenumbraMask, RadialProfile, Receivers};
-use crate::reference::{visible_fraction_estimate, Estimate, OnAxis};
+use crate::reference::{visible_fraction_estimate, Integral, OnAxis};
 use crate::render::{Backend, Sampling, View, NO_RECEIVER};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::{Light, Scene};
@@ -223,18 +223,18 @@ pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Recei
         .iter()
         .filter_map(|l| if let Light::Disk(d) = l { Some(d) } else { None })
         .collect();
-    let values: Vec<(usize, f32, Estimate)> = points
+    let values: Vec<(usize, f32, Integral)> = points
         .par_iter()
         .map(|&(i, p)| {
             let e = disks
                 .iter()
                 .map(|l| visible_fraction_estimate(p, pl.normal, l, &spheres, &planes))
-                .fold(Estimate::default(), |a, b| a + b);
+                .fold(Integral::default(), |a, b| a + b);
             let k = disks.len() as f64;
             (
                 i,
                 (e.value / k) as f32,
-                Estimate {
+                Integral {
                     error: e.error / k,
                     ..e
                 },
