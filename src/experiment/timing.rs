@@ -34,13 +34,21 @@ use serde::{Deserialize, Serialize};
 /// The rule, as every report states it.
 pub const RULE: &str = "Every time is a median with its distribution-free 95 % interval (order statistics of its \
 repeats, visited in seeded, counterbalanced interleaved rounds). A is called faster than B only when the whole \
-95 % interval of the time ratio A / B (the median of per-round ratios; along a camera path, of per-frame \
-ratios, its interval from the medians of blocks of frames longer than their correlation) lies below 0.95, \
+95 % interval of the time ratio A / B (the median of per-round ratios; over frames, of per-frame ratios, its \
+interval from order statistics where each frame's camera is an independent draw, from the medians of blocks of \
+frames longer than their correlation along a camera path) lies below 0.95, \
 slower when it lies above 1.05, and equal within noise otherwise (a difference under 5 % is never called); a \
 paper's claim that A is faster is answered yes, no or not clearly by the same interval.";
 
 /// Smallest relative difference a word is given: a time ratio's interval must clear 1 by it.
 pub const MARGIN: f64 = 0.05;
+
+/// How close (relative) a bound may come to a threshold of the rule before it is printed with
+/// more decimals ([`Estimate::show_ratio`]).
+pub const NEAR_THRESHOLD: f64 = 0.01;
+
+/// Most decimals a bound is printed with.
+pub const MAX_DIGITS: usize = 6;
 
 /// Default seed of the visiting order, where an experiment file gives none (recorded in the
 /// manifest either way).
@@ -127,6 +135,46 @@ impl Estimate {
             lo: 1.0 / self.hi,
             hi: 1.0 / self.lo,
         }
+    }
+
+    /// A time ratio A / B as [`show`](Self::show) prints it, with as many more decimals as it
+    /// takes for every bound near the rule's thresholds (1 -/+ [`MARGIN`]) to read on the side
+    /// of it that decided the word: `0.946`, not `0.95`, for a bound that did not clear 0.95.
+    pub fn show_ratio(&self, digits: usize) -> String {
+        self.show(self.deciding_digits(digits, &[1.0 - MARGIN, 1.0 + MARGIN]))
+    }
+
+    /// A speed-up B / A, the reciprocal of a time ratio, printed as [`show_ratio`](Self::show_ratio)
+    /// prints one: its thresholds are 1 / (1 +/- [`MARGIN`]) (1.0526 is the least speed-up called
+    /// faster, so a bound of 1.045 is printed so, never as 1.05).
+    pub fn show_speedup(&self, digits: usize) -> String {
+        self.show(self.deciding_digits(digits, &[1.0 / (1.0 + MARGIN), 1.0 / (1.0 - MARGIN)]))
+    }
+
+    /// The fewest decimals, at least `digits` and at most [`MAX_DIGITS`], at which no bound
+    /// within [`NEAR_THRESHOLD`] of a threshold prints as the threshold or across it, and every
+    /// such bound gets at least three.
+    fn deciding_digits(&self, digits: usize, thresholds: &[f64]) -> usize {
+        let round = |v: f64, d: usize| format!("{v:.d$}").parse::<f64>().unwrap_or(v);
+        let near: Vec<(f64, f64)> = [self.lo, self.hi]
+            .into_iter()
+            .filter(|v| v.is_finite())
+            .flat_map(|v| thresholds.iter().map(move |&t| (v, t)))
+            .filter(|&(v, t)| ((v - t) / t).abs() <= NEAR_THRESHOLD)
+            .collect();
+        if near.is_empty() {
+            return digits;
+        }
+        let mut d = digits.max(3);
+        while d < MAX_DIGITS
+            && near.iter().any(|&(v, t)| {
+                let (rv, rt) = (round(v, d), round(t, d));
+                rv == rt || (rv - t).signum() != (v - t).signum()
+            })
+        {
+            d += 1;
+        }
+        d
     }
 
     /// `1.23 [1.10, 1.41]` with `digits` decimals.
@@ -575,5 +623,22 @@ mod tests {
         assert_eq!(Comparison::Equal.answer(), "not clearly");
         assert_eq!(e(1.0, 3.0).show(2), "2.00 [1.00, 3.00]");
         assert_eq!(e(2.0, 4.0).recip().show(2), "0.33 [0.25, 0.50]");
+    }
+
+    /// The cases that read wrong at two decimals: a speed-up whose lower bound 1.0450 fell short
+    /// of 1.0526 (equal), a time ratio whose upper bound 0.9462 cleared 0.95 (faster), a bound
+    /// on the threshold to the fourth decimal; bounds far from any threshold keep their digits.
+    #[test]
+    fn intervals_print_the_digits_that_decide_their_word() {
+        let e = |median: f64, lo: f64, hi: f64| Estimate { median, lo, hi };
+        assert_eq!(e(1.05, 1.045, 1.06).show_speedup(2), "1.050 [1.045, 1.060]");
+        assert_eq!(Comparison::of_speedup(&e(1.05, 1.045, 1.06)), Comparison::Equal);
+        assert_eq!(e(0.94, 0.91, 0.9462).show_ratio(2), "0.940 [0.910, 0.946]");
+        assert_eq!(Comparison::of(&e(0.94, 0.91, 0.9462)), Comparison::Faster);
+        // 0.94996 clears 0.95: printed to the decimal that shows it.
+        assert_eq!(e(0.9, 0.8, 0.94996).show_ratio(2), "0.90000 [0.80000, 0.94996]");
+        assert_eq!(e(2.0, 1.5, 3.0).show_speedup(2), "2.00 [1.50, 3.00]");
+        assert_eq!(e(1.0, 0.8, 1.2).show_ratio(2), "1.00 [0.80, 1.20]");
+        assert_eq!(Estimate::NAN.show_ratio(2), "n/a");
     }
 }

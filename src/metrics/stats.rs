@@ -33,8 +33,13 @@ impl MeanCi {
     };
 }
 
+/// Fewest values a mean's interval is given from: with two or three, t(0.975) is 12.7 or 4.3
+/// and the spread of so few values is itself a guess, so two seeds that happen to agree would
+/// print a tight interval ("0.0257 +- 0.0000").
+pub const MIN_VALUES_FOR_INTERVAL: usize = 4;
+
 /// Mean and the half-width of its 95 % confidence interval, mean +- t s / sqrt(k); the
-/// half-width is NaN with fewer than two values. One NaN value (a seed whose metric is not
+/// half-width is NaN with fewer than [`MIN_VALUES_FOR_INTERVAL`] values. One NaN value (a seed whose metric is not
 /// measurable, e.g. an extent beyond the patch) makes both NaN: a mean over fewer seeds than the
 /// row claims would be another statistic.
 pub fn mean_ci(v: &[f64]) -> MeanCi {
@@ -43,7 +48,7 @@ pub fn mean_ci(v: &[f64]) -> MeanCi {
         return MeanCi::NAN;
     }
     let mean = v.iter().sum::<f64>() / k as f64;
-    if k < 2 {
+    if k < MIN_VALUES_FOR_INTERVAL {
         return MeanCi { mean, ci95: f64::NAN };
     }
     let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
@@ -91,6 +96,8 @@ mod tests {
         // s = sqrt(5/3), t(3) = 3.182: h = 3.182 * sqrt(5/12).
         assert!((ci95 - 3.182 * (5.0f64 / 12.0).sqrt()).abs() < 1e-12);
         assert!(mean_ci(&[1.0]).ci95.is_nan());
+        assert!(mean_ci(&[1.0, 2.0, 3.0]).ci95.is_nan(), "three values give no interval");
+        assert_eq!(mean_ci(&[1.0, 2.0, 3.0]).mean, 2.0);
         let MeanCi { mean, ci95 } = mean_ci(&[f64::NAN, 2.0, 4.0]);
         assert!(mean.is_nan() && ci95.is_nan());
     }

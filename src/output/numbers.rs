@@ -57,6 +57,21 @@ pub fn thousands(n: usize) -> String {
     out
 }
 
+/// Bytes per triangle of a structure, the figure that compares structures across scene sizes
+/// (a CWBVH's ~12 B against a field's kilobytes): three significant digits, "n/a" for no
+/// triangles.
+pub fn per_triangle(bytes: u64, triangles: usize) -> String {
+    if triangles == 0 {
+        return "n/a".into();
+    }
+    let b = bytes as f64 / triangles as f64;
+    match b {
+        b if b >= 100.0 => thousands(b.round() as usize),
+        b if b >= 10.0 => format!("{b:.1}"),
+        b => format!("{b:.2}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -76,6 +91,10 @@ mod tests {
         assert_eq!(with_ci(0.014, f64::NAN, mm), "14.00 mm ± n/a");
         assert_eq!(with_ci(f64::NAN, 0.001, mm), "n/a");
         assert_eq!(with_ci(0.014, 0.0004, mm), "14.00 mm ± 0.40 mm");
+        assert_eq!(per_triangle(6_455_044_812, 1_024_000), "6,304");
+        assert_eq!(per_triangle(14_780_480, 1_024_000), "14.4");
+        assert_eq!(per_triangle(1, 3), "0.33");
+        assert_eq!(per_triangle(5, 0), "n/a");
         assert_eq!(or_na(f64::INFINITY, |x| x.to_string()), "n/a");
     }
 

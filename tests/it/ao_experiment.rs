@@ -77,7 +77,32 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     assert!(texts.iter().any(|t| t.ends_with("triangles")), "{texts:?}");
     common::browser::check_page(&out);
     let tables = common::assert_tidy_tables(&out);
-    assert_eq!(tables.len(), 2, "ao.csv and tuning.csv: {tables:?}");
+    assert_eq!(tables.len(), 3, "ao.csv, rounds.csv and tuning.csv: {tables:?}");
+    // Every timed frame is committed: each row's median and interval recompute from rounds.csv.
+    let mut rounds = csv::Reader::from_path(out.join("rounds.csv")).unwrap();
+    let rh = rounds.headers().unwrap().clone();
+    let rc = |name: &str| rh.iter().position(|h| h == name).unwrap();
+    let rounds: Vec<csv::StringRecord> = rounds.records().map(Result::unwrap).collect();
+    for r in &rows {
+        let times: Vec<f64> = rounds
+            .iter()
+            .filter(|x| {
+                x[rc("mesh")] == r[col("mesh")]
+                    && x[rc("structure")] == r[col("structure")]
+                    && x[rc("issue")] == r[col("issue")]
+            })
+            .map(|x| x[rc("frame_s")].parse().unwrap())
+            .collect();
+        assert_eq!(times.len().to_string(), r[col("timed_frames")], "{r:?}");
+        let e = penumbra::experiment::timing::median_interval(&times);
+        for (name, v) in [("frame_s", e.median), ("frame_s_lo", e.lo), ("frame_s_hi", e.hi)] {
+            let committed: f64 = r[col(name)].parse().unwrap();
+            assert!(
+                (committed - v).abs() <= 1e-9 * v.abs(),
+                "{name}: {committed} vs {v} from rounds.csv"
+            );
+        }
+    }
     assert!(header.iter().any(|h| h == "vlf_depth") && header.iter().any(|h| h == "kdtree_max_depth"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("equals the first structure's, bit for bit"), "{report}");

@@ -26,6 +26,71 @@ fn ci() -> String {
     std::fs::read_to_string(common::repo("experiments/frames-ci.toml")).unwrap()
 }
 
+/// Random cameras and per-scene tuning: each tuned structure keeps exactly one candidate, the
+/// one built (builds.csv), chosen on tuning cameras apart from the frames; frames drawn with one
+/// seed are the same frames on a second run, and another seed draws others; the verdict's
+/// intervals are order statistics over independent frames.
+#[test]
+fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_frames() {
+    let tuned = |seed: u32| {
+        ci().replace(
+            "[path]\nframes = 3",
+            &format!("[path]\nframes = 6\ncameras = \"random\"\nseed = {seed}"),
+        )
+        .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]")
+        .replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]")
+            + "\n[accel.kdtree]\nmax_depth = [8, 20]\n\n[tuning]\ncameras = 2\nrepeats = 3\n"
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (header, rows, report) = run(dir.path(), &tuned(7));
+    let out = dir.path().join("out");
+    let mut tuning = csv::Reader::from_path(out.join("tuning.csv")).unwrap();
+    let th = tuning.headers().unwrap().clone();
+    let trows: Vec<csv::StringRecord> = tuning.records().map(Result::unwrap).collect();
+    let tc = |n: &str| th.iter().position(|h| h == n).unwrap();
+    assert_eq!(trows.len(), 4, "two candidates each for kdtree and vlf: {trows:?}");
+    let builds = std::fs::read_to_string(out.join("builds.csv")).unwrap();
+    for structure in ["kdtree", "vlf"] {
+        let chosen: Vec<&csv::StringRecord> = trows
+            .iter()
+            .filter(|r| &r[tc("structure")] == structure && &r[tc("chosen")] == "true")
+            .collect();
+        assert_eq!(chosen.len(), 1, "{structure}: {trows:?}");
+        let depth = match structure {
+            "kdtree" => format!(",{},median,", &chosen[0][tc("kdtree_max_depth")]),
+            _ => format!("51224,vlf,,{},", &chosen[0][tc("vlf_depth")]),
+        };
+        assert!(
+            builds.contains(&depth),
+            "{structure}: the kept candidate is the one built ({depth}): {builds}"
+        );
+    }
+    assert!(
+        report.contains("Kept: scene=classroom shading=opengl viewpoint=walk frames=0..6: `kdtree` leaf_size=8"),
+        "{report}"
+    );
+    assert!(report.contains("95 % interval over independent frames"), "{report}");
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rays = |rows: &[csv::StringRecord]| -> Vec<String> {
+        rows.iter()
+            .filter(|r| &r[col("structure")] == "brute")
+            .map(|r| r[col("rays")].to_string())
+            .collect()
+    };
+    let again = tempfile::tempdir().unwrap();
+    let (_, same, _) = run(again.path(), &tuned(7));
+    let image = |d: &std::path::Path| std::fs::read(d.join("out/images/strip_opengl.png")).unwrap();
+    assert_eq!(image(dir.path()), image(again.path()), "one seed, the same frames");
+    assert_eq!(rays(&rows), rays(&same));
+    let other = tempfile::tempdir().unwrap();
+    run(other.path(), &tuned(8));
+    assert_ne!(
+        image(dir.path()),
+        image(other.path()),
+        "another seed draws other cameras"
+    );
+}
+
 #[test]
 fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let dir = tempfile::tempdir().unwrap();

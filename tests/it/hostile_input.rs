@@ -360,6 +360,30 @@ fn cases() -> Vec<Case> {
         frames.replace("frames = 3", "frames = 4294967295"),
         &["exp.toml", "path.frames"],
     ));
+    v.push(case(
+        "cameras placed in a way no generator knows",
+        "frames-ci",
+        frames.replace("[path]\nframes = 3", "[path]\nframes = 3\ncameras = \"orbit\""),
+        &["exp.toml", "path.cameras", "path, random"],
+    ));
+    v.push(case(
+        "a camera seed for a path that draws nothing",
+        "frames-ci",
+        frames.replace("[path]\nframes = 3", "[path]\nframes = 3\nseed = 4"),
+        &["exp.toml", "path.seed", "random"],
+    ));
+    v.push(case(
+        "a tuning table with nothing to tune",
+        "frames-ci",
+        format!("{frames}\n[tuning]\ncameras = 2\n"),
+        &["exp.toml", "tuning", "no structure lists candidates"],
+    ));
+    v.push(case(
+        "no tuning cameras",
+        "frames-ci",
+        format!("{frames}\n[tuning]\ncameras = 0\n").replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]"),
+        &["exp.toml", "tuning.cameras"],
+    ));
     let no_field = frames
         .split("[accel.vlf]")
         .next()

@@ -10,7 +10,7 @@ use crate::experiment::outputs::Outputs;
 use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
-use crate::output::numbers::thousands;
+use crate::output::numbers::{per_triangle, thousands};
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{grouped_bars, Bar, Group};
 use crate::output::table::{float, write_rows};
@@ -53,6 +53,18 @@ struct Measured {
     #[serde(with = "float")]
     mean_ao: f64,
     same_image_as_first: bool,
+}
+
+/// A row of rounds.csv: one timed frame of one mesh, structure and issue, in round order, so
+/// every "median of per-round ratios" in the report recomputes from committed numbers.
+#[derive(Serialize)]
+struct RoundCsv<'a> {
+    mesh: &'a str,
+    structure: &'a str,
+    issue: &'a str,
+    round: usize,
+    #[serde(with = "float")]
+    frame_s: f64,
 }
 
 /// A row of tuning.csv: a candidate's mesh and structure, its parameters one column each, then
@@ -127,7 +139,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
         let count = |c: Comparison| per_mesh.iter().filter(|m| m.2 == c).count();
         let listed: Vec<String> = per_mesh
             .iter()
-            .map(|(m, e, c)| format!("{m} {}x ({})", e.show(2), c.word()))
+            .map(|(m, e, c)| format!("{m} {}x ({})", e.show_speedup(2), c.word()))
             .collect();
         let claim = if *other == spec.claim.baseline {
             let paper: Vec<f64> = spec
@@ -168,17 +180,19 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
                 .filter(|o| o.mesh == m.name && o.structure != subject && o.issue == Issue::Single)
                 .map(|o| {
                     format!(
-                        "{} {:.2} MB / {:.2} s",
+                        "{} {:.2} MB ({} B per triangle) / {:.2} s",
                         o.structure,
                         o.memory_bytes as f64 / 1e6,
+                        per_triangle(o.memory_bytes, o.triangles),
                         o.build_seconds
                     )
                 })
                 .collect();
             Some(format!(
-                "{} {:.0} MB / {:.2} s ({})",
+                "{} {:.0} MB ({} B per triangle) / {:.2} s ({})",
                 m.name,
                 v.memory_bytes as f64 / 1e6,
+                per_triangle(v.memory_bytes, v.triangles),
                 v.build_seconds,
                 others.join(", ")
             ))
@@ -252,6 +266,18 @@ pub fn write_ao(
         )
     });
     write_rows(&out("ao.csv")?, csv)?;
+    write_rows(
+        &out("rounds.csv")?,
+        rows.iter().flat_map(|r| {
+            r.frame_seconds.iter().enumerate().map(move |(round, &s)| RoundCsv {
+                mesh: &r.mesh,
+                structure: r.structure,
+                issue: r.issue.name(),
+                round,
+                frame_s: s,
+            })
+        }),
+    )?;
     let galleries = galleries(spec, rows);
     for g in &galleries {
         for s in &g.shots {
@@ -387,16 +413,17 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
     md += "## Verdict\n\n";
     md += &verdict(spec, rows);
     md += &open_question(spec, rows);
-    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited, a kd-tree packet's node once for its rays; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited, a kd-tree packet's node once for its rays; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | bytes per triangle | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         md += &format!(
-            "| {} | {} | {} | {} | {:.2} | {:.1} | {} | {:.2} | {:.3e} | {:.3e} | {} |\n",
+            "| {} | {} | {} | {} | {:.2} | {:.1} | {} | {} | {:.2} | {:.3e} | {:.3e} | {} |\n",
             r.mesh,
             r.triangles,
             r.label(),
             r.settings.describe(),
             r.build_seconds,
             r.memory_bytes as f64 / 1e6,
+            per_triangle(r.memory_bytes, r.triangles),
             r.frame.show(3),
             r.rays_per_s() / 1e6,
             r.work.nodes as f64,
@@ -408,7 +435,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
     md += &format!("\n## The paper's Table 1 beside ours\n\nThe paper (2.8 GHz Pentium 4, 256x256, 513 rays per point): CRT and VLF-RT seconds at each one's best depth. Ours: `{baseline}`'s frame time over `{subject}`'s (median of per-round ratios, 95 % interval).\n\n| mesh | paper CRT s (depth) | paper VLF-RT s (depth) | paper speed-up | our speed-up |\n|---|---|---|---|---|\n");
     for m in &spec.meshes {
         let ours = match (find(rows, &m.name, subject), find(rows, &m.name, baseline)) {
-            (Some(a), Some(b)) => format!("{}x", speedup(a, b).0.show(2)),
+            (Some(a), Some(b)) => format!("{}x", speedup(a, b).0.show_speedup(2)),
             _ => "n/a".into(),
         };
         match &m.paper {
@@ -427,7 +454,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `rounds.csv` (every timed frame, in round order: the per-round ratios recompute from it), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
     md
 }
 
@@ -488,7 +515,7 @@ pub fn open_question(spec: &AoSpec, rows: &[AoRow]) -> String {
                 |m| match (find_issued(rows, &m.name, a, *ia), find_issued(rows, &m.name, b, *ib)) {
                     (Some(x), Some(y)) => {
                         let (e, c) = speedup(x, y);
-                        format!("{}x {}", e.show(2), c.word())
+                        format!("{}x {}", e.show_speedup(2), c.word())
                     }
                     _ => "n/a".into(),
                 },

@@ -8,6 +8,7 @@
 pub mod report;
 pub mod runner;
 pub mod spec;
+pub mod tuning;
 pub mod verdict;
 
 pub use runner::{run_block, run_frames, Block, FramesOutcome};
@@ -23,7 +24,7 @@ use std::path::PathBuf;
 
 impl FramesSpec {
     /// The scenes as the `scene` axis names them: `classroom`, or each triangle count.
-    fn scene_names(&self) -> Vec<String> {
+    pub fn scene_names(&self) -> Vec<String> {
         match &self.generator {
             Generator::Classroom => vec!["classroom".into()],
             Generator::RandomTriangles { counts, .. } => counts.iter().map(usize::to_string).collect(),
@@ -81,20 +82,11 @@ impl Declaration for FramesSpec {
     }
 
     fn units(&self) -> Vec<Unit> {
-        let names = self.scene_names();
         let pixels = (self.width * self.height) as f64;
         runner::blocks(self)
             .into_iter()
             .map(|b| {
-                let mut label = format!("scene={}", names[b.scene]);
-                if self.motion.is_none() {
-                    label += &format!(
-                        " shading={} viewpoint={}",
-                        self.shadings[b.shadings.start].0.name(),
-                        self.viewpoints[b.viewpoints.start]
-                    );
-                }
-                label += &format!(" frames={}..{}", b.frames.start, b.frames.end);
+                let label = b.label(self);
                 let frames = (b.shadings.len() * b.viewpoints.len()) as f64 * b.frames.len() as f64;
                 let n = self.triangles_of(b.scene).map_or(1.0, |n| n as f64);
                 let repeats = self.header.schedule.repeats.max(1) as f64;
@@ -147,6 +139,7 @@ impl Declaration for FramesSpec {
             outcome.builds.extend(o.builds);
             outcome.pictures.extend(o.pictures);
             outcome.scenes.extend(o.scenes);
+            outcome.tuning.extend(o.tuning);
         }
         let threads = rayon::current_num_threads();
         report::write_frames(

@@ -4,10 +4,10 @@
 //! around the verdict ([`super::verdict`]).
 
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
-use super::spec::{FramesSpec, Generator};
-use super::verdict::{label, labels, median_at, verdict};
+use super::spec::{Cameras, FramesSpec, Generator};
+use super::verdict::{label, labels, median_at, over_frames, verdict};
 use crate::accel::settings::ParameterColumns;
-use crate::experiment::timing::{median_interval, series_median, Estimate, RULE};
+use crate::experiment::timing::{median_interval, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
@@ -68,7 +68,35 @@ struct BuildCost {
     memory_bytes: u64,
 }
 
-/// Writes frames.csv, builds.csv, plots/, images/, report.md and index.html under `out`.
+/// A row of tuning.csv: the unit that tuned, the scene size and structure, the candidate's
+/// parameters one column each, then its time over the tuning cameras and its work.
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, TuningCost);
+
+/// The columns before the parameters in tuning.csv.
+#[derive(Serialize)]
+struct Tuned<'a> {
+    unit: &'a str,
+    triangles: usize,
+    structure: &'a str,
+}
+
+/// The columns after the parameters in tuning.csv.
+#[derive(Serialize)]
+struct TuningCost {
+    #[serde(with = "float")]
+    build_s: f64,
+    #[serde(with = "float")]
+    tuning_s: f64,
+    #[serde(with = "float")]
+    tuning_s_lo: f64,
+    #[serde(with = "float")]
+    tuning_s_hi: f64,
+    nodes_visited: u64,
+    primitive_tests: u64,
+    chosen: bool,
+}
+
+/// Writes frames.csv, builds.csv, tuning.csv (where a structure was tuned), plots/, images/, report.md and index.html under `out`.
 pub fn write_frames(
     spec: &FramesSpec,
     outcome: &FramesOutcome,
@@ -119,6 +147,30 @@ pub fn write_frames(
             )
         }),
     )?;
+    if !outcome.tuning.is_empty() {
+        write_rows(
+            &out.join("tuning.csv"),
+            outcome.tuning.iter().map(|(unit, t)| -> TuningCsv {
+                (
+                    Tuned {
+                        unit,
+                        triangles: t.triangles,
+                        structure: t.structure,
+                    },
+                    ParameterColumns::of(&t.settings),
+                    TuningCost {
+                        build_s: t.build_seconds,
+                        tuning_s: t.seconds.median,
+                        tuning_s_lo: t.seconds.lo,
+                        tuning_s_hi: t.seconds.hi,
+                        nodes_visited: t.work.nodes,
+                        primitive_tests: t.work.primitives,
+                        chosen: t.chosen,
+                    },
+                )
+            }),
+        )?;
+    }
     write_rows(&out.join("summary.csv"), summarise(spec, outcome))?;
     let all = labels(rows);
     let largest = outcome.builds.iter().map(|b| b.triangles).max().unwrap_or(0);
@@ -379,12 +431,12 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     continue;
                 }
                 let secs: Vec<f64> = sel.iter().map(|r| r.seconds).collect();
-                let (frame, block) = series_median(&secs);
+                let (frame, block) = over_frames(&secs, spec.cameras);
                 let upd: Vec<f64> = sel.iter().filter_map(|r| r.update_seconds).collect();
                 let update = if upd.is_empty() {
                     Estimate::NAN
                 } else {
-                    series_median(&upd).0
+                    over_frames(&upd, spec.cameras).0
                 };
                 let of = |f: fn(&FrameRow) -> u64| median(&sel.iter().map(|r| f(r) as f64).collect::<Vec<_>>());
                 out.push(Summary {
@@ -408,16 +460,67 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
     out
 }
 
+/// What was tuned, over which candidates, and what each scene kept.
+fn tuning_paragraph(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
+    let tuned: Vec<String> = spec
+        .candidates
+        .iter()
+        .filter(|c| c.len() > 1)
+        .map(|c| {
+            format!(
+                "`{}` over {} candidates ({})",
+                c[0].name,
+                c.len(),
+                c.iter().map(|x| x.describe()).collect::<Vec<_>>().join("; ")
+            )
+        })
+        .collect();
+    if tuned.is_empty() {
+        return "Every structure runs at the one setting its file gives (nothing listed to tune).\n\n".into();
+    }
+    let fixed: Vec<String> = spec
+        .candidates
+        .iter()
+        .filter(|c| c.len() == 1)
+        .map(|c| format!("`{}` ({})", c[0].name, c[0].describe()))
+        .collect();
+    let kept: Vec<String> = outcome
+        .tuning
+        .iter()
+        .filter(|(_, t)| t.chosen)
+        .map(|(unit, t)| format!("{unit}: `{}` {}", t.structure, t.settings.describe()))
+        .collect();
+    let t = &spec.tuning;
+    format!(
+        "Tuning, per scene before its frames are timed: {}; each candidate built and timed rendering {} camera(s) per viewpoint drawn at random with their own seed ({}, never the frames measured) at {}x{} under {} shading, in {} interleaved rounds, the fastest median kept (`tuning.csv`). At one setting: {}. Kept: {}.\n\n",
+        tuned.join("; "),
+        t.cameras,
+        t.seed,
+        spec.width,
+        spec.height,
+        super::tuning::tuning_shading(spec).name(),
+        t.repeats,
+        if fixed.is_empty() { "none".to_string() } else { fixed.join(", ") },
+        kept.join("; ")
+    )
+}
+
 fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f64) -> String {
     let rows = &outcome.frames;
     let mut md = format!("# {}: frame times per acceleration structure\n\n", spec.name);
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (counterbalanced seeded orders of the structures; order seed {}), the median kept (`frames.csv`: every frame with the interval of its renders: their range for three, a 75 % interval), and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
+        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}; {}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (counterbalanced seeded orders of the structures; order seed {}), the median kept (`frames.csv`: every frame with the interval of its renders: their range for three, a 75 % interval), and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
         spec.path.display(),
         seconds,
         outcome.scenes.join("; "),
         spec.frames,
         spec.viewpoints.join(", "),
+        match spec.cameras {
+            Cameras::Path => "frames follow each viewpoint's path".to_string(),
+            Cameras::Random { seed } => format!(
+                "each frame's camera an independent draw from its viewpoint's cameras, seed {seed}, so every interval over frames is the exact order-statistic interval of a median"
+            ),
+        },
         spec.width,
         spec.height,
         spec.shadings.iter().map(|s| s.0.name()).collect::<Vec<_>>().join(", "),
@@ -435,9 +538,14 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
         Generator::RandomTriangles { .. } => format!("Random triangles: {}.\n\n", random::DISTRIBUTION),
         Generator::Classroom => "The classroom (src/scene/procedural/classroom.rs): a 10 x 8 x 3.2 m room with tessellated walls, floor and ceiling, four windows, a blackboard, 20 desks with chairs, a teacher's desk, two bookshelves of books, four ceiling lamps over four point lights, two wall mirrors (weight 0.85) and a chrome ball (0.7); the camera walks one loop round the desks.\n\n".to_string(),
     };
+    md += &tuning_paragraph(spec, outcome);
     md += "## Verdict\n\n";
     md += &verdict(spec, outcome);
-    md += "\n## Medians\n\nFrame seconds: the median over the path's frames with its 95 % interval from the medians of blocks of frames (block length in `summary.csv`; n/a where the path is too short or too correlated for six blocks); rays, nodes visited and primitive tests: per-frame medians (deterministic).\n\n| triangles | shading | structure | frame s | update s | rays per frame | nodes per frame | tests per frame | frames |\n|---|---|---|---|---|---|---|---|---|\n";
+    md += &format!("\n## Medians\n\nFrame seconds: the median over the frames with its 95 % interval ({}); rays, nodes visited and primitive tests: per-frame medians (deterministic).\n\n| triangles | shading | structure | frame s | update s | rays per frame | nodes per frame | tests per frame | frames |\n|---|---|---|---|---|---|---|---|---|\n",
+        match spec.cameras {
+            Cameras::Random { .. } => "order statistics over independent frames",
+            Cameras::Path => "from the medians of blocks of consecutive frames, block length in `summary.csv`; n/a where the path is too short or too correlated for six blocks",
+        });
     let summaries = summarise(spec, outcome);
     for r in &summaries {
         md += &format!(
@@ -463,18 +571,19 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f
         }
         v
     });
-    md += "\n## Builds\n\n| triangles | structure | parameters | build s | MB |\n|---|---|---|---|---|\n";
+    md += "\n## Builds\n\n| triangles | structure | parameters | build s | MB | bytes per triangle |\n|---|---|---|---|---|---|\n";
     for b in &outcome.builds {
         md += &format!(
-            "| {} | {} | {} | {:.3} | {:.1} |\n",
+            "| {} | {} | {} | {:.3} | {:.1} | {} |\n",
             b.triangles,
             b.structure,
             b.settings.describe(),
             b.build_seconds,
-            b.memory_bytes as f64 / 1e6
+            b.memory_bytes as f64 / 1e6,
+            crate::output::numbers::per_triangle(b.memory_bytes, b.triangles)
         );
     }
-    md += "\nOutputs: `frames.csv` (one row per frame and structure), `summary.csv` (the medians above), `builds.csv`, `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
+    md += "\nOutputs: `frames.csv` (one row per frame and structure), `summary.csv` (the medians above), `builds.csv`, `tuning.csv` (where a structure was tuned), `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
     if spec.motion.is_some() {
         md += ", `plots/update_time_SHADING.png` (update time along the path)";
     }

@@ -28,7 +28,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// The frames' sampling (point lights need none; fixed for the record).
-const SAMPLING: Sampling = Sampling {
+pub const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 1,
@@ -105,6 +105,9 @@ pub struct FramesOutcome {
     pub pictures: Vec<Picture>,
     /// The scenes, as their generators describe them.
     pub scenes: Vec<String>,
+    /// Every tuning candidate timed, after the block that tuned it ([`Block::label`]).
+    #[serde(default)]
+    pub tuning: Vec<(String, super::tuning::TuningRow)>,
 }
 
 /// How a row names the way its structure follows motion: an [`UpdateMethod`]'s name, or `none`.
@@ -161,10 +164,14 @@ impl Variant {
 
 /// The variants of `generated`: one per structure, or with motion, one per way each structure
 /// follows it (each with a structure of its own); and each structure's build.
-fn variants(spec: &FramesSpec, generated: &Generated) -> anyhow::Result<(Vec<Variant>, Vec<BuildRow>)> {
+fn variants(
+    spec: &FramesSpec,
+    generated: &Generated,
+    structures: &[AccelSettings],
+) -> anyhow::Result<(Vec<Variant>, Vec<BuildRow>)> {
     let mut out = Vec::new();
     let mut builds = Vec::new();
-    for settings in &spec.structures {
+    for settings in structures {
         let scene = generated.scene(BTreeMap::new(), settings.clone())?;
         let accel = scene.accel.as_ref().expect("generated scenes have triangles");
         let stats = accel.stats();
@@ -214,9 +221,10 @@ pub fn strip_frames(count: u32, frames: u32) -> Vec<u32> {
 }
 
 /// A unit of a frame-time experiment: frames `frames` of the viewpoints and shadings in their
-/// ranges (indices into the spec's lists), on scene `scene`. A static scene's block is one
-/// shading and viewpoint and `[path] block` frames; a moving part carries its state through
-/// every frame, shading and viewpoint, so a moving scene is one block.
+/// ranges (indices into the spec's lists), on scene `scene`. With `[path] block` a static
+/// scene's block is one shading and viewpoint and that many frames; without it (and always
+/// for a moving part, which carries its state through every frame, shading and viewpoint) a
+/// scene is one block.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Block {
     /// Scene index.
@@ -233,6 +241,20 @@ impl Block {
     /// Whether it is its scene's first block (which records the builds and the scene).
     fn first(&self) -> bool {
         self.shadings.start == 0 && self.viewpoints.start == 0 && self.frames.start == 0
+    }
+
+    /// The block as a unit's label names it: its scene, its shading and viewpoint where it has
+    /// one of each, and its frames.
+    pub fn label(&self, spec: &FramesSpec) -> String {
+        let mut label = format!("scene={}", spec.scene_names()[self.scene]);
+        if self.shadings.len() == 1 && self.viewpoints.len() == 1 {
+            label += &format!(
+                " shading={} viewpoint={}",
+                spec.shadings[self.shadings.start].0.name(),
+                spec.viewpoints[self.viewpoints.start]
+            );
+        }
+        label + &format!(" frames={}..{}", self.frames.start, self.frames.end)
     }
 
     /// As a unit's coordinates.
@@ -264,7 +286,7 @@ impl Block {
 pub fn blocks(spec: &FramesSpec) -> Vec<Block> {
     let mut out = Vec::new();
     for scene in 0..spec.scene_count() {
-        if spec.motion.is_some() {
+        let Some(block) = spec.block.filter(|_| spec.motion.is_none()) else {
             out.push(Block {
                 scene,
                 shadings: 0..spec.shadings.len(),
@@ -272,15 +294,15 @@ pub fn blocks(spec: &FramesSpec) -> Vec<Block> {
                 frames: 0..spec.frames,
             });
             continue;
-        }
+        };
         for h in 0..spec.shadings.len() {
             for v in 0..spec.viewpoints.len() {
-                for start in (0..spec.frames).step_by(spec.block.max(1) as usize) {
+                for start in (0..spec.frames).step_by(block.max(1) as usize) {
                     out.push(Block {
                         scene,
                         shadings: h..h + 1,
                         viewpoints: v..v + 1,
-                        frames: start..(start + spec.block).min(spec.frames),
+                        frames: start..(start + block).min(spec.frames),
                     });
                 }
             }
@@ -298,6 +320,7 @@ pub fn run_frames(spec: &FramesSpec, backend: &mut dyn Backend, progress: &Progr
         outcome.builds.extend(o.builds);
         outcome.pictures.extend(o.pictures);
         outcome.scenes.extend(o.scenes);
+        outcome.tuning.extend(o.tuning);
     }
     Ok(outcome)
 }
@@ -318,8 +341,13 @@ pub fn run_block(
         &generated.description,
         (block.shadings.len() * block.viewpoints.len()) as u64 * block.frames.len() as u64,
     );
+    bar.message(format!("tuning {} structures", spec.structures.len()));
+    let (structures, tuning) = super::tuning::tune(spec, &generated, backend)?;
+    outcome
+        .tuning
+        .extend(tuning.into_iter().map(|t| (block.label(spec), t)));
     bar.message(format!("building {} structures", spec.structures.len()));
-    let (mut variants, builds) = variants(spec, &generated)?;
+    let (mut variants, builds) = variants(spec, &generated, &structures)?;
     if block.first() {
         outcome.scenes.push(generated.description.clone());
         outcome.builds.extend(builds);

@@ -5,6 +5,7 @@
 //! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part
 //! moves every frame and each structure is updated before rendering it).
 
+use super::tuning::FramesTuning;
 use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
 use crate::experiment::comparison::{Claim, Comparison};
@@ -35,11 +36,14 @@ crate::experiment_file! {
         accel: BTreeMap<String, toml::Table>,
         #[serde(default = "six")]
         strip: u32,
+        tuning: Option<FramesTuning>,
     }
 }
 
 /// Most frames per viewpoint a path may have.
 pub const MAX_FRAMES: u32 = 100_000;
+/// Most tuning cameras per viewpoint.
+pub const MAX_TUNING_CAMERAS: u32 = 64;
 /// Most triangles a random-triangle scene may ask for.
 pub const MAX_TRIANGLES: usize = 16 << 20;
 
@@ -93,6 +97,8 @@ struct SceneEntry {
 struct PathEntry {
     frames: u32,
     block: Option<u32>,
+    cameras: Option<String>,
+    seed: Option<u32>,
     #[serde(default)]
     viewpoints: Vec<String>,
     look_at: Option<[f64; 3]>,
@@ -119,6 +125,31 @@ pub enum Generator {
     },
 }
 
+/// How a viewpoint's frames place the camera.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cameras {
+    /// Along the viewpoint's path, frame after frame (the paper's walkthrough and orbit):
+    /// consecutive frames are correlated, so a median over them takes a moving-block interval.
+    Path,
+    /// Each frame an independent draw from the viewpoint's cameras, seeded
+    /// ([`random::random_camera`], [`classroom::random_camera`]): a median over them takes the
+    /// exact order-statistic interval, which decides a claim with far fewer frames.
+    Random {
+        /// Seed of the draws (`[path] seed`).
+        seed: u32,
+    },
+}
+
+impl Cameras {
+    /// `path` or `random`, as the file names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Cameras::Path => "path",
+            Cameras::Random { .. } => "random",
+        }
+    }
+}
+
 /// A part moved by a fixed step every frame, each structure updated in its own way.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Motion {
@@ -142,22 +173,30 @@ pub struct FramesSpec {
     pub width: u32,
     /// Image size.
     pub height: u32,
-    /// Each structure with its parameters.
+    /// Each structure with its parameters (its first candidate).
     pub structures: Vec<AccelSettings>,
+    /// Each structure's candidates, in `structures`' order: more than one where its
+    /// `[accel.NAME]` table lists values, and then it is tuned per scene ([`super::tuning`]).
+    pub candidates: Vec<Vec<AccelSettings>>,
+    /// How candidates are tuned.
+    pub tuning: FramesTuning,
     /// Shadings rendered, each over the whole path.
     pub shadings: Vec<(ShadingName, Shading)>,
     /// The claim the verdict answers.
     pub claim: Claim,
     /// The scene generator.
     pub generator: Generator,
-    /// Frames per unit of work (`[path] block`, default all): a static scene's path is cut
-    /// into blocks of this many frames, each shading and viewpoint apart, so shards can share
-    /// one long path; every structure of a block is timed in the same interleaved rounds.
-    pub block: u32,
+    /// Frames per unit of work (`[path] block`): a static scene's path is cut into blocks of
+    /// this many frames, each shading and viewpoint apart, so shards can share one long path;
+    /// every structure of a block is timed in the same interleaved rounds. Without it a scene is
+    /// one unit (its structures built once for every shading and viewpoint).
+    pub block: Option<u32>,
     /// Frames per viewpoint.
     pub frames: u32,
     /// Viewpoints (random triangles: each a short path; the classroom: its one walk).
     pub viewpoints: Vec<String>,
+    /// How each viewpoint's frames place the camera (`[path] cameras`, default `path`).
+    pub cameras: Cameras,
     /// A point every camera of the path looks at instead of its own (keeps a moving part in
     /// view).
     pub look_at: Option<DVec3>,
@@ -185,14 +224,40 @@ impl FramesSpec {
                 format!("must be in 1..={}, got {}", Shading::MAX_MIRROR_DEPTH, f.mirror_depth),
             ));
         }
-        let Comparison { names, tables: given } = Comparison::read(source, &f.structures, &f.accel, &f.claim, false)?;
-        let structures: Vec<AccelSettings> = names
+        let Comparison { names, tables: given } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
+        let candidates: Vec<Vec<AccelSettings>> = names
             .into_iter()
             .map(|name| match given.get(name) {
-                Some(one) => one[0].clone(),
-                None => AccelSettings::default_for(crate::accel::registered(name).expect("registered")),
+                Some(listed) => listed.clone(),
+                None => vec![AccelSettings::default_for(
+                    crate::accel::registered(name).expect("registered"),
+                )],
             })
             .collect();
+        let structures: Vec<AccelSettings> = candidates.iter().map(|c| c[0].clone()).collect();
+        let tuning = f.tuning.unwrap_or_default();
+        if !(1..=MAX_TUNING_CAMERAS).contains(&tuning.cameras) {
+            return Err(err(
+                &key_path!["tuning", "cameras"],
+                format!("tuning cameras per viewpoint: must be in 1..={MAX_TUNING_CAMERAS}"),
+            ));
+        }
+        if !(3..=crate::experiment::header::MAX_REPEATS).contains(&tuning.repeats) {
+            return Err(err(
+                &key_path!["tuning", "repeats"],
+                format!(
+                    "must be in 3..={} (the rounds behind each candidate's median and its interval)",
+                    crate::experiment::header::MAX_REPEATS
+                ),
+            ));
+        }
+        if f.tuning.is_some() && candidates.iter().all(|c| c.len() == 1) {
+            return Err(err(
+                &key_path!["tuning"],
+                "no structure lists candidates to tune: list values in an `[accel.NAME]` table or remove `[tuning]`"
+                    .into(),
+            ));
+        }
         if f.shadings.is_empty() {
             return Err(err(&key_path!["shadings"], "name at least one shading".into()));
         }
@@ -310,6 +375,24 @@ impl FramesSpec {
                 f.path.viewpoints.clone()
             }
         };
+        let cameras = match (f.path.cameras.as_deref(), f.path.seed) {
+            (None | Some("path"), None) => Cameras::Path,
+            (None | Some("path"), Some(_)) => {
+                return Err(err(
+                    &key_path!["path", "seed"],
+                    "a seed draws random cameras: set `cameras = \"random\"` or remove it".into(),
+                ))
+            }
+            (Some("random"), seed) => Cameras::Random {
+                seed: seed.unwrap_or(1),
+            },
+            (Some(other), _) => {
+                return Err(err(
+                    &key_path!["path", "cameras"],
+                    format!("unknown `{other}`; known: path, random"),
+                ))
+            }
+        };
         let look_at = match f.path.look_at {
             Some(p) if !p.iter().all(|x| x.is_finite()) => {
                 return Err(err(&key_path!["path", "look_at"], "coordinates must be finite".into()))
@@ -353,13 +436,16 @@ impl FramesSpec {
             width: f.width,
             height: f.height,
             structures,
+            candidates,
+            tuning,
             shadings,
             claim: f.claim,
             generator,
             frames: f.path.frames,
             viewpoints,
+            cameras,
             look_at,
-            block: f.path.block.unwrap_or(f.path.frames),
+            block: f.path.block,
             motion,
             strip: f.strip,
         };
@@ -452,14 +538,28 @@ impl FramesSpec {
         };
         let available = crate::accel::memory::available();
         // One scene is held at a time, with its triangle list, a copy per structure and every
-        // structure built over it.
+        // structure built over it; before that, one structure's tuning candidates together.
         for (k, &n) in counts.iter().enumerate() {
-            let scene = (2 + self.structures.len()) as u64 * SCENE_BYTES_PER_TRIANGLE * n as u64;
-            let structures: u64 = self
+            let copies = self
                 .structures
+                .len()
+                .max(self.candidates.iter().map(Vec::len).max().unwrap_or(1));
+            let scene = (2 + copies) as u64 * SCENE_BYTES_PER_TRIANGLE * n as u64;
+            let each = |c: &Vec<AccelSettings>| -> Vec<u64> {
+                c.iter().map(|s| crate::accel::memory::estimate(s, n)).collect()
+            };
+            let kept: u64 = self
+                .candidates
                 .iter()
-                .map(|s| crate::accel::memory::estimate(s, n))
+                .map(|c| each(c).into_iter().max().unwrap_or(0))
                 .sum();
+            let tuning = self
+                .candidates
+                .iter()
+                .map(|c| each(c).into_iter().sum::<u64>())
+                .max()
+                .unwrap_or(0);
+            let structures = kept.max(tuning);
             if let Some(budget) = available.filter(|b| scene + structures > b.bytes) {
                 let at: Vec<Seg> = match self.generator {
                     Generator::Classroom => key_path!["structures"].to_vec(),
@@ -477,7 +577,12 @@ impl FramesSpec {
                 ));
             }
         }
-        for (i, s) in self.structures.iter().enumerate() {
+        for (i, s) in self
+            .candidates
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| c.iter().map(move |s| (i, s)))
+        {
             for &n in &counts {
                 crate::accel::memory::check(s, n, available).map_err(|e| {
                     let at = if tables.contains_key(s.name) {
@@ -509,15 +614,19 @@ impl FramesSpec {
         })
     }
 
-    /// The camera of `frame` along `viewpoint` (looking at the file's `look_at` where it has
-    /// one; [`FramesSpec::from_source`] checks every camera of the path can).
+    /// The camera of `frame` of `viewpoint`, on its path or drawn at random ([`Cameras`]), looking
+    /// at the file's `look_at` where it has one ([`FramesSpec::from_source`] checks every camera
+    /// can).
     pub fn camera(&self, viewpoint: &str, frame: u32) -> crate::scene::camera::Camera {
-        let mut camera = match self.generator {
-            Generator::Classroom => classroom::camera_path(frame, self.frames),
-            Generator::RandomTriangles { .. } => {
-                random::camera_path(viewpoint, frame).expect("viewpoints are validated")
+        let mut camera = match (&self.generator, self.cameras) {
+            (Generator::Classroom, Cameras::Path) => Some(classroom::camera_path(frame, self.frames)),
+            (Generator::Classroom, Cameras::Random { seed }) => Some(classroom::random_camera(seed, frame)),
+            (Generator::RandomTriangles { .. }, Cameras::Path) => random::camera_path(viewpoint, frame),
+            (Generator::RandomTriangles { .. }, Cameras::Random { seed }) => {
+                random::random_camera(viewpoint, seed, frame)
             }
-        };
+        }
+        .expect("viewpoints are validated");
         if let Some(p) = self.look_at {
             camera.look_at = p;
         }

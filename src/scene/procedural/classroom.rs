@@ -227,7 +227,19 @@ pub fn classroom() -> Generated {
 /// ellipse between the desks and the walls, looking at a point a sixth of a loop ahead on a
 /// smaller ellipse at desk height.
 pub fn camera_path(frame: u32, frames: u32) -> Camera {
-    let s = TAU * frame as f64 / frames.max(1) as f64;
+    camera_on_loop(frame as f64 / frames.max(1) as f64)
+}
+
+/// Camera `frame` drawn at random from the walk, independently of every other frame, from the
+/// seeded stream `seed`: its place on the loop uniform in [0, 1). Independent frames let a median
+/// over them take an exact order-statistic interval (a path's consecutive frames are correlated).
+pub fn random_camera(seed: u32, frame: u32) -> Camera {
+    camera_on_loop(crate::sampling::Stream::new(seed, 0, Some(frame)).unit(0))
+}
+
+/// The walk's camera a fraction `t` of the way round the loop.
+fn camera_on_loop(t: f64) -> Camera {
+    let s = TAU * t;
     let position = v(-4.2 * s.cos(), -3.3 * s.sin(), 1.6);
     let ahead = s + TAU / 6.0;
     let look_at = v(-2.0 * ahead.cos(), -1.5 * ahead.sin(), 1.0);

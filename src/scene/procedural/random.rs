@@ -72,15 +72,48 @@ pub fn camera_path(viewpoint: &str, frame: u32) -> Option<Camera> {
         }
         _ => return None,
     };
-    Some(Camera {
+    Some(looking(position, look_at))
+}
+
+/// Camera `frame` of `viewpoint` drawn at random, independently of every other frame, from the
+/// seeded stream `seed`: `outside`, at 3.2 m from the centre at an azimuth uniform in [0, 360)
+/// degrees and an elevation uniform in [10, 40] degrees, looking at the centre; `inside`,
+/// anywhere in [-0.8, 0.8]^3 looking at a point uniform in the core [-0.3, 0.3]^3 at least
+/// 0.3 m away and not within 25 degrees of vertical (drawn again until it is), so that every
+/// inside view looks through the triangles rather than out of the cube past its edge. Frames
+/// drawn so are independent samples of the viewpoint's cameras, so a median over them has an
+/// exact order-statistic interval (a path's consecutive frames are correlated and do not).
+pub fn random_camera(viewpoint: &str, seed: u32, frame: u32) -> Option<Camera> {
+    let stream = crate::sampling::Stream::new(seed, 0, Some(frame));
+    let u = |i: u32| stream.unit(i);
+    let angle = |i: u32, lo: f64, hi: f64| (lo + (hi - lo) * u(i)).to_radians();
+    let along = |az: f64, el: f64| DVec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+    let point = |i: u32, half: f64| (DVec3::new(u(i), u(i + 1), u(i + 2)) * 2.0 - DVec3::ONE) * half;
+    let (position, look_at) = match viewpoint {
+        "outside" => (3.2 * along(angle(0, 0.0, 360.0), angle(1, 10.0, 40.0)), DVec3::ZERO),
+        "inside" => (0..)
+            .map(|k| (point(6 * k, 0.8), point(6 * k + 3, 0.3)))
+            .find(|&(p, t)| {
+                let d = t - p;
+                d.length() >= 0.3 && d.normalize().z.abs() <= 25f64.to_radians().cos()
+            })
+            .expect("a draw succeeds with probability above one half"),
+        _ => return None,
+    };
+    Some(looking(position, look_at))
+}
+
+/// The viewpoints' camera at `position` looking at `look_at`, z up, 60 degrees vertical field.
+fn looking(position: DVec3, look_at: DVec3) -> Camera {
+    Camera {
         position,
         look_at,
         up: DVec3::Z,
         projection: Projection::Perspective { fov_y_deg: 60.0 },
-    })
+    }
 }
 
-/// The viewpoints [`camera_path`] knows.
+/// The viewpoints [`camera_path`] and [`random_camera`] know.
 pub const VIEWPOINTS: [&str; 2] = ["outside", "inside"];
 
 #[cfg(test)]

@@ -158,7 +158,7 @@ Every configuration timed with its first seed, once per round, in {} interleaved
                 config.pattern,
                 config.samples,
                 config.light_radius,
-                ratio.show(3),
+                ratio.show_ratio(3),
                 word.word(),
                 if word == Comparison::Equal {
                     ", as it must be."
@@ -177,7 +177,7 @@ fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>) -> String
     match (x, uniform) {
         (Some(a), Some(b)) => {
             let (ratio, word) = compare(a, b);
-            format!("{}x uniform's time: {}", ratio.show(2), word.word())
+            format!("{}x uniform's time: {}", ratio.show_ratio(2), word.word())
         }
         _ => "untimed".into(),
     }

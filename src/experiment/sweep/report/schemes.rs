@@ -99,7 +99,7 @@ fn sentence(m: &Metric, r: &[(DiskScheme, MeanCi)], subject: DiskScheme) -> Stri
     let call = if r.len() < 2 {
         "the only scheme measured by it here, so none is called best".to_string()
     } else if !b.ci95.is_finite() {
-        "no interval (fewer than two seeds), so no scheme is called best".to_string()
+        "no interval (fewer than four seeds), so no scheme is called best".to_string()
     } else if tied.is_empty() {
         "below every other scheme, 95 % intervals disjoint".to_string()
     } else {
@@ -234,7 +234,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
         let ratio = match (&x.timing, &budget.timing) {
             (Some(a), Some(b)) => {
                 let (r, word) = compare(a, b);
-                format!("{}x: {}", r.show(2), word.word())
+                format!("{}x: {}", r.show_ratio(2), word.word())
             }
             _ => "untimed".into(),
         };

@@ -76,7 +76,7 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
             c.accelerator,
             ms(&other.frame),
             ms(&first.frame),
-            or_na(ratio.median, |_| format!("{}x", ratio.show(2))),
+            or_na(ratio.median, |_| format!("{}x", ratio.show_ratio(2))),
             count(other.work, |w| w.nodes),
             count(first.work, |w| w.nodes),
             count(other.work, |w| w.primitives),

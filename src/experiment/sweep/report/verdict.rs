@@ -4,7 +4,7 @@
 //! experiment's `[verdict]` may ask the same of another pair (its own pattern against uniform).
 //!
 //! Two means are called different only when their 95 % intervals are disjoint; without intervals
-//! (fewer than two seeds) nothing is called different, and the verdict says it needs more seeds.
+//! (fewer than four seeds) nothing is called different, and the verdict says it needs more seeds.
 
 use super::summary::{find, Summary};
 use crate::experiment::sweep::axes::Config;
@@ -127,8 +127,8 @@ impl Verdict {
             "**At {} shadow rays, light radius {} m, {} pattern, {} seeds.**\n\n",
             self.samples, self.light_radius, self.pattern, self.seeds
         );
-        if self.seeds < 2 {
-            s += "- *No verdict:* comparing two configurations needs at least two seeds each (for an interval over seeds); this sweep has fewer. The numbers below are single renders.\n";
+        if self.seeds < crate::metrics::stats::MIN_VALUES_FOR_INTERVAL {
+            s += &format!("- *No verdict:* comparing two configurations needs at least {} seeds each (for an interval over seeds); this sweep has fewer. The numbers below carry no interval.\n", crate::metrics::stats::MIN_VALUES_FOR_INTERVAL);
         }
         let (e, w) = self.exact;
         s += &format!(
@@ -141,7 +141,7 @@ impl Verdict {
                 format!("{big_a_s} penumbra is wider (95 % intervals disjoint).")
             } else if self.extent.a_below() {
                 format!("{big_a_s} penumbra is narrower (95 % intervals disjoint).")
-            } else if self.seeds < 2 {
+            } else if self.seeds < crate::metrics::stats::MIN_VALUES_FOR_INTERVAL {
                 "Without intervals no difference can be called.".into()
             } else if !self.extent.comparable() {
                 "No difference can be called: an extent is missing (no penumbra, or beyond the measured patch).".into()
@@ -166,7 +166,7 @@ impl Verdict {
                 format!("{big_a_s} extra width is a departure from the exact profile: a bias, not a truer penumbra.")
             } else if departs {
                 format!("{big_a_s} profile is narrower than the exact one by more than {b_s} departs, beyond noise: a bias.")
-            } else if self.seeds < 2 {
+            } else if self.seeds < crate::metrics::stats::MIN_VALUES_FOR_INTERVAL {
                 "Without intervals no difference can be called.".into()
             } else if !self.width_10_90.comparable() || !w.is_finite() {
                 "No difference can be called: a 10-90 % width is missing (no penumbra, or beyond the measured patch).".into()

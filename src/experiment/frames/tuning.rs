@@ -1,0 +1,184 @@
+//! Each structure tuned per scene before its frames are timed, as the visibility-field paper
+//! tuned both of its methods per scene (Table 1 gives each one's best depth) and as the ao kind
+//! does: a structure whose `[accel.NAME]` table lists several values is built at every
+//! combination, each candidate renders the tuning cameras at the experiment's own resolution
+//! ([`tuning_shading`]) in interleaved rounds, and the fastest median is kept. The tuning cameras are
+//! drawn at random from every viewpoint with their own seed, never the frames measured, so the
+//! choice is not fitted to the frames it is judged on. A structure with one candidate is not
+//! timed. Candidates of one structure are held together and dropped before the next is tuned.
+
+use super::runner::SAMPLING;
+use super::spec::{FramesSpec, Generator, ShadingName};
+use crate::accel::settings::{registry_name, RegistryName};
+use crate::accel::work::Work;
+use crate::accel::AccelSettings;
+use crate::experiment::timing::{median_interval, Estimate, Schedule};
+use crate::render::{Backend, View};
+use crate::scene::camera::Camera;
+use crate::scene::procedural::{classroom, random, Generated};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// How a frame-time experiment tunes (`[tuning]`; used only where a structure lists
+/// candidates).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct FramesTuning {
+    /// Tuning cameras drawn per viewpoint.
+    #[serde(default = "two")]
+    pub cameras: u32,
+    /// Interleaved rounds per candidate.
+    #[serde(default = "three")]
+    pub repeats: u32,
+    /// Seed of the tuning cameras' draws.
+    #[serde(default = "tuning_seed")]
+    pub seed: u32,
+}
+
+impl Default for FramesTuning {
+    fn default() -> Self {
+        FramesTuning {
+            cameras: two(),
+            repeats: three(),
+            seed: tuning_seed(),
+        }
+    }
+}
+
+fn two() -> u32 {
+    2
+}
+
+fn three() -> u32 {
+    3
+}
+
+/// The tuning cameras' seed when the file gives none: apart from any `[path] seed` a file is
+/// likely to use.
+fn tuning_seed() -> u32 {
+    0x7475_6e65
+}
+
+/// One candidate of the tuning sweep, timed: a row of tuning.csv.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TuningRow {
+    /// Triangles in the scene.
+    pub triangles: usize,
+    /// Structure name.
+    #[serde(with = "registry_name")]
+    pub structure: RegistryName,
+    /// Its parameters.
+    pub settings: AccelSettings,
+    /// Median seconds to render every tuning camera once, with its interval over rounds.
+    pub seconds: Estimate,
+    /// What rendering every tuning camera once cost.
+    pub work: Work,
+    /// Build seconds.
+    pub build_seconds: f64,
+    /// Whether this candidate was kept.
+    pub chosen: bool,
+}
+
+/// The shading candidates are timed under: Whitted where the experiment renders it (its shadow
+/// and mirror rays are most of the work), else the first listed.
+pub fn tuning_shading(spec: &FramesSpec) -> ShadingName {
+    let listed = |n| spec.shadings.iter().any(|(s, _)| *s == n);
+    if listed(ShadingName::Whitted) {
+        ShadingName::Whitted
+    } else {
+        spec.shadings[0].0
+    }
+}
+
+/// The tuning cameras of `spec`: `cameras` draws from each viewpoint with the tuning seed.
+fn tuning_cameras(spec: &FramesSpec) -> Vec<Camera> {
+    let t = &spec.tuning;
+    spec.viewpoints
+        .iter()
+        .flat_map(|v| {
+            (0..t.cameras).map(move |k| {
+                let mut c = match spec.generator {
+                    Generator::Classroom => classroom::random_camera(t.seed, k),
+                    Generator::RandomTriangles { .. } => {
+                        random::random_camera(v, t.seed, k).expect("viewpoints are validated")
+                    }
+                };
+                if let Some(p) = spec.look_at {
+                    c.look_at = p;
+                }
+                c
+            })
+        })
+        .collect()
+}
+
+/// The settings each structure of `spec` renders `generated` with (its fastest candidate, or
+/// its one), and every candidate timed.
+pub fn tune(
+    spec: &FramesSpec,
+    generated: &Generated,
+    backend: &mut dyn Backend,
+) -> anyhow::Result<(Vec<AccelSettings>, Vec<TuningRow>)> {
+    let cameras = tuning_cameras(spec);
+    let shading = spec
+        .shadings
+        .iter()
+        .find(|(n, _)| *n == tuning_shading(spec))
+        .expect("the tuning shading is listed")
+        .1;
+    let (mut chosen, mut rows) = (Vec::new(), Vec::new());
+    for candidates in &spec.candidates {
+        if candidates.len() == 1 {
+            chosen.push(candidates[0].clone());
+            continue;
+        }
+        let mut scenes = Vec::new();
+        for c in candidates {
+            let mut scene = generated.scene(BTreeMap::new(), c.clone())?;
+            scene.shading = shading;
+            scenes.push(scene);
+        }
+        let view = |camera| View {
+            camera,
+            width: spec.width,
+            height: spec.height,
+        };
+        let mut work = vec![Work::ZERO; scenes.len()];
+        for (scene, w) in scenes.iter().zip(&mut work) {
+            for c in &cameras {
+                *w += backend.render(scene, view(c), SAMPLING)?.work;
+            }
+        }
+        let schedule = Schedule {
+            repeats: spec.tuning.repeats,
+            warmup: 0,
+            seed: spec.tuning.seed ^ spec.header.schedule.seed,
+        };
+        let times = schedule.run(scenes.len(), |i| -> anyhow::Result<f64> {
+            let start = Instant::now();
+            for c in &cameras {
+                backend.render(&scenes[i], view(c), SAMPLING)?;
+            }
+            Ok(start.elapsed().as_secs_f64())
+        })?;
+        let first = rows.len();
+        for ((c, t), (w, scene)) in candidates.iter().zip(&times).zip(work.into_iter().zip(&scenes)) {
+            rows.push(TuningRow {
+                triangles: generated.triangle_count(),
+                structure: c.name,
+                settings: c.clone(),
+                seconds: median_interval(t),
+                work: w,
+                build_seconds: scene.accel.as_ref().map_or(0.0, |a| a.stats().build_time.as_secs_f64()),
+                chosen: false,
+            });
+        }
+        let best = (first..rows.len())
+            .min_by(|&a, &b| rows[a].seconds.median.total_cmp(&rows[b].seconds.median))
+            .expect("at least two candidates");
+        rows[best].chosen = true;
+        chosen.push(rows[best].settings.clone());
+    }
+    Ok((chosen, rows))
+}
