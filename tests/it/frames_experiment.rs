@@ -422,3 +422,24 @@ fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
         "{v}"
     );
 }
+
+/// The redesigned scaling and walkthrough files load, draw their cameras at random and tune
+/// both kd-trees, and their cameras can all look where they are told (checked on load).
+#[test]
+fn the_random_camera_designs_load_and_tune_both_kd_trees() {
+    use penumbra::experiment::frames::spec::Cameras;
+    for name in ["scaling-random", "walkthrough-random"] {
+        let spec = penumbra::experiment::frames::FramesSpec::load(&common::repo(&format!("experiments/{name}.toml")))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(spec.cameras, Cameras::Random { seed: 1 }, "{name}");
+        for (structure, candidates) in spec.structures.iter().zip(&spec.candidates) {
+            let tuned = candidates.len() > 1;
+            assert_eq!(
+                tuned,
+                structure.name.starts_with("kdtree"),
+                "{name}: {}",
+                structure.name
+            );
+        }
+    }
+}

@@ -14,7 +14,6 @@ mod command_line;
 mod common;
 mod cwbvh;
 mod dynamic_updates;
-mod frame_power;
 mod frames_experiment;
 mod fuzz_config;
 mod fuzz_mesh_files;
