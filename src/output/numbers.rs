@@ -91,7 +91,7 @@ mod tests {
         assert_eq!(with_ci(0.014, f64::NAN, mm), "14.00 mm ± n/a");
         assert_eq!(with_ci(f64::NAN, 0.001, mm), "n/a");
         assert_eq!(with_ci(0.014, 0.0004, mm), "14.00 mm ± 0.40 mm");
-        assert_eq!(per_triangle(6_455_044_812, 1_024_000), "6,304");
+        assert_eq!(per_triangle(6_455_044_812, 1_024_000), "6\u{2009}304");
         assert_eq!(per_triangle(14_780_480, 1_024_000), "14.4");
         assert_eq!(per_triangle(1, 3), "0.33");
         assert_eq!(per_triangle(5, 0), "n/a");
