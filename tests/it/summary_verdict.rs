@@ -40,18 +40,18 @@ fn sweep(seeds: &str) -> (Outcome, Vec<Summary>) {
 
 #[test]
 fn summaries_match_the_runs_recomputed_by_hand() {
-    let (out, summaries) = sweep("seeds = [1, 2, 3]");
+    let (out, summaries) = sweep("seeds = [1, 2, 3, 4]");
     for s in &summaries {
         let rows: Vec<_> = out.records.iter().filter(|r| r.run.config() == s.config).collect();
-        assert_eq!((rows.len(), s.seeds), (3, 3));
+        assert_eq!((rows.len(), s.seeds), (4, 4));
         let x: Vec<f64> = rows.iter().map(|r| r.metrics.rmse).collect();
-        let mean = x.iter().sum::<f64>() / 3.0;
-        let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        let mean = x.iter().sum::<f64>() / 4.0;
+        let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3.0).sqrt();
         assert!((s.metrics.rmse.mean - mean).abs() < 1e-15);
-        // Student's t for 2 degrees of freedom: 4.303.
-        assert!((s.metrics.rmse.ci95 - 4.303 * sd / 3f64.sqrt()).abs() < 1e-12);
+        // Student's t for 3 degrees of freedom: 3.182.
+        assert!((s.metrics.rmse.ci95 - 3.182 * sd / 2.0).abs() < 1e-12);
         // Over the same mask, the mean of the runs' MSE is exactly bias^2 + variance.
-        let mse = x.iter().map(|v| v * v).sum::<f64>() / 3.0;
+        let mse = x.iter().map(|v| v * v).sum::<f64>() / 4.0;
         let split = s.stats.split;
         assert!(
             (mse - (split.bias2 + split.variance)).abs() < 1e-6 * mse,
@@ -64,8 +64,8 @@ fn summaries_match_the_runs_recomputed_by_hand() {
 }
 
 #[test]
-fn the_verdict_needs_two_seeds_and_never_prints_nan() {
-    let (_, one) = sweep("seeds = [1]");
+fn the_verdict_needs_four_seeds_and_never_prints_nan() {
+    let (_, one) = sweep("seeds = [1, 2, 3]");
     let v = Verdict::new(
         &one,
         &at(&one, DiskScheme::Paper),
@@ -81,10 +81,10 @@ fn the_verdict_needs_two_seeds_and_never_prints_nan() {
     assert!(text.contains("± n/a"), "{text}");
     assert!(!v.wider() && !v.extent.a_below());
 
-    let (_, three) = sweep("seeds = [1, 2, 3]");
+    let (_, four) = sweep("seeds = [1, 2, 3, 4]");
     let v = Verdict::new(
-        &three,
-        &at(&three, DiskScheme::Paper),
+        &four,
+        &at(&four, DiskScheme::Paper),
         (DiskScheme::Paper, DiskScheme::Uniform),
     )
     .unwrap();
@@ -92,7 +92,7 @@ fn the_verdict_needs_two_seeds_and_never_prints_nan() {
     assert!(!text.contains("No verdict") && !text.contains("NaN"), "{text}");
     // Squared biases read as values with their intervals, never bare (or negative) numbers.
     for scheme in [DiskScheme::Paper, DiskScheme::Uniform] {
-        let s = find(&three, &at(&three, scheme)).unwrap();
+        let s = find(&four, &at(&four, scheme)).unwrap();
         let b = penumbra::output::numbers::bias2(&s.stats.split);
         assert!(b.contains(" ± ") && text.contains(&b), "{b} not in {text}");
     }
