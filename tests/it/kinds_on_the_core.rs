@@ -152,3 +152,35 @@ fn filters_keep_the_units_and_values_named_and_refuse_what_a_kind_lacks() {
         .collect();
     assert_eq!(kept, [("cow", "bvh"), ("cow", "brute")]);
 }
+
+/// Filters on two axes where the first thins the second's values: fps' sphere keeps only one
+/// light, so its light counts are [2] once `scene=body` is kept, and `lights=2` must still mean
+/// two lights (it indexed the list before the scene filter, out of bounds).
+#[test]
+fn a_filter_keeps_its_value_after_another_axis_thins_the_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = variant(dir.path(), "experiments/fps-ci.toml", |t| {
+        let edited = t
+            .replacen(
+                "lights = [1, 2]\npaper_fps = [15.95, 9.39]",
+                "lights = [1]\npaper_fps = [15.95]",
+                1,
+            )
+            .replacen(
+                "lights = [1, 2]\npaper_fps = [8.36, 6.13]",
+                "lights = [2]\npaper_fps = [6.13]",
+                1,
+            );
+        assert_ne!(edited, t, "the edit applies");
+        edited
+    });
+    // It panicked (exit 101) indexing the thinned list.
+    run_ok(&[
+        exp.as_os_str(),
+        OsStr::new("--dry-run"),
+        OsStr::new("--filter"),
+        OsStr::new("scene=body"),
+        OsStr::new("--filter"),
+        OsStr::new("lights=2"),
+    ]);
+}

@@ -264,7 +264,17 @@ impl<D: Declaration> Declared<D> {
         let mut spec = self.0.clone();
         let axes = spec.axes();
         for (axis, keep) in filter::select(&axes, filters, filter::same_text).map_err(BadInput)? {
-            spec.restrict(axis, &keep);
+            // An earlier axis's restriction may have thinned this axis's values (fps: a scene
+            // kept takes only its own light counts), so the kept values are found again.
+            let kept: Vec<&String> = keep.iter().map(|&i| &axes[axis].values[i]).collect();
+            let now: Vec<usize> = spec.axes()[axis]
+                .values
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| kept.contains(v))
+                .map(|(i, _)| i)
+                .collect();
+            spec.restrict(axis, &now);
         }
         Ok(spec)
     }
