@@ -393,6 +393,14 @@ impl FramesSpec {
                 ))
             }
         };
+        if let Cameras::Random { seed } = cameras {
+            if seed == tuning.seed {
+                return Err(err(
+                    &key_path!["tuning", "seed"],
+                    format!("equals the cameras' seed ({seed}): tuning would run on the frames it is judged on"),
+                ));
+            }
+        }
         let look_at = match f.path.look_at {
             Some(p) if !p.iter().all(|x| x.is_finite()) => {
                 return Err(err(&key_path!["path", "look_at"], "coordinates must be finite".into()))
