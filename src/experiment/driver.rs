@@ -74,7 +74,11 @@ fn run_into(
     let kind = header.kind.name();
     let accepts = experiment.accepts();
     check_home(home, kind, &header.name, &cli.experiment, cli.fresh).map_err(BadInput)?;
-    let out = Outputs::begin(home).map_err(|e| BadInput(format!("{e:#}")))?;
+    let out = match cli.shard {
+        Some(shard) => Outputs::begin_shard(home, &shard.dir(home)),
+        None => Outputs::begin(home),
+    }
+    .map_err(|e| BadInput(format!("{e:#}")))?;
     let mut backend: Box<dyn Backend> = if accepts.gpu {
         open_backend(choice)?
     } else {

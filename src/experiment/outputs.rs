@@ -24,8 +24,11 @@ pub struct Outputs {
     home: PathBuf,
     staging: PathBuf,
     committed: bool,
-    /// The results folder, open and locked for as long as this run may replace it.
-    _lock: File,
+    /// Whether `staging` is a shard's own folder, which outlives the run and is never swapped in.
+    shard: bool,
+    /// The results folder (exclusively) or a shard's folder (with the results folder shared),
+    /// open and locked for as long as this run writes there.
+    _locks: Vec<File>,
 }
 
 /// The results folder a run will replace, as the real path its swap acts on: created if
@@ -67,20 +70,35 @@ fn check_kept(path: &Path) -> anyhow::Result<()> {
     check_plain_tree(path)
 }
 
-/// Takes an exclusive lock on the results folder for this run, or says another run holds it.
-fn lock(home: &Path) -> anyhow::Result<File> {
-    use std::os::fd::AsRawFd;
-    let dir = File::open(home).with_context(|| format!("opening {}", home.display()))?;
-    // SAFETY: a valid open descriptor; the lock lasts as long as the file stays open.
-    let rc = unsafe { libc::flock(dir.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
-    if rc != 0 {
-        bail!(
-            "{}: another run is writing into this results folder; wait for it or choose another --out",
-            home.display()
-        );
-    }
-    Ok(dir)
+/// How a run holds a folder: alone (a run that swaps the results folder, a merge, a shard in its
+/// own folder) or beside others (shards in one results folder, which must not be swapped under
+/// them).
+#[derive(Clone, Copy)]
+enum Hold {
+    Alone,
+    Shared,
 }
+
+/// Locks `dir` for this run as `hold` says, or says which run holds it; the lock lasts as long
+/// as the returned file stays open.
+fn lock(dir: &Path, hold: Hold, held: &str) -> anyhow::Result<File> {
+    use std::os::fd::AsRawFd;
+    let file = File::open(dir).with_context(|| format!("opening {}", dir.display()))?;
+    let how = match hold {
+        Hold::Alone => libc::LOCK_EX,
+        Hold::Shared => libc::LOCK_SH,
+    };
+    // SAFETY: a valid open descriptor.
+    let rc = unsafe { libc::flock(file.as_raw_fd(), how | libc::LOCK_NB) };
+    if rc != 0 {
+        bail!("{}: {held}", dir.display());
+    }
+    Ok(file)
+}
+
+/// What a run refused by a held results folder is told.
+const HOME_HELD: &str =
+    "another run is writing into this results folder (a whole run, a merge or a shard); wait for it or choose another --out";
 
 /// This host's name, for staging folders on file systems shared by several machines.
 fn host() -> String {
@@ -97,7 +115,7 @@ impl Outputs {
     /// special file, and a link or file named like a staging folder, are refused with their path
     /// before anything is moved or removed.
     pub fn begin(home: &Path) -> anyhow::Result<Outputs> {
-        let lock = lock(home)?;
+        let lock = lock(home, Hold::Alone, HOME_HELD)?;
         let name = home
             .file_name()
             .map(|n| n.to_string_lossy())
@@ -151,7 +169,30 @@ impl Outputs {
             home: home.to_path_buf(),
             staging,
             committed: false,
-            _lock: lock,
+            shard: false,
+            _locks: vec![lock],
+        })
+    }
+
+    /// The shard folder `dir` under `home`, written in place: locked alone (one run per shard),
+    /// with `home` held shared, so shards of one results folder run side by side (one node's
+    /// cores, or nodes sharing the folder) while no run swaps the folder under them or merges
+    /// a shard still being written. Kept state is checked as in [`Outputs::begin`].
+    pub fn begin_shard(home: &Path, dir: &Path) -> anyhow::Result<Outputs> {
+        let replacing = "a run that replaces this results folder (a whole run or a merge) holds it; wait for it, then run the shard";
+        let home_lock = lock(home, Hold::Shared, replacing)?;
+        for kept in KEPT {
+            check_kept(&home.join(kept))?;
+        }
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        check_plain_folder(dir)?;
+        let dir_lock = lock(dir, Hold::Alone, "another run is writing this shard; wait for it")?;
+        Ok(Outputs {
+            home: home.to_path_buf(),
+            staging: dir.to_path_buf(),
+            committed: false,
+            shard: true,
+            _locks: vec![home_lock, dir_lock],
         })
     }
 
@@ -178,6 +219,12 @@ impl Outputs {
     /// Replaces the results folder with the staged set, carrying over [`KEPT`] entries; if the
     /// swap fails, the carried entries go back where they were and the earlier set stays.
     pub fn commit(mut self) -> anyhow::Result<()> {
+        if self.shard {
+            bail!(
+                "{}: a shard's folder is written in place, never swapped in",
+                self.staging.display()
+            );
+        }
         if self.home.is_dir() {
             let mut moved = Vec::new();
             let carried = (|| -> anyhow::Result<()> {
@@ -214,7 +261,7 @@ impl Outputs {
 
 impl Drop for Outputs {
     fn drop(&mut self) {
-        if !self.committed {
+        if !self.committed && !self.shard {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
@@ -309,6 +356,33 @@ pub fn check_home(home: &Path, kind: &str, name: &str, experiment: &Path, fresh:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shards_run_side_by_side_but_never_beside_a_run_that_replaces_the_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(&home).unwrap();
+        let (one, two) = (home.join("shards/1-of-2"), home.join("shards/2-of-2"));
+        let first = Outputs::begin_shard(&home, &one).unwrap();
+        let second = Outputs::begin_shard(&home, &two).unwrap();
+        let again = Outputs::begin_shard(&home, &one).unwrap_err().to_string();
+        assert!(again.contains("another run is writing this shard"), "{again}");
+        let whole = Outputs::begin(&home).unwrap_err().to_string();
+        assert!(
+            whole.contains("another run is writing into this results folder"),
+            "{whole}"
+        );
+        // A shard's folder outlives its run: nothing is removed, and it is never swapped in.
+        std::fs::write(one.join("unit.toml"), b"kept").unwrap();
+        assert!(first.commit().is_err());
+        drop(second);
+        assert_eq!(std::fs::read(one.join("unit.toml")).unwrap(), b"kept");
+        let merge = Outputs::begin(&home).unwrap();
+        let shard = Outputs::begin_shard(&home, &two).unwrap_err().to_string();
+        assert!(shard.contains("a whole run or a merge"), "{shard}");
+        drop(merge);
+        Outputs::begin_shard(&home, &two).unwrap();
+    }
 
     #[test]
     fn a_committed_set_replaces_the_old_and_keeps_state() {

@@ -32,7 +32,8 @@ fn variant(dir: &Path, experiment: &str, edit: impl Fn(String) -> String) -> Pat
     path
 }
 
-/// Runs `experiment` whole, as two shards merged (after a refused merge missing one), and killed
+/// Runs `experiment` whole, as two concurrent shards merged (after a refused merge missing one's
+/// manifest, and that shard's rerun from its journal), and killed
 /// after one unit then resumed; every run's `tables` must equal the whole run's but for the clock,
 /// and the first table must have rows.
 fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
@@ -44,8 +45,22 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
     let [o, f] = out(&full);
     run_ok(&[exp, &o, &f]);
 
+    // Both shards at once into one results folder, as parallel.sh runs them on one node.
     let [o, s] = out(&sharded);
-    run_ok(&[exp, &o, &s, OsStr::new("--shard"), OsStr::new("1/2")]);
+    let shard = |k: &str| {
+        Command::new(env!("CARGO_BIN_EXE_sweep"))
+            .args([exp, &o, &s, OsStr::new("--shard"), OsStr::new(k)])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let running = [shard("1/2"), shard("2/2")];
+    for child in running {
+        let done = child.wait_with_output().unwrap();
+        assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    }
+    // A shard without its manifest is unfinished: the merge refuses it, naming the rerun.
+    std::fs::remove_file(sharded.join("shards/2-of-2/shard.toml")).unwrap();
     let (code, err) = run(&[exp, &o, &s, OsStr::new("--merge"), OsStr::new("2")]);
     assert_eq!(code, 4, "{err}");
     assert!(
@@ -53,7 +68,11 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
         "{err}"
     );
     assert!(!sharded.join("manifest.toml").exists(), "a refused merge wrote results");
-    run_ok(&[exp, &o, &s, OsStr::new("--shard"), OsStr::new("2/2")]);
+    let err = run_ok(&[exp, &o, &s, OsStr::new("--shard"), OsStr::new("2/2")]);
+    assert!(
+        err.contains(" resumed)") && !err.contains("(0 resumed)"),
+        "the rerun shard measured again:\n{err}"
+    );
     run_ok(&[exp, &o, &s, OsStr::new("--merge"), OsStr::new("2")]);
 
     let [o, k] = out(&killed);
@@ -65,6 +84,28 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
         .status;
     assert!(!status.success() && status.code().is_none(), "not killed: {status:?}");
     assert!(!killed.join("manifest.toml").exists());
+    // A journaled unit changed after it was written (one digit, or cut short) is refused, not
+    // taken as measured; restored, it resumes.
+    let journaled: Vec<PathBuf> = std::fs::read_dir(killed.join(".journal"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(journaled.len(), 1, "{journaled:?}");
+    let original = std::fs::read_to_string(&journaled[0]).unwrap();
+    let digit = original.rfind(|c: char| c.is_ascii_digit() && c != '7').unwrap();
+    let mut edited = original.clone();
+    edited.replace_range(digit..digit + 1, "7");
+    for damaged in [edited, original[..original.len() * 2 / 3].to_string()] {
+        std::fs::write(&journaled[0], damaged).unwrap();
+        let (code, err) = run(&[exp, &o, &k]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("has changed since it was written") && err.contains("--fresh"),
+            "{err}"
+        );
+        assert!(!killed.join("manifest.toml").exists());
+    }
+    std::fs::write(&journaled[0], &original).unwrap();
     let err = run_ok(&[exp, &o, &k]);
     assert!(
         err.contains("1 of") && err.contains("units taken from the journal"),

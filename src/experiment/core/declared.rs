@@ -160,6 +160,9 @@ fn identity(context: &str, units: &[Unit]) -> String {
     format!("{:016x}", fnv1a(keys.join(",").as_bytes()))
 }
 
+/// The first line of a journaled unit's file, before the FNV-1a of the rest.
+const CHECK: &str = "# fnv1a ";
+
 /// A folder of journaled units, one TOML file each, written atomically as each finishes.
 struct UnitJournal {
     dir: PathBuf,
@@ -178,19 +181,38 @@ impl UnitJournal {
         self.dir.join(format!("{key}.toml"))
     }
 
-    /// The outcome journaled under `key`, if a whole, readable one is there.
-    fn read<O: DeserializeOwned>(path: &Path, key: &str) -> Option<O> {
-        let text = crate::files::read_regular_text(path).ok()?;
-        let j: Journaled<O> = toml::from_str(&text).ok()?;
-        (j.key == key).then_some(j.outcome)
+    /// The outcome journaled under `key`: none if no file is there, and a refusal if one is
+    /// there but is not the file this run wrote (its first line, `# fnv1a HASH`, hashes the rest
+    /// as written: an edited, cut or foreign file would otherwise be taken as measured).
+    fn read<O: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Option<O>> {
+        if std::fs::symlink_metadata(path).is_err() {
+            return Ok(None);
+        }
+        let damaged = |why: &str| {
+            BadInput(format!(
+                "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
+                path.display()
+            ))
+        };
+        let text = crate::files::read_regular_text(path).map_err(|e| damaged(&format!("cannot be read ({e:#})")))?;
+        let (check, body) = text.split_once('\n').unwrap_or((&text, ""));
+        if check.strip_prefix(CHECK) != Some(&format!("{:016x}", fnv1a(body.as_bytes()))) {
+            return Err(damaged("has changed since it was written (its checksum does not match)").into());
+        }
+        let j: Journaled<O> = toml::from_str(body).map_err(|e| damaged(&format!("does not parse ({e})")))?;
+        if j.key != key {
+            return Err(damaged(&format!("holds unit {} under another unit's name", j.key)).into());
+        }
+        Ok(Some(j.outcome))
     }
 
     fn write<O: Serialize>(&self, key: &str, label: &str, outcome: O) -> anyhow::Result<()> {
-        let text = toml::to_string(&Journaled {
+        let body = toml::to_string(&Journaled {
             key: key.into(),
             label: label.into(),
             outcome,
         })?;
+        let text = format!("{CHECK}{:016x}\n{body}", fnv1a(body.as_bytes()));
         crate::files::write_atomic(&self.path(key), text.as_bytes())?;
         die_after_journaled();
         Ok(())
@@ -230,7 +252,7 @@ fn measure_all<D: Declaration>(
     for unit in units {
         let key = unit_key(context, unit);
         let path = journal.path(&key);
-        let outcome = match UnitJournal::read::<D::Outcome>(&path, &key) {
+        let outcome = match UnitJournal::read::<D::Outcome>(&path, &key)? {
             Some(o) => {
                 resumed += 1;
                 o
@@ -239,7 +261,7 @@ fn measure_all<D: Declaration>(
                 bar.message(unit.label.clone());
                 let measured = spec.measure(unit, backend, progress)?;
                 journal.write(&key, &unit.label, measured)?;
-                UnitJournal::read(&path, &key)
+                UnitJournal::read(&path, &key)?
                     .ok_or_else(|| anyhow::anyhow!("{}: a journaled unit does not read back", path.display()))?
             }
         };
@@ -378,7 +400,7 @@ impl<D: Declaration> Declared<D> {
                     let bytes = crate::files::read_regular(&path).ok();
                     let outcome = bytes
                         .filter(|b| format!("{:016x}", fnv1a(b)) == *want)
-                        .and_then(|_| UnitJournal::read::<D::Outcome>(&path, &key));
+                        .and_then(|_| UnitJournal::read::<D::Outcome>(&path, &key).ok().flatten());
                     match outcome {
                         Some(o) => outcomes.push(o),
                         None => {
