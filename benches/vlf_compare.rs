@@ -64,7 +64,7 @@ use penumbra::accel::work;
 use penumbra::accel::{Accelerator, Bvh, Preset, Query};
 use penumbra::experiment::timing::median_interval;
 use penumbra::mesh::Triangles;
-use penumbra::sampling::rng::pcg;
+use penumbra::sampling::rng::Seeded as Rng;
 use rayon::prelude::*;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -162,33 +162,12 @@ fn build(name: &'static str) -> Mesh {
     }
 }
 
-struct Rng(u32);
-impl Rng {
-    fn f(&mut self) -> f64 {
-        self.0 = pcg(self.0);
-        self.0 as f64 / 4_294_967_296.0
-    }
-    fn unit(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(self.f(), self.f(), self.f()) * 2.0 - 1.0;
-            let l = v.length();
-            if l > 1e-3 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
-
 /// A seeded point on the mesh: (point, normal, triangle).
 fn point(t: &Triangles, r: &mut Rng) -> (DVec3, DVec3, u32) {
-    let i = ((r.f() * t.positions.len() as f64) as usize).min(t.positions.len() - 1);
+    let i = r.index(t.positions.len());
     let p = &t.positions[i];
-    let (mut a, mut b) = (r.f(), r.f());
-    if a + b > 1.0 {
-        (a, b) = (1.0 - a, 1.0 - b);
-    }
     let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    (p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b, n, i as u32)
+    (r.point_on(p), n, i as u32)
 }
 
 /// A receiver of the AO experiment's frame: lifted origin, normal facing the camera, triangle.

@@ -172,12 +172,6 @@ pub trait Accelerator: Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// The ways it can follow triangles that moved, its own first (a field's update in place,
-    /// paper Section 8; a BVH's refit; a rebuild): what [`Accelerator::update`] takes.
-    fn updates(&self) -> &'static [UpdateMethod] {
-        &[UpdateMethod::Rebuild]
-    }
-
     /// Brings it up to date after the triangles of `object` moved by `step` (the scene's
     /// triangles are now `moved`, same count and order), by `method`, one of
     /// [`Accelerator::updates`]; says what it did.
@@ -242,7 +236,11 @@ impl Updated {
 
 /// Refuses an update method a structure does not offer.
 pub(crate) fn unknown_update(structure: &dyn Accelerator, method: UpdateMethod) -> anyhow::Error {
-    let offered: Vec<&str> = structure.updates().iter().map(|m| m.name()).collect();
+    let offered: Vec<&str> = registered(structure.name())
+        .map_or(&[][..], |r| r.updates)
+        .iter()
+        .map(|m| m.name())
+        .collect();
     anyhow::anyhow!(
         "{} cannot update by `{}`; it offers {}",
         structure.name(),
@@ -303,6 +301,10 @@ pub struct Registered {
     /// The ball (centre, radius) a structure built over these triangles can follow moved
     /// triangles within, where it has one (the field's directions are fixed to its ball).
     pub follows_within: Option<Region>,
+    /// The ways it can follow triangles that moved, its own first (a field's update in place,
+    /// paper Section 8; a BVH's refit; a rebuild): what [`Accelerator::update`] takes, and how
+    /// many copies of it a moving scene times.
+    pub updates: &'static [UpdateMethod],
 }
 
 /// The ball (centre, radius) a structure built over some triangles can follow them within.
@@ -321,6 +323,10 @@ pub const REGISTRY: &[Registered] = &[
         // Two 32-byte nodes and an index per triangle, f32 and f64 copies of the triangles.
         memory: |n, _| n as u64 * (64 + 4 + 48 + 72),
         follows_within: None,
+        // A refit keeps the tree's topology (cheap; the tree decays as things move); a rebuild
+        // with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
+        // frame (the fastest tree to build, slower to walk).
+        updates: &[UpdateMethod::Refit, UpdateMethod::Rebuild, UpdateMethod::RebuildFastest],
     },
     Registered {
         name: "brute",
@@ -332,6 +338,7 @@ pub const REGISTRY: &[Registered] = &[
         build: |t, _| Ok(Arc::new(brute::Brute::build(t))),
         memory: |n, _| n as u64 * 72,
         follows_within: None,
+        updates: &[UpdateMethod::Rebuild],
     },
     Registered {
         name: "vlf",
@@ -343,6 +350,9 @@ pub const REGISTRY: &[Registered] = &[
         build: |t, s| Ok(Arc::new(vlf::VisibilityField::build(t, s.typed())?)),
         memory: |n, s| vlf::min_bytes(n, &s.typed()),
         follows_within: Some(vlf::ball),
+        // The object's ids removed from every tile it covered and inserted again where it now
+        // is (paper Section 8).
+        updates: &[UpdateMethod::InPlace],
     },
     Registered {
         name: "kdtree",
@@ -359,6 +369,7 @@ pub const REGISTRY: &[Registered] = &[
         // A leaf entry per triangle at least, and the f64 copy.
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
+        updates: &[UpdateMethod::Rebuild],
     },
     Registered {
         name: "kdtree-sah",
@@ -376,6 +387,7 @@ pub const REGISTRY: &[Registered] = &[
         },
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
+        updates: &[UpdateMethod::Rebuild],
     },
     Registered {
         name: "cwbvh",
@@ -393,6 +405,7 @@ pub const REGISTRY: &[Registered] = &[
         // A primitive slot per triangle at least, and the f64 copy.
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
+        updates: &[UpdateMethod::Rebuild],
     },
 ];
 

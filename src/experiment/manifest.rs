@@ -456,6 +456,7 @@ mod tests {
                 driver: "y".into(),
                 api: "cpu".into(),
                 loop_cap: None,
+                threads: None,
             },
             timing: Schedule {
                 seed: 1,
@@ -554,6 +555,7 @@ mod tests {
                 driver: "y".into(),
                 api: "cpu".into(),
                 loop_cap: None,
+                threads: None,
             },
             timing: Schedule {
                 seed: 1,

@@ -30,9 +30,10 @@ impl Default for CpuBackend {
             info: AdapterInfo {
                 backend: "cpu".into(),
                 name: "penumbra f64 reference".into(),
-                driver: format!("rayon, {} threads", rayon::current_num_threads()),
+                driver: "rayon".into(),
                 api: "cpu".into(),
                 loop_cap: None,
+                threads: Some(rayon::current_num_threads()),
             },
             dispatches: 0,
         }

@@ -149,10 +149,14 @@ pub struct AdapterInfo {
     pub name: String,
     /// Driver name and version.
     pub driver: String,
-    /// Graphics API under wgpu (Vulkan, Metal, ...), or the CPU thread count.
+    /// Graphics API under wgpu (Vulkan, Metal, ...), or `cpu`.
     pub api: String,
     /// Iterations after which the adapter leaves a loop, where it caps them (Mesa's llvmpipe).
     pub loop_cap: Option<u32>,
+    /// Worker threads of the CPU backend: they change its times, never its values, so they are
+    /// recorded but kept out of the keys that say which device made a result.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<usize>,
 }
 
 /// A renderer of scenes into frames.

@@ -84,16 +84,19 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     let rc = |name: &str| rh.iter().position(|h| h == name).unwrap();
     let rounds: Vec<csv::StringRecord> = rounds.records().map(Result::unwrap).collect();
     for r in &rows {
-        let times: Vec<f64> = rounds
+        let mine: Vec<&csv::StringRecord> = rounds
             .iter()
             .filter(|x| {
                 x[rc("mesh")] == r[col("mesh")]
                     && x[rc("structure")] == r[col("structure")]
                     && x[rc("issue")] == r[col("issue")]
             })
-            .map(|x| x[rc("frame_s")].parse().unwrap())
             .collect();
+        let times: Vec<f64> = mine.iter().map(|x| x[rc("frame_s")].parse().unwrap()).collect();
         assert_eq!(times.len().to_string(), r[col("timed_frames")], "{r:?}");
+        // One frame per round, rounds numbered from 0 in the order they ran.
+        let numbers: Vec<usize> = mine.iter().map(|x| x[rc("round")].parse().unwrap()).collect();
+        assert_eq!(numbers, (0..times.len()).collect::<Vec<_>>(), "{r:?}");
         let e = penumbra::experiment::timing::median_interval(&times);
         for (name, v) in [("frame_s", e.median), ("frame_s_lo", e.lo), ("frame_s_hi", e.hi)] {
             let committed: f64 = r[col(name)].parse().unwrap();

@@ -50,6 +50,10 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
     let tc = |n: &str| th.iter().position(|h| h == n).unwrap();
     assert_eq!(trows.len(), 4, "two candidates each for kdtree and vlf: {trows:?}");
     let builds = std::fs::read_to_string(out.join("builds.csv")).unwrap();
+    let kept_line = report
+        .lines()
+        .find_map(|l| l.split_once("Kept: ").map(|(_, k)| k.to_string()))
+        .unwrap_or_else(|| panic!("no Kept line: {report}"));
     for structure in ["kdtree", "vlf"] {
         let chosen: Vec<&csv::StringRecord> = trows
             .iter()
@@ -64,10 +68,29 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
             builds.contains(&depth),
             "{structure}: the kept candidate is the one built ({depth}): {builds}"
         );
+        // The report names the kept candidate, not merely the structure: its depth and no other.
+        let (key, other) = match structure {
+            "kdtree" => ("kdtree_max_depth", ["8", "20"]),
+            _ => ("vlf_depth", ["2", "3"]),
+        };
+        let kept = &chosen[0][tc(key)];
+        let name = key.trim_start_matches(structure).trim_start_matches('_');
+        let said = kept_line
+            .split("; ")
+            .find(|k| k.contains(&format!("`{structure}` ")))
+            .unwrap_or_else(|| panic!("{structure} not kept: {kept_line}"));
+        let words: Vec<&str> = said.split(' ').collect();
+        assert!(
+            words.contains(&format!("{name}={kept}").as_str()),
+            "{said} (kept {kept})"
+        );
+        for o in other.iter().filter(|o| **o != kept) {
+            assert!(!words.contains(&format!("{name}={o}").as_str()), "{said}");
+        }
     }
     assert!(
-        report.contains("Kept: scene=classroom shading=opengl viewpoint=walk frames=0..6: `kdtree` leaf_size=8"),
-        "{report}"
+        kept_line.starts_with("scene=classroom shading=opengl viewpoint=walk frames=0..6: "),
+        "{kept_line}"
     );
     assert!(report.contains("95 % interval over independent frames"), "{report}");
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();

@@ -384,6 +384,28 @@ fn cases() -> Vec<Case> {
         format!("{frames}\n[tuning]\ncameras = 0\n").replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]"),
         &["exp.toml", "tuning.cameras"],
     ));
+    v.push(case(
+        "tuning candidates on a path cut into blocks",
+        "frames-ci",
+        frames
+            .replace("[path]\nframes = 3", "[path]\nframes = 3\nblock = 1")
+            .replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]"),
+        &["exp.toml", "path.block", "`vlf` lists 2 candidates", "[accel.vlf]"],
+    ));
+    v.push(case(
+        "a moving part on a path cut into blocks",
+        "frames-ci",
+        format!("{frames}\n[motion]\npart = \"chrome-ball\"\nstep = [0.01, 0.0, 0.0]\n")
+            .replace("[path]\nframes = 3", "[path]\nframes = 3\nblock = 1"),
+        &["exp.toml", "path.block", "one unit of work"],
+    ));
+    v.push(case(
+        "a moving part seen from random cameras",
+        "frames-ci",
+        format!("{frames}\n[motion]\npart = \"chrome-ball\"\nstep = [0.01, 0.0, 0.0]\n")
+            .replace("[path]\nframes = 3", "[path]\nframes = 3\ncameras = \"random\""),
+        &["exp.toml", "path.cameras", "not independent draws"],
+    ));
     let no_field = frames
         .split("[accel.vlf]")
         .next()

@@ -28,7 +28,9 @@ fn variant(dir: &Path, experiment: &str, edit: impl Fn(String) -> String) -> Pat
         .replace("\"../assets", &format!("\"{assets}"))
         .replace("\"scenes/", &format!("\"{scenes}/"));
     let path = dir.join(Path::new(experiment).file_name().unwrap());
-    std::fs::write(&path, edit(text)).unwrap();
+    let edited = edit(text.clone());
+    assert_ne!(edited, text, "{experiment}: the edit changed nothing");
+    std::fs::write(&path, edited).unwrap();
     path
 }
 
@@ -111,6 +113,15 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
         err.contains("1 of") && err.contains("units taken from the journal"),
         "{err}"
     );
+    let from_journal = |home: &Path| {
+        let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
+            .unwrap()
+            .parse()
+            .unwrap();
+        manifest["details"]["units_from_journal"].as_integer().unwrap()
+    };
+    assert_eq!(from_journal(&killed), 1, "the manifest counts the unit resumed");
+    assert_eq!(from_journal(&full), 0);
 
     for (i, table) in tables.iter().enumerate() {
         let whole = common::without_clock(&full.join(table));
@@ -134,7 +145,7 @@ fn ao_sharded_merged_and_resumed_gives_the_whole_runs_tables() {
         t.replace("max_depth = [8, 22]", "max_depth = 22")
             .replace("depth = [2, 4]", "depth = 3")
     });
-    whole_sharded_and_resumed_agree(&exp, &["ao.csv", "tuning.csv"]);
+    whole_sharded_and_resumed_agree(&exp, &["ao.csv", "rounds.csv"]);
 }
 
 #[test]

@@ -438,14 +438,6 @@ impl Accelerator for Bvh {
         gpu::too_deep(self.depth)
     }
 
-    /// A refit keeps the tree's topology (cheap; the tree decays as things move); a rebuild
-    /// with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
-    /// frame (the fastest tree to build, slower to walk).
-    fn updates(&self) -> &'static [super::UpdateMethod] {
-        use super::UpdateMethod::*;
-        &[Refit, Rebuild, RebuildFastest]
-    }
-
     fn update(
         &mut self,
         method: super::UpdateMethod,

@@ -350,12 +350,6 @@ impl Accelerator for VisibilityField {
         gpu::structure(self, frame)
     }
 
-    /// Its own update (paper Section 8): the object's ids removed from every tile it covered
-    /// and inserted again where it now is.
-    fn updates(&self) -> &'static [crate::accel::UpdateMethod] {
-        &[crate::accel::UpdateMethod::InPlace]
-    }
-
     /// The field moves its own copy of the object; the scene's moved triangles must be that
     /// copy, bit for bit, or the field would answer for triangles the scene no longer has.
     fn update(

@@ -217,26 +217,30 @@ pub fn write_ao(
     outputs: &Outputs,
 ) -> anyhow::Result<()> {
     let out = |name: &str| outputs.path(name);
-    write_rows(
-        &out("tuning.csv")?,
-        tuning.iter().map(|t| -> TuningCsv {
-            (
-                Tuned {
-                    mesh: &t.mesh,
-                    structure: t.structure,
-                },
-                ParameterColumns::of(&t.settings),
-                Candidate {
-                    frame_s: t.frame.median,
-                    frame_s_lo: t.frame.lo,
-                    frame_s_hi: t.frame.hi,
-                    nodes_visited: t.work.nodes,
-                    primitive_tests: t.work.primitives,
-                    chosen: t.chosen,
-                },
-            )
-        }),
-    )?;
+    // Written where a structure had candidates to choose among, as the frames kind does: a file
+    // with no rows would have no header either (its parameter columns come from the rows).
+    if !tuning.is_empty() {
+        write_rows(
+            &out("tuning.csv")?,
+            tuning.iter().map(|t| -> TuningCsv {
+                (
+                    Tuned {
+                        mesh: &t.mesh,
+                        structure: t.structure,
+                    },
+                    ParameterColumns::of(&t.settings),
+                    Candidate {
+                        frame_s: t.frame.median,
+                        frame_s_lo: t.frame.lo,
+                        frame_s_hi: t.frame.hi,
+                        nodes_visited: t.work.nodes,
+                        primitive_tests: t.work.primitives,
+                        chosen: t.chosen,
+                    },
+                )
+            }),
+        )?;
+    }
     let csv = rows.iter().map(|r| -> CsvRow {
         (
             Named {
@@ -454,7 +458,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `rounds.csv` (every timed frame, in round order: the per-round ratios recompute from it), `tuning.csv` (every candidate of the tuning sweep), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `rounds.csv` (every timed frame, in round order: the per-round ratios recompute from it), `tuning.csv` (every candidate of the tuning sweep, where a structure had more than one), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
     md
 }
 

@@ -91,11 +91,21 @@ impl Declaration for FramesSpec {
                 let n = self.triangles_of(b.scene).map_or(1.0, |n| n as f64);
                 let repeats = self.header.schedule.repeats.max(1) as f64;
                 let structures = self.structures.len() as f64;
+                // Tuning (only ever in a scene's one unit: blocks refuse candidates): each
+                // candidate built, rendered once for its work and once per round.
+                let tuning_renders =
+                    (1 + self.tuning.repeats) as f64 * self.tuning.cameras as f64 * self.viewpoints.len() as f64;
+                let candidates: f64 = self
+                    .candidates
+                    .iter()
+                    .filter(|c| c.len() > 1)
+                    .map(|c| c.len() as f64 * (tuning_renders * pixels + n))
+                    .sum();
                 Unit {
                     at: b.at(),
                     cost: Cost {
                         // Renders (rays times a logarithmic walk) and builds (n log n).
-                        work: structures * (frames * repeats * pixels + n) * n.ln().max(1.0),
+                        work: (structures * (frames * repeats * pixels + n) + candidates) * n.ln().max(1.0),
                         setup: None,
                         tie: label.clone(),
                     },

@@ -190,7 +190,7 @@ fn variants(
             });
             continue;
         }
-        let methods = accel.updates();
+        let methods = crate::accel::registered(settings.name).expect("registered").updates;
         for (k, &method) in methods.iter().enumerate() {
             let scene = if k + 1 == methods.len() {
                 scene.clone()
@@ -353,19 +353,28 @@ pub fn run_block(
         outcome.builds.extend(builds);
     }
     let triangles = generated.triangle_count();
-    // A moving part keeps moving through every shading and viewpoint: the structures it
-    // updates carry their state along.
+    let scene_name = &spec.scene_names()[s];
+    // A moving part moves along each path from where the scene puts it, the structures it
+    // updates built afresh: every path is the same whether or not the others run (a filter on
+    // shading or viewpoint keeps the whole run's rows).
     let mut current = generated.triangles();
     let moving = spec.motion.as_ref().map(|m| {
         let (index, _) = generated.part(&m.part).expect("validated part");
         (index as u32, m.step)
     });
+    let mut as_built = true;
     for &(name, shading) in &spec.shadings[block.shadings.clone()] {
         bar.message(format!("{} shading", name.name()));
-        for v in &mut variants {
-            v.scene.shading = shading;
-        }
         for vp in block.viewpoints.clone() {
+            if moving.is_some() && !as_built {
+                bar.message(format!("rebuilding {} structures", spec.structures.len()));
+                variants = self::variants(spec, &generated, &structures)?.0;
+                current = generated.triangles();
+            }
+            as_built = false;
+            for v in &mut variants {
+                v.scene.shading = shading;
+            }
             let viewpoint = &spec.viewpoints[vp];
             let first_camera = spec.camera(viewpoint, block.frames.start);
             let first_view = View {
@@ -400,7 +409,7 @@ pub fn run_block(
                 // Every round renders each variant once, in the round's own order; the
                 // first render of each gives the frame compared and counted.
                 let mut frames: Vec<Option<Frame>> = vec![None; variants.len()];
-                let rounds = frame_rounds(&schedule, (s, vp, frame));
+                let rounds = frame_rounds(&schedule, (scene_name, name.name(), viewpoint, frame));
                 let times = rounds.run(variants.len(), |i| -> anyhow::Result<f64> {
                     let start = Instant::now();
                     let f = backend.render(&variants[i].scene, view, SAMPLING)?;
@@ -445,15 +454,14 @@ pub fn run_block(
     Ok(outcome)
 }
 
-/// The schedule of one frame's interleaved rounds: the experiment's seed, varied by scene,
-/// viewpoint and frame so every frame's rounds visit the structures in their own orders.
+/// The schedule of one frame's interleaved rounds: the experiment's seed, varied by the
+/// frame's scene, shading, viewpoint (by name: a filtered run keeps the whole run's orders) and
+/// number, so every frame's rounds visit the structures in their own orders.
 fn frame_rounds(
     schedule: &crate::experiment::timing::Schedule,
-    (scene, viewpoint, frame): (usize, usize, u32),
+    (scene, shading, viewpoint, frame): (&str, &str, &str, u32),
 ) -> crate::experiment::timing::Schedule {
-    let key = (scene as u32) << 28 ^ (viewpoint as u32) << 20 ^ frame;
-    crate::experiment::timing::Schedule {
-        seed: crate::sampling::rng::pcg(schedule.seed ^ crate::sampling::rng::pcg(key)),
-        ..*schedule
-    }
+    let at = crate::fingerprint::fnv1a(format!("{scene}|{shading}|{viewpoint}|{frame}").as_bytes());
+    let seed = crate::sampling::rng::pcg(schedule.seed ^ crate::sampling::rng::pcg(at as u32 ^ (at >> 32) as u32));
+    crate::experiment::timing::Schedule { seed, ..*schedule }
 }

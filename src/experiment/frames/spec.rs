@@ -258,6 +258,19 @@ impl FramesSpec {
                     .into(),
             ));
         }
+        // Tuning picks by time, once per unit; blocks of one scene may run on different
+        // machines, so their picks could differ and one scene's frames would mix settings.
+        if let (Some(_), Some(listed)) = (f.path.block, candidates.iter().find(|c| c.len() > 1)) {
+            return Err(err(
+                &key_path!["path", "block"],
+                format!(
+                    "`{}` lists {} candidates to tune, and tuning picks by time once per unit: blocks of one scene                      (which may run on different machines) could pick differently; give `[accel.{}]` one value                      per key (an unblocked run's tuning.csv says which is fastest) or remove `block`",
+                    listed[0].name,
+                    listed.len(),
+                    listed[0].name
+                ),
+            ));
+        }
         if f.shadings.is_empty() {
             return Err(err(&key_path!["shadings"], "name at least one shading".into()));
         }
@@ -394,6 +407,16 @@ impl FramesSpec {
             }
         };
         if let Cameras::Random { seed } = cameras {
+            // Random cameras are judged as independent draws; a moving part's frames are not:
+            // each carries the part (and the structures that follow it) on from the last.
+            if f.motion.is_some() {
+                return Err(err(
+                    &key_path!["path", "cameras"],
+                    "a moving part carries its state from frame to frame, so a moving scene's frames are a \
+                     path, not independent draws: use cameras = \"path\""
+                        .into(),
+                ));
+            }
             if seed == tuning.seed {
                 return Err(err(
                     &key_path!["tuning", "seed"],
@@ -546,11 +569,18 @@ impl FramesSpec {
         };
         let available = crate::accel::memory::available();
         // One scene is held at a time, with its triangle list, a copy per structure and every
-        // structure built over it; before that, one structure's tuning candidates together.
+        // structure built over it (with a moving part, once per way it follows the part); before
+        // that, one structure's tuning candidates together.
+        let variants = |s: &AccelSettings| match self.motion {
+            Some(_) => crate::accel::registered(s.name).map_or(1, |r| r.updates.len()),
+            None => 1,
+        };
         for (k, &n) in counts.iter().enumerate() {
             let copies = self
                 .structures
-                .len()
+                .iter()
+                .map(variants)
+                .sum::<usize>()
                 .max(self.candidates.iter().map(Vec::len).max().unwrap_or(1));
             let scene = (2 + copies) as u64 * SCENE_BYTES_PER_TRIANGLE * n as u64;
             let each = |c: &Vec<AccelSettings>| -> Vec<u64> {
@@ -559,7 +589,7 @@ impl FramesSpec {
             let kept: u64 = self
                 .candidates
                 .iter()
-                .map(|c| each(c).into_iter().max().unwrap_or(0))
+                .map(|c| variants(&c[0]) as u64 * each(c).into_iter().max().unwrap_or(0))
                 .sum();
             let tuning = self
                 .candidates

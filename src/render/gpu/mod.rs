@@ -107,6 +107,7 @@ impl GpuBackend {
             driver: format!("{} {}", ai.driver, ai.driver_info).trim().to_string(),
             api: format!("{:?}", ai.backend),
             loop_cap,
+            threads: None,
         };
         Ok(GpuBackend {
             device,

@@ -4,33 +4,9 @@
 use glam::DVec3;
 use penumbra::accel::vlf::directions::Directions;
 use penumbra::mesh::Triangles;
-use penumbra::sampling::rng::pcg;
 
-/// A seeded stream of uniform numbers in [0, 1).
-pub struct Rng(pub u32);
-
-impl Rng {
-    pub fn f(&mut self) -> f64 {
-        self.0 = pcg(self.0);
-        let hi = pcg(self.0 ^ 0x9e37_79b9);
-        (self.0 as f64 + hi as f64 / 4_294_967_296.0) / 4_294_967_296.0
-    }
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-    pub fn index(&mut self, n: usize) -> usize {
-        ((self.f() * n as f64) as usize).min(n - 1)
-    }
-    pub fn unit(&mut self) -> DVec3 {
-        loop {
-            let v = DVec3::new(self.range(-1., 1.), self.range(-1., 1.), self.range(-1., 1.));
-            let l = v.length();
-            if l > 1e-3 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-}
+/// The seeded generator the benches draw with too.
+pub use penumbra::sampling::rng::Seeded as Rng;
 
 /// A query: origin, unit direction, tmax, skip.
 pub type Ray = (DVec3, DVec3, f64, u32);
@@ -55,11 +31,7 @@ pub fn bounds(t: &Triangles) -> (DVec3, DVec3) {
 }
 
 pub fn point_on(t: &[DVec3; 3], r: &mut Rng) -> DVec3 {
-    let (mut a, mut b) = (r.f(), r.f());
-    if a + b > 1.0 {
-        (a, b) = (1.0 - a, 1.0 - b);
-    }
-    t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b
+    r.point_on(t)
 }
 
 pub fn normal(t: &[DVec3; 3]) -> DVec3 {
