@@ -127,6 +127,16 @@ struct Layout {
     overflowed: bool,
 }
 
+/// The f32 next to finite `x`, above it (`up`) or below.
+fn adjacent(x: f32, up: bool) -> f32 {
+    if x == 0.0 {
+        let least = f32::from_bits(1);
+        return if up { least } else { -least };
+    }
+    let bits = x.to_bits();
+    f32::from_bits(if (x > 0.0) == up { bits + 1 } else { bits - 1 })
+}
+
 impl Layout {
     fn new(origin: DVec3, budget: usize) -> Layout {
         Layout {
@@ -144,6 +154,20 @@ impl Layout {
     fn stored(&self, axis: usize, s: f64) -> f64 {
         let o = self.origin[axis];
         o + (s - o) as f32 as f64
+    }
+
+    /// The greatest plane a node can store at or below `v` on `axis` (`up`: the least at or
+    /// above): a coordinate rounded outward onto the planes a split can take.
+    fn stored_toward(&self, axis: usize, v: f64, up: bool) -> f64 {
+        let o = self.origin[axis];
+        let mut x = (v - o) as f32;
+        while up && o + (x as f64) < v {
+            x = adjacent(x, true);
+        }
+        while !up && o + (x as f64) > v {
+            x = adjacent(x, false);
+        }
+        o + x as f64
     }
 
     /// Makes node `at` a leaf holding `tris`.
@@ -315,5 +339,46 @@ impl Accelerator for KdTree {
             m => return Err(crate::accel::unknown_update(self, m)),
         }
         Ok(crate::accel::Updated::Rebuilt)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A coordinate rounded outward lands on storable planes on either side of it, adjacent
+    /// ones (no storable plane strictly between), and a storable coordinate stays put.
+    #[test]
+    fn adjacent_floats_step_by_one_unit_in_the_last_place() {
+        for x in [1.0f32, -1.0, 0.1, -3.5e-20, 1e30, f32::from_bits(1)] {
+            let (up, down) = (adjacent(x, true), adjacent(x, false));
+            assert!(down < x && x < up, "{x}");
+            assert_eq!(adjacent(up, false), x);
+            assert_eq!(adjacent(down, true), x);
+        }
+        assert_eq!(adjacent(0.0, true), f32::from_bits(1));
+        assert_eq!(adjacent(-0.0, false), -f32::from_bits(1));
+    }
+
+    #[test]
+    fn coordinates_round_outward_onto_adjacent_storable_planes() {
+        let layout = Layout::new(DVec3::new(-5.0, 0.1, 1e6), 1);
+        let mut v = 0.123_456_789_f64;
+        for axis in 0..3 {
+            for k in 0..2000 {
+                v = (v * 7.77 + k as f64 * 0.0131).rem_euclid(10.0) - 5.0;
+                let (down, up) = (
+                    layout.stored_toward(axis, v, false),
+                    layout.stored_toward(axis, v, true),
+                );
+                assert!(down <= v && v <= up, "{down} {v} {up}");
+                assert_eq!(layout.stored(axis, down), down);
+                assert_eq!(layout.stored(axis, up), up);
+                let o = layout.origin[axis];
+                let (xd, xu) = ((down - o) as f32, (up - o) as f32);
+                assert!(xd == xu || adjacent(xd, true) == xu, "{axis}: {xd} {xu} not adjacent");
+                assert_eq!(xd == xu, layout.stored(axis, v) == v);
+            }
+        }
     }
 }

@@ -147,13 +147,21 @@ impl Builder<'_> {
             if hi <= lo {
                 continue;
             }
+            // Every candidate must be a plane the node can store (f32): with each triangle's
+            // extent rounded outward onto those planes, the sweep's counts at a plane are the
+            // split's own (a triangle is left of a storable plane exactly when its rounded start
+            // is), and a triangle lies in one only where it lies there exactly.
             events.clear();
             for (_, (a, b)) in tris {
-                if a[axis] == b[axis] {
-                    events.push((a[axis], PLANAR));
+                let (a, b) = (
+                    self.layout.stored_toward(axis, a[axis], false),
+                    self.layout.stored_toward(axis, b[axis], true),
+                );
+                if a == b {
+                    events.push((a, PLANAR));
                 } else {
-                    events.push((a[axis], START));
-                    events.push((b[axis], END));
+                    events.push((a, START));
+                    events.push((b, END));
                 }
             }
             events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
