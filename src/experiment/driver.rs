@@ -39,9 +39,12 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         print!("{}", experiment.dry_run(cli)?);
         return Ok(());
     }
+    // The folder's name checks the filters: a wrong one is refused here, before any folder or
+    // backend is opened, whether or not --out names the folder.
+    let folder = experiment.folder(cli)?;
     let out = match &cli.out {
         Some(out) => out.clone(),
-        None => PathBuf::from("results").join(experiment.folder(cli)?),
+        None => PathBuf::from("results").join(folder),
     };
     // The folders this run makes for its results, innermost first: a failed run removes those
     // it left empty (a journal worth resuming keeps its folder).

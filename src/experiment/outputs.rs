@@ -91,7 +91,16 @@ fn lock(dir: &Path, hold: Hold, held: &str) -> anyhow::Result<File> {
     // SAFETY: a valid open descriptor.
     let rc = unsafe { libc::flock(file.as_raw_fd(), how | libc::LOCK_NB) };
     if rc != 0 {
-        bail!("{}: {held}", dir.display());
+        let e = std::io::Error::last_os_error();
+        // Only "would block" means another run holds it; anything else (a file system that
+        // cannot lock folders) is said as it is, not taken for a run that does not exist.
+        if e.raw_os_error() == Some(libc::EWOULDBLOCK) {
+            bail!("{}: {held}", dir.display());
+        }
+        bail!(
+            "{}: cannot lock the folder for this run ({e}); results folders must be on a file system with flock",
+            dir.display()
+        );
     }
     Ok(file)
 }
@@ -177,15 +186,18 @@ impl Outputs {
     /// The shard folder `dir` under `home`, written in place: locked alone (one run per shard),
     /// with `home` held shared, so shards of one results folder run side by side (one node's
     /// cores, or nodes sharing the folder) while no run swaps the folder under them or merges
-    /// a shard still being written. Kept state is checked as in [`Outputs::begin`].
+    /// a shard still being written.
     pub fn begin_shard(home: &Path, dir: &Path) -> anyhow::Result<Outputs> {
         let replacing = "a run that replaces this results folder (a whole run or a merge) holds it; wait for it, then run the shard";
         let home_lock = lock(home, Hold::Shared, replacing)?;
-        for kept in KEPT {
-            check_kept(&home.join(kept))?;
+        // The shared folders as folders, and only this shard's own tree: the other shards
+        // write files into theirs and into the cache (read through checks of their own) while
+        // it runs.
+        for kept in ["cache", "shards"] {
+            check_plain_folder(&home.join(kept))?;
         }
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        check_plain_folder(dir)?;
+        check_kept(dir)?;
         let dir_lock = lock(dir, Hold::Alone, "another run is writing this shard; wait for it")?;
         Ok(Outputs {
             home: home.to_path_buf(),

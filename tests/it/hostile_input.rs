@@ -839,6 +839,10 @@ fn every_hostile_input_is_refused_with_its_place_and_nothing_written() {
         if stderr.contains("panicked") {
             wrong.push("panicked".into());
         }
+        // A message broken over source lines without its continuation keeps the indentation.
+        if stderr.lines().any(|l| l.trim().contains("     ")) {
+            wrong.push("a run of spaces in the message".into());
+        }
         for n in &c.names {
             if !stderr.contains(n) {
                 wrong.push(format!("does not name `{n}`"));
@@ -1117,4 +1121,30 @@ fn an_address_space_limit_refuses_a_build_past_it() {
         "{stderr}"
     );
     assert_eq!(snapshot(&s.root), before, "wrote something");
+}
+
+/// A sweep's journal edited after it was written (a value changed, or rows cut off) is refused
+/// on resume with exit 2, naming the table and `--fresh`, and nothing of the earlier results is
+/// replaced; `--fresh` measures again.
+#[test]
+fn an_edited_sweep_journal_is_refused_not_resumed() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    let home = s.work.join("results/tiny");
+    let runs = home.join(".journal/runs.csv");
+    let good = std::fs::read_to_string(&runs).unwrap();
+    let digit = good.rfind(|c: char| c.is_ascii_digit() && c != '7').unwrap();
+    let mut edited = good.clone();
+    edited.replace_range(digit..digit + 1, "7");
+    for bad in [edited, good[..good.len() / 2].to_string()] {
+        std::fs::write(&runs, &bad).unwrap();
+        let before = snapshot(&s.root);
+        let (code, stderr) = s.run(&["exp.toml"]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains("runs.csv") && stderr.contains("--fresh"), "{stderr}");
+        assert_eq!(snapshot(&s.root), before, "a refused resume changed something");
+    }
+    let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
+    assert_eq!(code, 0, "{stderr}");
 }

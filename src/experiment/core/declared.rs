@@ -247,12 +247,19 @@ fn measure_all<D: Declaration>(
     backend: &mut dyn Backend,
     progress: &Progress,
 ) -> anyhow::Result<(Vec<D::Outcome>, usize, Vec<UnitFile>)> {
-    let bar = progress.bar("units", units.len() as u64);
-    let (mut outcomes, mut resumed, mut files) = (Vec::new(), 0, Vec::new());
+    // Every journaled unit is read before anything is measured: a damaged one is refused
+    // before hours of work, not after.
+    let mut journaled = Vec::with_capacity(units.len());
     for unit in units {
         let key = unit_key(context, unit);
+        journaled.push(UnitJournal::read::<D::Outcome>(&journal.path(&key), &key)?);
+    }
+    let bar = progress.bar("units", units.len() as u64);
+    let (mut outcomes, mut resumed, mut files) = (Vec::new(), 0, Vec::new());
+    for (unit, earlier) in units.iter().zip(journaled) {
+        let key = unit_key(context, unit);
         let path = journal.path(&key);
-        let outcome = match UnitJournal::read::<D::Outcome>(&path, &key)? {
+        let outcome = match earlier {
             Some(o) => {
                 resumed += 1;
                 o

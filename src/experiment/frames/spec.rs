@@ -264,7 +264,9 @@ impl FramesSpec {
             return Err(err(
                 &key_path!["path", "block"],
                 format!(
-                    "`{}` lists {} candidates to tune, and tuning picks by time once per unit: blocks of one scene                      (which may run on different machines) could pick differently; give `[accel.{}]` one value                      per key (an unblocked run's tuning.csv says which is fastest) or remove `block`",
+                    "`{}` lists {} candidates to tune, and tuning picks by time once per unit: blocks of one scene \
+                     (which may run on different machines) could pick differently; give `[accel.{}]` one value \
+                     per key (an unblocked run's tuning.csv says which is fastest) or remove `block`",
                     listed[0].name,
                     listed.len(),
                     listed[0].name

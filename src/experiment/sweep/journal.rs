@@ -11,7 +11,7 @@ use super::run::{Group, GroupStats};
 use super::timing::ConfigTiming;
 use crate::files::write_atomic;
 use crate::metrics::BiasVariance;
-use crate::output::table::{append_rows, float, read_rows};
+use crate::output::table::{append_sealed, float, read_sealed};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::fs;
@@ -142,21 +142,21 @@ impl Journal {
             fs::remove_dir_all(dir)?;
         }
         fs::create_dir_all(dir)?;
-        Ok(Journal::read(dir))
+        Journal::read(dir)
     }
 
     /// What the journal in `dir` holds, without creating it (an absent journal holds nothing).
-    pub fn read(dir: &Path) -> Journal {
-        let runs = read_rows::<Record>(&dir.join("runs.csv"))
+    pub fn read(dir: &Path) -> anyhow::Result<Journal> {
+        let runs = read_sealed::<Record>(&dir.join("runs.csv"))?
             .into_iter()
             .map(|r| (r.run_key.clone(), r))
             .collect();
-        let groups = read_rows::<GroupRow>(&dir.join("groups.csv"))
+        let groups = read_sealed::<GroupRow>(&dir.join("groups.csv"))?
             .into_iter()
             .map(|g| (g.group_key.clone(), g.split()))
             .collect();
         let mut sets: HashMap<(String, String), (usize, ConfigTiming)> = HashMap::new();
-        for f in read_rows::<FrameRow>(&dir.join("timings.csv")) {
+        for f in read_sealed::<FrameRow>(&dir.join("timings.csv"))? {
             let set = sets
                 .entry((f.key, f.settings))
                 .or_insert_with(|| (0, ConfigTiming::empty()));
@@ -179,12 +179,12 @@ impl Journal {
             .filter(|(_, (frames, t))| *frames == t.frame_seconds.len())
             .map(|(k, (_, t))| (k, t))
             .collect();
-        Journal {
+        Ok(Journal {
             dir: dir.to_path_buf(),
             runs,
             groups,
             timings,
-        }
+        })
     }
 
     /// The timed frames journaled for `key` under timing settings `settings`.
@@ -205,7 +205,7 @@ impl Journal {
                 clock: t.clock.clone(),
             })
         });
-        append_rows(&self.dir.join("timings.csv"), rows)?;
+        append_sealed(&self.dir.join("timings.csv"), rows)?;
         for (key, t) in timings {
             self.timings.insert((key.clone(), settings.to_string()), t.clone());
         }
@@ -237,8 +237,8 @@ impl Journal {
         if self.groups.contains_key(group_key) {
             return Ok(());
         }
-        append_rows(&self.dir.join("runs.csv"), records)?;
-        append_rows(&self.dir.join("groups.csv"), [GroupRow::new(group_key, &stats.split)])?;
+        append_sealed(&self.dir.join("runs.csv"), records)?;
+        append_sealed(&self.dir.join("groups.csv"), [GroupRow::new(group_key, &stats.split)])?;
         self.groups.insert(group_key.to_string(), stats.split);
         Ok(())
     }

@@ -75,7 +75,7 @@ fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<ShardFiles, S
             manifest.runs
         ));
     }
-    let journal = Journal::read(&dir.join(".journal"));
+    let journal = Journal::read(&dir.join(".journal")).map_err(|e| format!("{e:#}"))?;
     Ok(ShardFiles {
         dir: dir.to_path_buf(),
         shard,

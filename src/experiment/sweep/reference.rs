@@ -256,7 +256,7 @@ const MAGIC: &[u8; 8] = b"PNBRGT02";
 /// Cached (visibility of the measured light, object ids) of a ground-truth render.
 /// A cached ground truth: each light's visibility image, then the hit ids.
 fn load_cached(path: &Path, view: View, lights: usize) -> Option<(Vec<Vec<f32>>, Vec<u32>)> {
-    let bytes = std::fs::read(path).ok()?;
+    let bytes = crate::files::read_regular(path).ok()?;
     let n = view.pixels();
     if bytes.len() != 8 + 4 * n * (lights + 1) || &bytes[..8] != MAGIC {
         return None;
