@@ -39,22 +39,19 @@ fn identical_inputs_give_identical_runs_csv_and_resume_reproduces_it() {
     );
     assert!(std::fs::read_to_string(a.join("runs.csv")).unwrap().lines().count() == 1 + 2 * 2 * 2 * 2);
 
-    // Interrupt: keep the journal's first group and a torn half line, lose the outputs.
-    sweep_into(&exp, &c, &[]);
+    // Interrupt: killed after its first journaled group, with a torn half line an append
+    // killed before sealing would leave, and no outputs.
+    let killed = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .args([exp.as_os_str(), OsStr::new("--out"), c.as_os_str()])
+        .env("PENUMBRA_TEST_DIE_AFTER", "1")
+        .output()
+        .unwrap();
+    assert!(killed.status.code().is_none(), "not killed: {:?}", killed.status);
+    assert!(!c.join("runs.csv").exists());
     let journal = c.join(".journal/runs.csv");
     let text = std::fs::read_to_string(&journal).unwrap();
-    let lines: Vec<&str> = text.lines().collect();
-    std::fs::write(
-        &journal,
-        format!("{}\n{}\n{}\n{}", lines[0], lines[1], lines[2], &lines[3][..10]),
-    )
-    .unwrap();
-    let groups = c.join(".journal/groups.csv");
-    let g = std::fs::read_to_string(&groups).unwrap();
-    std::fs::write(&groups, g.lines().take(2).collect::<Vec<_>>().join("\n") + "\n").unwrap();
-    for f in ["runs.csv", "summary.csv", "report.md"] {
-        std::fs::remove_file(c.join(f)).unwrap();
-    }
+    let torn = &text.lines().nth(1).unwrap()[..10];
+    std::fs::write(&journal, format!("{text}{torn}")).unwrap();
     let log = sweep_into(&exp, &c, &[]);
     assert!(log.contains("1 groups resumed"), "{log}");
     assert_eq!(
