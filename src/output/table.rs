@@ -98,15 +98,14 @@ pub fn append_sealed<T: Serialize>(path: &Path, rows: impl IntoIterator<Item = T
 
 /// The rows of a table [`append_sealed`] wrote, as [`read_rows`] reads them, from the bytes its
 /// seal covers (an append killed before sealing is not read); refused where those bytes are not
-/// the ones sealed (an edited or cut journal is never taken as measured), or where a table has
-/// no seal.
+/// the ones sealed (an edited or cut journal is never taken as measured). A table without a
+/// seal holds nothing sealed: none of its rows are read.
 pub fn read_sealed<T: Serialize + DeserializeOwned>(path: &Path) -> anyhow::Result<Vec<T>> {
     let exists = std::fs::symlink_metadata(path).is_ok();
+    // No seal: nothing was sealed (a run killed during its first append), so nothing is read,
+    // and the next append starts the table again.
     let Some((len, hash)) = read_seal(path)? else {
-        return match exists {
-            true => Err(tampered(path, "has no seal (`.seal` beside it)")),
-            false => Ok(vec![]),
-        };
+        return Ok(vec![]);
     };
     let bytes = if exists {
         crate::files::read_regular(path)?
@@ -317,7 +316,16 @@ mod tests {
         let keys: Vec<String> = read_sealed::<Head>(&path).unwrap().into_iter().map(|h| h.key).collect();
         assert_eq!(keys, ["a", "b", "d"]);
         fs::remove_file(dir.path().join("j.csv.seal")).unwrap();
-        assert!(format!("{:#}", read_sealed::<Head>(&path).unwrap_err()).contains("no seal"));
+        assert!(
+            read_sealed::<Head>(&path).unwrap().is_empty(),
+            "nothing sealed, nothing read"
+        );
+        append_sealed(&path, [row("e", 5.0)]).unwrap();
+        assert_eq!(
+            fs::read_to_string(&path).unwrap(),
+            "key,x\ne,5\n",
+            "the unsealed table starts again"
+        );
     }
 
     #[test]

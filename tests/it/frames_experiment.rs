@@ -315,7 +315,7 @@ fn bad_input_is_located_and_writes_nothing() {
         (
             text.replace(
                 "frames = 3",
-                "frames = 3\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, 0.0, 1.0]",
+                "frames = 3\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, 0.0, 3.0]",
             ),
             "motion.step",
         ),

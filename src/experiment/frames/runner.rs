@@ -223,8 +223,8 @@ pub fn strip_frames(count: u32, frames: u32) -> Vec<u32> {
 /// A unit of a frame-time experiment: frames `frames` of the viewpoints and shadings in their
 /// ranges (indices into the spec's lists), on scene `scene`. With `[path] block` a static
 /// scene's block is one shading and viewpoint and that many frames; without it (and always
-/// for a moving part, which carries its state through every frame, shading and viewpoint) a
-/// scene is one block.
+/// for a moving part, which carries its state from frame to frame along each path) a scene is
+/// one block.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Block {
     /// Scene index.
@@ -368,6 +368,8 @@ pub fn run_block(
         for vp in block.viewpoints.clone() {
             if moving.is_some() && !as_built {
                 bar.message(format!("rebuilding {} structures", spec.structures.len()));
+                // The old set goes first: two sets at once would pass the memory check's peak.
+                variants.clear();
                 variants = self::variants(spec, &generated, &structures)?.0;
                 current = generated.triangles();
             }

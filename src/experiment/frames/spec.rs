@@ -189,7 +189,8 @@ pub struct FramesSpec {
     /// Frames per unit of work (`[path] block`): a static scene's path is cut into blocks of
     /// this many frames, each shading and viewpoint apart, so shards can share one long path;
     /// every structure of a block is timed in the same interleaved rounds. Without it a scene is
-    /// one unit (its structures built once for every shading and viewpoint).
+    /// one unit (its structures built once for every shading and viewpoint; a moving scene's
+    /// once per path).
     pub block: Option<u32>,
     /// Frames per viewpoint.
     pub frames: u32,
@@ -516,7 +517,7 @@ impl FramesSpec {
             return Err(source.error(
                 &key_path!["motion", "step"],
                 format!(
-                    "over {} frames (every shading and viewpoint) `{}` would travel {:?} m, beyond the +-{MAX_EXTENT:e} m any coordinate may reach: shorten the step",
+                    "over {} frames `{}` would travel {:?} m, beyond the +-{MAX_EXTENT:e} m any coordinate may reach: shorten the step",
                     self.moving_frames(),
                     m.part,
                     travel.to_array()
@@ -548,7 +549,7 @@ impl FramesSpec {
                     return Err(source.error(
                         &key_path!["motion", "step"],
                         format!(
-                            "over {} frames (every shading and viewpoint) `{}` travels {:?} m and leaves the ball `{name}` is built in ({:.3} m from its centre, radius {:.3} m), where it cannot follow: shorten the step",
+                            "over {} frames `{}` travels {:?} m and leaves the ball `{name}` is built in ({:.3} m from its centre, radius {:.3} m), where it cannot follow: shorten the step",
                             self.moving_frames(),
                             m.part,
                             travel.to_array(),
@@ -673,8 +674,9 @@ impl FramesSpec {
         camera
     }
 
-    /// Frames the moving part moves through: it moves on through every shading and viewpoint.
+    /// Frames the moving part moves through: one path's (each shading and viewpoint starts it
+    /// again from where the scene puts it).
     pub fn moving_frames(&self) -> u32 {
-        self.frames * self.shadings.len() as u32 * self.viewpoints.len() as u32
+        self.frames
     }
 }
