@@ -10,7 +10,8 @@
 //! ```
 //!
 //! against `K_I * N` for a leaf. The candidate planes are the faces of each triangle clipped to
-//! `V` ("perfect splits": a triangle's part outside the node does not count). One sweep per
+//! `V` ("perfect splits": a triangle's part outside the node does not count), rounded outward
+//! onto the f32 planes a node stores, so that the sweep counts what the split will do. One sweep per
 //! axis over the sorted start, end and planar events (their incremental sweep) gives
 //! `N_L`, `N_R` and the triangles lying in the plane (`N_P`), which go to whichever side is
 //! cheaper. A node becomes a leaf where no plane costs less than the leaf (their
@@ -119,8 +120,9 @@ impl Builder<'_> {
                 }
             }
         }
-        // The plane as stored (rounded to f32) may move triangles across it: the split is kept
-        // only if it still costs less than a leaf, as every kept split does.
+        // The sweep's counts are the split's own (its planes are storable), but the children's
+        // counts are taken after clipping: the split is kept only if it costs less than a leaf
+        // with them, as every kept split does.
         let whole = area(bounds);
         let (pl, pr) = (area(lo_box) / whole, area(hi_box) / whole);
         if self.cost(pl, pr, left.len(), right.len()) >= self.leaf_cost(n) {
