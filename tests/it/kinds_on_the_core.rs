@@ -212,19 +212,16 @@ fn filters_keep_the_units_and_values_named_and_refuse_what_a_kind_lacks() {
 fn a_filter_keeps_its_value_after_another_axis_thins_the_list() {
     let dir = tempfile::tempdir().unwrap();
     let exp = variant(dir.path(), "experiments/fps-ci.toml", |t| {
-        let edited = t
-            .replacen(
-                "lights = [1, 2]\npaper_fps = [15.95, 9.39]",
-                "lights = [1]\npaper_fps = [15.95]",
-                1,
-            )
-            .replacen(
-                "lights = [1, 2]\npaper_fps = [8.36, 6.13]",
-                "lights = [2]\npaper_fps = [6.13]",
-                1,
-            );
-        assert_ne!(edited, t, "the edit applies");
-        edited
+        t.replacen(
+            "lights = [1, 2]\npaper_fps = [15.95, 9.39]",
+            "lights = [1]\npaper_fps = [15.95]",
+            1,
+        )
+        .replacen(
+            "lights = [1, 2]\npaper_fps = [8.36, 6.13]",
+            "lights = [2]\npaper_fps = [6.13]",
+            1,
+        )
     });
     // It panicked (exit 101) indexing the thinned list.
     run_ok(&[

@@ -252,12 +252,12 @@ fn measure_all<D: Declaration>(
     let mut journaled = Vec::with_capacity(units.len());
     for unit in units {
         let key = unit_key(context, unit);
-        journaled.push(UnitJournal::read::<D::Outcome>(&journal.path(&key), &key)?);
+        let earlier = UnitJournal::read::<D::Outcome>(&journal.path(&key), &key)?;
+        journaled.push((key, earlier));
     }
     let bar = progress.bar("units", units.len() as u64);
     let (mut outcomes, mut resumed, mut files) = (Vec::new(), 0, Vec::new());
-    for (unit, earlier) in units.iter().zip(journaled) {
-        let key = unit_key(context, unit);
+    for (unit, (key, earlier)) in units.iter().zip(journaled) {
         let path = journal.path(&key);
         let outcome = match earlier {
             Some(o) => {
