@@ -446,12 +446,12 @@ fn frames_all_slower(spec: &penumbra::experiment::frames::FramesSpec) {
     );
 }
 
-/// The redesigned scaling and walkthrough files load, draw their cameras at random and tune
+/// The scaling and walkthrough files load, draw their cameras at random and tune
 /// both kd-trees, and their cameras can all look where they are told (checked on load).
 #[test]
 fn the_random_camera_designs_load_and_tune_both_kd_trees() {
     use penumbra::experiment::frames::spec::Cameras;
-    for name in ["scaling-random", "walkthrough-random"] {
+    for name in ["scaling", "walkthrough"] {
         let spec = penumbra::experiment::frames::FramesSpec::load(&common::repo(&format!("experiments/{name}.toml")))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(spec.cameras, Cameras::Random { seed: 1 }, "{name}");

@@ -8,7 +8,7 @@
 //! not to the scene). Objects must stay inside the build's ball: anything else needs a full
 //! rebuild, and is refused.
 
-use super::layer::{entry_id, kill, to_tile, Layer};
+use super::layer::{entry_id, for_each_id, kill, to_tile, Layer};
 use super::raster::for_each_tile;
 use super::{VisibilityField, EPS};
 use glam::DVec3;
@@ -33,7 +33,7 @@ impl VisibilityField {
         let e = EPS * self.frame.half_tiles;
         let dirs = self.frame.directions.len();
         let offsets = &self.base.offsets;
-        let (wide, step) = (self.base.wide, self.base.entry_words());
+        let wide = self.base.wide;
         // Disjoint per-direction slices of `words`.
         let mut slices = Vec::with_capacity(dirs);
         let mut rest: &mut [u32] = &mut self.base.words;
@@ -55,11 +55,11 @@ impl VisibilityField {
                     let (start, end, split) = offsets.block(k * n2 + (ty * n + tx) as usize);
                     // A split tile's header (split values and leaf bounds) holds no triangles.
                     let s = start - base + if split { header } else { 0 };
-                    for w in words[s..end - base].iter_mut().step_by(step) {
+                    for_each_id(&mut words[s..end - base], wide, |w| {
                         if entry_id(*w, wide) == t {
                             kill(w, wide);
                         }
-                    }
+                    });
                 });
             }
         });

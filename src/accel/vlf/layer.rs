@@ -15,8 +15,9 @@
 //!   entries, so one tile's lookup touches one region of memory.
 //! - An entry is the triangle index and its footprint box within the tile on a 16 x 16
 //!   sub-grid ([`super::raster::sub_box`]): one word `id | box << 16` when every index of the
-//!   layer fits 16 bits (`id` 0xffff marks a removed triangle), else two words `id, box`
-//!   (`u32::MAX` removed). The box is not in the paper: the tiles' lateral resolution is what
+//!   layer fits 16 bits (`id` 0xffff marks a removed triangle); otherwise entries go in pairs
+//!   of three words `id0, id1, box0 | box1 << 16` (`u32::MAX` removed; a block with an odd
+//!   count ends on a removed entry), six bytes each ([`id_word`], [`box_word`]). The box is not in the paper: the tiles' lateral resolution is what
 //!   bounds the candidates (the beam through a surface seen at a grazing angle holds many
 //!   triangles), and this refines it per entry for two bytes (measured on the body: 68 exact
 //!   tests per AO ray without it, 9.5 with it); beside the id it costs no second cache line.
@@ -155,7 +156,7 @@ pub struct Layer {
     pub offsets: Offsets,
     /// The blocks: split-tile headers and entries.
     pub words: Vec<u32>,
-    /// Whether entries take two words (some triangle index exceeds 16 bits).
+    /// Whether entries go in three-word pairs (some triangle index exceeds 16 bits).
     pub wide: bool,
     /// Words of split-tile headers (the rest are entries).
     pub header_words: usize,
@@ -211,10 +212,9 @@ impl Layer {
         ]
     }
 
-    /// Words per entry.
-    #[inline(always)]
-    pub fn entry_words(&self) -> usize {
-        entry_words(self.wide)
+    /// Entries the layer stores (a wide block's padding entry included).
+    pub fn entries(&self) -> usize {
+        entries_in(self.words.len() - self.header_words, self.wide)
     }
 
     /// Split tiles.
@@ -222,7 +222,7 @@ impl Layer {
         (0..self.offsets.tiles()).filter(|&k| self.offsets.block(k).2).count()
     }
 
-    /// Marks the entry at word `at` (its first word) as a removed triangle.
+    /// Marks the entry whose id is the word at `at` as a removed triangle.
     pub fn kill_at(&mut self, at: usize) {
         kill(&mut self.words[at], self.wide);
     }
@@ -293,13 +293,49 @@ pub fn dead_id(wide: bool) -> u32 {
     }
 }
 
-/// Words per entry: one (`id | box << 16`) or, when wide, two (`id`, `box`).
+/// The word holding entry `i`'s id, counted from the first word of its block's entries: the
+/// entry's own word, or in a wide layer the `i % 2`-th word of its pair.
 #[inline(always)]
-pub fn entry_words(wide: bool) -> usize {
-    1 + usize::from(wide)
+pub fn id_word(i: usize, wide: bool) -> usize {
+    if wide {
+        3 * (i >> 1) + (i & 1)
+    } else {
+        i
+    }
 }
 
-/// Appends the entry for triangle `id` with footprint `b`.
+/// The word holding entry `i`'s box and the shift that brings it to the low bits (bits above
+/// the box's 16 may remain).
+#[inline(always)]
+pub fn box_word(i: usize, wide: bool) -> (usize, u32) {
+    if wide {
+        (3 * (i >> 1) + 2, 16 * (i as u32 & 1))
+    } else {
+        (i, 16)
+    }
+}
+
+/// Entries in `words` words of entries (a wide block's padding entry included).
+#[inline(always)]
+pub fn entries_in(words: usize, wide: bool) -> usize {
+    if wide {
+        2 * (words / 3)
+    } else {
+        words
+    }
+}
+
+/// Calls `f` with every id word among `words` (a block's entries, from its first).
+pub fn for_each_id(words: &mut [u32], wide: bool, f: impl FnMut(&mut u32)) {
+    if wide {
+        words.chunks_exact_mut(3).flat_map(|pair| &mut pair[..2]).for_each(f);
+    } else {
+        words.iter_mut().for_each(f);
+    }
+}
+
+/// Appends the entry for triangle `id` with footprint `b` (a wide one as two words, `id, b`,
+/// until [`pack_pairs`] closes its block).
 #[inline]
 fn push_entry(words: &mut Vec<u32>, id: u32, b: u16, wide: bool) {
     if wide {
@@ -307,6 +343,23 @@ fn push_entry(words: &mut Vec<u32>, id: u32, b: u16, wide: bool) {
     } else {
         words.push(id | (b as u32) << 16);
     }
+}
+
+/// Rewrites the two-word entries from word `from` on in pairs of three words (see the module
+/// doc), padding an odd count with a removed entry. In place: pair `p` is read from words
+/// `4p..4p + 4` before words `3p..3p + 3` are written.
+fn pack_pairs(words: &mut Vec<u32>, from: usize) {
+    let entries = (words.len() - from) / 2;
+    if entries % 2 == 1 {
+        words.extend([u32::MAX, 0]);
+    }
+    for p in 0..entries.div_ceil(2) {
+        let r = from + 4 * p;
+        let [id0, b0, id1, b1] = [words[r], words[r + 1], words[r + 2], words[r + 3]];
+        let w = from + 3 * p;
+        words[w..w + 3].copy_from_slice(&[id0, id1, b0 | b1 << 16]);
+    }
+    words.truncate(from + 3 * entries.div_ceil(2));
 }
 
 /// Tile coordinates (x, y in tiles, z in ball units) of world point `p` for direction `k`.
@@ -359,7 +412,7 @@ fn direction_part(
     drop(pairs);
     let mut part = Part {
         tile_first: Vec::with_capacity(tiles),
-        words: Vec::with_capacity(sorted.len() * entry_words(wide)),
+        words: Vec::with_capacity(sorted.len() * (1 + usize::from(wide))),
         header_words: 0,
     };
     let header = bsp::header_len(settings.split, 1 << settings.depth);
@@ -390,6 +443,9 @@ fn direction_part(
             ) {
                 part.tile_first.push(at | SPLIT);
                 part.header_words += header;
+                if wide {
+                    pack_pairs(&mut part.words, at as usize + header);
+                }
                 continue;
             }
         }
@@ -401,13 +457,52 @@ fn direction_part(
                 sub_box(&proj[i as usize], tx, ty, e),
             );
         }
+        if wide {
+            pack_pairs(&mut part.words, at as usize);
+        }
     }
     part
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{Offsets, SPLIT};
+    use super::{box_word, entries_in, for_each_id, id_word, pack_pairs, push_entry, Offsets, SPLIT};
+
+    /// Wide entries packed in pairs read back by [`id_word`] and [`box_word`] after a header
+    /// word, six bytes each; an odd count ends on a removed entry that [`for_each_id`] visits
+    /// like any other id.
+    #[test]
+    fn wide_pairs_take_six_bytes_and_read_back() {
+        for m in [0usize, 1, 2, 5, 6] {
+            let mut words = vec![0xdead_beef];
+            let entry = |i: usize| (0x1_0000 + 7 * i as u32, 0x1234u16.wrapping_add(i as u16 * 0x0f0f));
+            for i in 0..m {
+                let (id, b) = entry(i);
+                push_entry(&mut words, id, b, true);
+            }
+            pack_pairs(&mut words, 1);
+            assert_eq!(words[0], 0xdead_beef, "m = {m}: the header is untouched");
+            let region = &words[1..];
+            assert_eq!(region.len(), 3 * m.div_ceil(2), "m = {m}");
+            assert_eq!(entries_in(region.len(), true), m + m % 2);
+            for i in 0..m {
+                let (id, b) = entry(i);
+                let (at, shift) = box_word(i, true);
+                assert_eq!(region[id_word(i, true)], id, "m = {m}, entry {i}");
+                assert_eq!((region[at] >> shift) & 0xffff, b as u32, "m = {m}, entry {i}");
+            }
+            if m % 2 == 1 {
+                assert_eq!(region[id_word(m, true)], u32::MAX, "m = {m}: padding is removed");
+            }
+            let mut ids = Vec::new();
+            for_each_id(&mut words[1..], true, |w| ids.push(*w));
+            let want: Vec<u32> = (0..m)
+                .map(|i| entry(i).0)
+                .chain((m % 2 == 1).then_some(u32::MAX))
+                .collect();
+            assert_eq!(ids, want, "m = {m}");
+        }
+    }
 
     /// Every tile's block and split flag read back from `o` as written in `flat`.
     fn same_blocks(o: &Offsets, flat: &[u32]) {

@@ -320,7 +320,7 @@ impl Accelerator for VisibilityField {
 
     fn stats(&self) -> BuildStats {
         let bytes = self.bytes();
-        let entries = (self.base.words.len() - self.base.header_words) / self.base.entry_words();
+        let entries = self.base.entries();
         let parts: Vec<String> = self
             .parts()
             .iter()

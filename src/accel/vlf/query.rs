@@ -10,7 +10,7 @@
 //! the first.
 
 use super::bsp::{self, median_leaf, uniform_leaf, uniform_plane, Split};
-use super::layer::{dead_id, entry_id, entry_words, Layer};
+use super::layer::{box_word, dead_id, entries_in, entry_id, id_word, Layer};
 use super::raster::sub_range;
 use super::{VisibilityField, EPS};
 use crate::accel::work;
@@ -67,9 +67,12 @@ pub fn exact_t(origin: DVec3, dir: DVec3, k: &[f64]) -> f64 {
 /// One leaf's entries as a walk visits them.
 #[derive(Clone, Copy, Debug)]
 pub struct Leaf<'a> {
-    /// The entries to test ([`super::layer`]: one word each, or two when `wide`).
+    /// The tile's entries from its first ([`super::layer`]: a word each, or three-word pairs
+    /// when `wide`).
     pub words: &'a [u32],
-    /// Whether entries take two words.
+    /// The entries to test, `a..b` counted from the first.
+    pub entries: (usize, usize),
+    /// Whether entries go in pairs.
     pub wide: bool,
     /// The ray's own sub-cell box over the tile, packed as the entries' boxes.
     pub ray_box: [u32; 4],
@@ -80,7 +83,7 @@ pub struct Leaf<'a> {
 impl Leaf<'_> {
     /// Entries the leaf lists for this walk.
     pub fn entries(&self) -> usize {
-        self.words.len() / entry_words(self.wide)
+        self.entries.1 - self.entries.0
     }
 
     /// Calls `f` with each triangle index whose footprint box meets the ray's (removed ones
@@ -88,11 +91,17 @@ impl Leaf<'_> {
     #[inline(always)]
     pub fn each(&self, mut f: impl FnMut(u32) -> bool) -> bool {
         // Two loops, so that each compiles without a branch on the width per entry.
+        let (a, b) = self.entries;
         if self.wide {
-            self.scan(self.words.chunks_exact(2).map(|w| (w[0], w[1])), dead_id(true), &mut f)
+            let w = self.words;
+            let pair = |i: usize| {
+                let (at, shift) = box_word(i, true);
+                (w[id_word(i, true)], w[at] >> shift)
+            };
+            self.scan((a..b).map(pair), dead_id(true), &mut f)
         } else {
             let narrow = |&w: &u32| (entry_id(w, false), w >> 16);
-            self.scan(self.words.iter().map(narrow), dead_id(false), &mut f)
+            self.scan(self.words[a..b].iter().map(narrow), dead_id(false), &mut f)
         }
     }
 
@@ -253,6 +262,7 @@ impl VisibilityField {
             return start < end
                 && leaf(Leaf {
                     words: &layer.words[start..end],
+                    entries: (0, entries_in(end - start, wide)),
                     wide,
                     ray_box,
                     exit: f64::INFINITY,
@@ -263,7 +273,7 @@ impl VisibilityField {
         let stride = kind.stride(leaves);
         let head = &layer.words[start..start + bsp::header_len(kind, leaves)];
         let bounds = &head[stride..];
-        let (h, w) = (start + head.len(), layer.entry_words());
+        let h = start + head.len();
         let (za, zb) = (ray.o.z + ray.d.z * ta, ray.o.z + ray.d.z * tb);
         let (zlo, zhi) = (za.min(zb) - EPS, za.max(zb) + EPS);
         let up = ray.d.z >= 0.0;
@@ -290,7 +300,8 @@ impl VisibilityField {
             };
             let (a, b) = bsp::LeafBounds::read(bounds, l).tested(i == 0, up);
             if leaf(Leaf {
-                words: &layer.words[h + w * a..h + w * b],
+                words: &layer.words[h..end],
+                entries: (a, b),
                 wide,
                 ray_box,
                 exit,

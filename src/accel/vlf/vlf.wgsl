@@ -138,9 +138,11 @@ fn vlf_cell(v: f32) -> u32 {
     return u32(clamp(floor(v), 0.0, f32(vlf_head[VLF_H_TILES] - 1u)));
 }
 
-// Entries a..b (words) of a leaf: one word `id | box << 16` each, or two (`id`, `box`) when
-// wide; an id of all ones (in its 16 or 32 bits) is a removed triangle.
+// Entries a..b of a leaf, counted from the tile's first entry at word h: a word `id | box << 16`
+// each, or when wide pairs of three words (`id0`, `id1`, boxes; layer.rs); an id of all ones
+// (in its 16 or 32 bits) is a removed triangle.
 struct VlfLeaf {
+    h: u32,
     a: u32,
     b: u32,
     wide: bool,
@@ -148,11 +150,10 @@ struct VlfLeaf {
 
 fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, best_in: AccelHit, any: bool) -> AccelHit {
     var best = best_in;
-    let step = select(1u, 2u, leaf.wide);
     let mask = select(0xffffu, 0xffffffffu, leaf.wide);
     var i = leaf.a;
-    for (; i < leaf.b && !(any && best.triangle != NO_HIT); i += step) {
-        let id = vlf_word(at, i) & mask;
+    for (; i < leaf.b && !(any && best.triangle != NO_HIT); i++) {
+        let id = vlf_word(at, leaf.h + select(i, 3u * (i >> 1u) + (i & 1u), leaf.wide)) & mask;
         if (id == mask || id == skip) {
             continue;
         }
@@ -213,7 +214,8 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
     let end = (vlf_tile_first[k + 1u] & ~VLF_SPLIT) - rebase;
     let wide = ((vlf_head[VLF_H_WIDE] >> layer) & 1u) == 1u;
     if ((first & VLF_SPLIT) == 0u) {
-        return vlf_leaf(at, VlfLeaf(start, end, wide), o, d, skip, best_in, any);
+        let entries = select(end - start, 2u * ((end - start) / 3u), wide);
+        return vlf_leaf(at, VlfLeaf(start, 0u, entries, wide), o, d, skip, best_in, any);
     }
     var best = best_in;
     let depth = vlf_head[VLF_H_DEPTH];
@@ -221,7 +223,6 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
     let stride = select(leaves - 1u, 2u, vlf_head[VLF_H_MEDIAN] == 0u);
     let bounds = start + stride;
     let h = bounds + 2u * leaves;
-    let step = select(1u, 2u, wide);
     let e = ray.e_z;
     let za = ray.o.z + ray.d.z * ta;
     let zb = ray.o.z + ray.d.z * tb;
@@ -244,7 +245,7 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
             a = w0 & 0xffffu;
             b = w1 & 0xffffu;
         }
-        best = vlf_leaf(at, VlfLeaf(h + step * a, h + step * b, wide), o, d, skip, best, any);
+        best = vlf_leaf(at, VlfLeaf(h, a, b, wide), o, d, skip, best, any);
         if (best.triangle != NO_HIT && l != select(l0, l1, up)) {
             // Closest hit: later leaves only hold hits beyond this leaf's exit plane.
             let exit = (vlf_leaf_exit(at, l, up, start, e) - ray.o.z) / ray.d.z;
