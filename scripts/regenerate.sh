@@ -33,7 +33,7 @@ order=(
     ao-bundles      # the same workload with SAH and ray bundles: the paper's open question
     walkthrough     # Fig. 6, the classroom walk
     dynamic         # the classroom again, with the chrome ball moving
-    scaling         # last: its 1M-triangle field peaks near 13 GiB, so a short machine fails after the rest
+    scaling         # last: its 256K-triangle field peaks near 5.4 GiB, so a short machine fails after the rest
 )
 
 allow_dirty=false
@@ -89,6 +89,13 @@ done
 commit=$(git rev-parse HEAD)
 cargo build --release --bin sweep
 sweep="${CARGO_TARGET_DIR:-target}/release/sweep"
+# A build whose provenance is stale (a target folder copied from another checkout keeps that
+# checkout's build-script output) would name the wrong commit in every manifest: stop first.
+built=$("$sweep" --version)
+if [[ $built != *"($commit, clean = true)"* ]] && ! $allow_dirty; then
+    echo "$0: $sweep reports '$built', not commit $commit with a clean tree; remove ${CARGO_TARGET_DIR:-target}/release/build/penumbra-* and run again" >&2
+    exit 1
+fi
 times="${CARGO_TARGET_DIR:-target}/regenerate-times.txt"
 
 now() { date +%s.%N; }

@@ -5,6 +5,18 @@ use super::core::shard::Shard;
 use crate::render::BackendChoice;
 use std::path::PathBuf;
 
+/// `--version`: the package version, the commit the binary was built from and whether that
+/// checkout was clean, as every manifest records them; scripts/regenerate.sh compares them
+/// with HEAD before running anything.
+const BUILD: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (",
+    env!("PENUMBRA_COMMIT"),
+    ", clean = ",
+    env!("PENUMBRA_CLEAN"),
+    ")"
+);
+
 /// Exit statuses, stated in `--help`.
 pub const AFTER_HELP: &str = "Exit status: 0 when every run rendered and the results are written; 2 for bad \
 input (the experiment or scene file, a mesh, a command-line value, an output folder that holds something \
@@ -22,7 +34,7 @@ the same kind of device with the same binary; scripts/slurm/sweep.sbatch and scr
 
 /// Runs an experiment file of any kind (sweep, fps, ao, frames) and writes its results folder.
 #[derive(clap::Parser, Debug, Clone)]
-#[command(name = "sweep", version, after_help = AFTER_HELP)]
+#[command(name = "sweep", version = BUILD, after_help = AFTER_HELP)]
 pub struct Cli {
     /// Experiment file, e.g. experiments/sphere.toml.
     pub experiment: PathBuf,

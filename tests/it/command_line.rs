@@ -101,3 +101,17 @@ fn a_filter_runs_a_subset_into_its_own_folder() {
     assert_eq!(runs.lines().count(), 1 + 8, "{runs}");
     assert!(!dir.path().join("results/tiny").exists());
 }
+
+/// `--version` names the commit and the cleanliness every manifest records (scripts/regenerate.sh
+/// compares them with HEAD before it runs anything).
+#[test]
+fn version_names_the_build_the_manifests_record() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .arg("--version")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    let want = format!("({}, clean = {})", env!("PENUMBRA_COMMIT"), env!("PENUMBRA_CLEAN"));
+    assert!(text.contains(&want), "{text} lacks {want}");
+}

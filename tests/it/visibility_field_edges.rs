@@ -85,6 +85,7 @@ fn wide_entries_and_flat_offsets_are_exact() {
             "rows this full need u32 offsets"
         );
         assert!(field.base.split_tiles() > 0);
+        assert_six_bytes_per_entry(&field);
         let rays = random_segments(&t, 300, &mut r);
         assert_eq!(mismatches(&field, &t, &rays), 0, "{split:?}: intact");
         field.remove_object(1).unwrap();
@@ -109,6 +110,31 @@ fn wide_entries_and_flat_offsets_are_exact() {
     )
     .unwrap();
     assert!(!field.base.wide && matches!(field.base.offsets, Offsets::Rows { .. }));
+}
+
+/// A wide layer's entries take six bytes each: every split tile's entry words, counted against
+/// the entries its leaf bounds list (independent of how entries are encoded), are three per
+/// pair, an odd count padded (two-word entries would take four per pair).
+fn assert_six_bytes_per_entry(field: &VisibilityField) {
+    use penumbra::accel::vlf::bsp::{header_len, LeafBounds};
+    let layer = &field.base;
+    let leaves = 1usize << field.settings.depth;
+    let stride = field.settings.split.stride(leaves);
+    let header = header_len(field.settings.split, leaves);
+    let mut checked = 0;
+    for k in 0..layer.offsets.tiles() {
+        let (start, end, split) = layer.offsets.block(k);
+        if split {
+            let entries = LeafBounds::read(&layer.words[start + stride..start + header], leaves - 1).end;
+            assert_eq!(
+                end - start - header,
+                3 * entries.div_ceil(2),
+                "tile {k}: {entries} entries"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 0, "no split tile to check");
 }
 
 /// Geometry touching the ball (an octahedron's corners lie on it), seen from far away: the ray's

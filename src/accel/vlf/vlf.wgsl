@@ -34,7 +34,7 @@ const VLF_H_EPS_TILE: u32 = 11u;
 const VLF_H_EPS_Z: u32 = 12u;
 const VLF_H_CHUNK_START: u32 = 13u;
 const VLF_H_DIRS: u32 = 17u;
-// Bit 0: the base layer's entries take two words (id, box); bit 1: the overlay's.
+// Bit 0: the base layer's entries go in three-word pairs (two ids, both boxes); bit 1: the overlay's.
 const VLF_H_WIDE: u32 = 18u;
 const VLF_H_ROWS: u32 = 19u;
 
