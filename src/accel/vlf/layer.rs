@@ -17,10 +17,11 @@
 //!   sub-grid ([`super::raster::sub_box`]): one word `id | box << 16` when every index of the
 //!   layer fits 16 bits (`id` 0xffff marks a removed triangle); otherwise entries go in pairs
 //!   of three words `id0, id1, box0 | box1 << 16` (`u32::MAX` removed; a block with an odd
-//!   count ends on a removed entry), six bytes each ([`id_word`], [`box_word`]). The box is not in the paper: the tiles' lateral resolution is what
-//!   bounds the candidates (the beam through a surface seen at a grazing angle holds many
-//!   triangles), and this refines it per entry for two bytes (measured on the body: 68 exact
-//!   tests per AO ray without it, 9.5 with it); beside the id it costs no second cache line.
+//!   count ends on a removed entry), six bytes each ([`id_word`], [`box_word`]). The box is
+//!   not in the paper: the tiles' lateral resolution is what bounds the candidates (the beam
+//!   through a surface seen at a grazing angle holds many triangles), and this refines it per
+//!   entry for two bytes (measured on the body: 68 exact tests per AO ray without it, 9.5 with
+//!   it); beside the id it costs no second cache line.
 //!
 //! Against the first layout (a u32 id with the leaf range in its top bits and a u16 box in a
 //! second array, 6 bytes per entry; a u32 per tile) this takes 63-71 % of the bytes on the cow,
