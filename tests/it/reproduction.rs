@@ -78,16 +78,13 @@ fn kind_of(name: &str) -> Kind {
     }
 }
 
-/// Columns whose values depend on the clock, the device or the unit's neighbours (a filtered
-/// run's `same_image_as_first` compares with a different first structure).
+/// Columns whose values depend on the clock ([`common::from_clock`]), the device or the unit's
+/// neighbours (a filtered run's `same_image_as_first` compares with a different first
+/// structure).
 fn clock_dependent(column: &str) -> bool {
-    column.ends_with("_s")
-        || column.ends_with("_s_lo")
-        || column.ends_with("_s_hi")
-        || (column.ends_with("_per_s") && !column.starts_with("paper_"))
-        || column.starts_with("timed_")
+    common::from_clock(column)
         || [
-            "clock",
+            "timed_renders",
             "adapter",
             "driver",
             "api",

@@ -263,10 +263,14 @@ const CLOCK_COLUMNS: [&str; 8] = [
     "update_s",
 ];
 
+/// Whether column `name` holds a value that comes from the clock.
+pub fn from_clock(name: &str) -> bool {
+    CLOCK_COLUMNS.contains(&name) || name.starts_with("frame_s")
+}
+
 /// The rows of a CSV file with the clock's columns blanked: what must not differ between runs of
 /// one experiment, however its work was split, interrupted or resumed.
 pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
-    let clock = |name: &str| CLOCK_COLUMNS.contains(&name) || name.starts_with("frame_s");
     let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let header = r.headers().unwrap().clone();
     let mut rows = vec![header.iter().map(String::from).collect::<Vec<_>>()];
@@ -274,7 +278,7 @@ pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
         let rec = rec.unwrap();
         let row = rec.iter().zip(header.iter());
         rows.push(
-            row.map(|(v, h)| if clock(h) { String::new() } else { v.to_string() })
+            row.map(|(v, h)| if from_clock(h) { String::new() } else { v.to_string() })
                 .collect(),
         );
     }
