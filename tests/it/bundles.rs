@@ -2,7 +2,7 @@
 //! and its own single queries, hit for hit, on every kind of ray and on the hard cases (zero and
 //! -0.0 direction components, rays that miss the bounds, mixed octants, empty and one-ray
 //! bundles); the field's bundle walk does exactly the single walks' work, the kd-tree's packets
-//! the same triangle tests in fewer node visits; and an AO frame issued direction-major is the
+//! the same triangle tests (and at most 1 % more) in fewer node visits; and an AO frame issued direction-major is the
 //! single-ray frame to the bit.
 
 use crate::common;
@@ -37,8 +37,13 @@ fn brute_any(t: &Triangles, q: &Query) -> bool {
 
 /// Every CPU structure's bundled answers against brute force and its single answers.
 fn check_all(name: &str, t: &Triangles, qs: &[Query]) {
+    check(name, t, qs, |_| true)
+}
+
+/// [`check_all`] for the structures `only` names.
+fn check(name: &str, t: &Triangles, qs: &[Query], only: impl Fn(&str) -> bool) {
     let want: Vec<bool> = qs.par_iter().map(|q| brute_any(t, q)).collect();
-    for r in REGISTRY {
+    for r in REGISTRY.iter().filter(|r| only(r.name)) {
         let s = penumbra::accel::build(t, &AccelSettings::default_for(r))
             .unwrap()
             .unwrap();
@@ -76,11 +81,8 @@ fn bundled_answers_equal_brute_force_on_every_kind_of_ray() {
     }
 }
 
-/// A closed box with inner walls, rays along the axes with +0.0 and -0.0 components from on and
-/// off the planes, outside the bounds, with a short tmax and a skipped triangle, mixed in one
-/// bundle; and the empty and one-ray bundles.
-#[test]
-fn hard_bundles_match_brute_force() {
+/// A closed box `[-1, 1]^3` with an inner wall on x = 0 and one on y = 0, scaled by `scale`.
+fn walled_box(scale: f64) -> Triangles {
     let mut out = Vec::new();
     for axis in 0..3 {
         for side in [-1.0, 1.0] {
@@ -98,7 +100,36 @@ fn hard_bundles_match_brute_force() {
     }
     out.push([v(0., -1., -1.), v(0., 1., -1.), v(0., 1., 1.)]);
     out.push([v(-1., 0., -1.), v(1., 0., -1.), v(1., 0., 1.)]);
-    let t = tris(out);
+    tris(out.into_iter().map(|t| t.map(|p| p * scale)).collect())
+}
+
+/// Rays in `dirs` from a grid of points on and off `walled_box(scale)`'s walls and outside it,
+/// each unbounded, with a short tmax and with a skipped triangle.
+fn box_rays(scale: f64, dirs: &[DVec3]) -> Vec<Query> {
+    let grid = [-1.0, -0.5, 0.0, 0.5, 1.0, 1.5, -3.0];
+    let mut rays = Vec::new();
+    let mut r = Rng(5);
+    for &x in &grid {
+        for &y in &grid {
+            for &z in &grid {
+                for &d in dirs {
+                    let o = v(x, y, z) * scale;
+                    rays.push((o, d, f64::INFINITY, u32::MAX));
+                    rays.push((o, d, 0.5 * scale, u32::MAX));
+                    rays.push((o, d, f64::INFINITY, r.index(14) as u32));
+                }
+            }
+        }
+    }
+    queries(&rays)
+}
+
+/// A closed box with inner walls, rays along the axes with +0.0 and -0.0 components from on and
+/// off the planes, outside the bounds, with a short tmax and a skipped triangle, mixed in one
+/// bundle; and the empty and one-ray bundles.
+#[test]
+fn hard_bundles_match_brute_force() {
+    let t = walled_box(1.0);
     let mut dirs = Vec::new();
     for a in 0..3 {
         let mut d = DVec3::ZERO;
@@ -106,21 +137,7 @@ fn hard_bundles_match_brute_force() {
         dirs.extend([d, -d]);
     }
     dirs.extend([v(1., 1., 0.), v(-1., -1., -0.), v(-0., -1., 1.), v(0.3, -0.2, 0.9)].map(|d| d.normalize()));
-    let grid = [-1.0, -0.5, 0.0, 0.5, 1.0, 1.5, -3.0];
-    let mut rays = Vec::new();
-    let mut r = Rng(5);
-    for &x in &grid {
-        for &y in &grid {
-            for &z in &grid {
-                for &d in &dirs {
-                    rays.push((v(x, y, z), d, f64::INFINITY, u32::MAX));
-                    rays.push((v(x, y, z), d, 0.5, u32::MAX));
-                    rays.push((v(x, y, z), d, f64::INFINITY, r.index(14) as u32));
-                }
-            }
-        }
-    }
-    let qs = queries(&rays);
+    let qs = box_rays(1.0, &dirs);
     assert!(
         qs.iter()
             .filter(|q| q.dir.to_array().iter().any(|c| *c == 0.0 && c.is_sign_negative()))
@@ -132,9 +149,36 @@ fn hard_bundles_match_brute_force() {
     check_all("box, no ray", &t, &[]);
 }
 
+/// The kd-tree packets' f32 walk at its edges: rays tilted off a wall or an axis by components
+/// from 1e-30 (walked as parallel) to 1e-6 (f32 rounds the plane distance hard), on boxes from
+/// 1e-30 to 1e25 across (outside the f32 walk's range the packet is traced ray by ray). Every
+/// answer is brute force's and the single walk's.
+#[test]
+fn kdtree_packets_hold_at_the_edges_of_f32() {
+    let mut dirs = Vec::new();
+    for tilt in [1e-30, 1e-19, 1e-17, 1e-12, 1e-9, 1e-6] {
+        for a in 0..3 {
+            let (mut d, mut e) = (DVec3::ZERO, DVec3::ZERO);
+            d[a] = 1.0;
+            d[(a + 1) % 3] = tilt;
+            e[a] = -1.0;
+            e[(a + 2) % 3] = -tilt;
+            e[(a + 1) % 3] = tilt;
+            dirs.extend([d.normalize(), e.normalize()]);
+        }
+    }
+    for scale in [1e-30, 1e-17, 1.0, 1e17, 1e25] {
+        let qs = box_rays(scale, &dirs);
+        check(&format!("box x {scale:e}"), &walled_box(scale), &qs, |s| {
+            s.starts_with("kdtree")
+        });
+    }
+}
+
 /// The field's bundle walk reorders memory traffic only: its work equals the single walks'. The
-/// kd-tree's packets test the same triangles (each lane meets its own leaves in its own order and
-/// stops at its first hit) and fetch each node once per packet: fewer node visits on coherent AO
+/// kd-tree's packets test the single walks' triangles and, where an f32 lane's thicker plane
+/// reaches a neighbouring leaf, a few more (each lane meets its own leaves in its own order and
+/// stops at its first hit), and fetch each node once per packet: fewer node visits on coherent AO
 /// rays.
 #[test]
 fn bundles_do_the_work_the_design_says() {
@@ -166,7 +210,13 @@ fn bundles_do_the_work_the_design_says() {
     assert_eq!(single, bundled, "the field's bundle does the single walks' work");
     for name in ["kdtree", "kdtree-sah"] {
         let (single, bundled) = counted(name);
-        assert_eq!(single.primitives, bundled.primitives, "{name}: the same triangle tests");
+        // The f32 walk's thicker planes may add a neighbouring leaf, never drop one.
+        assert!(
+            bundled.primitives >= single.primitives && bundled.primitives as f64 <= 1.01 * single.primitives as f64,
+            "{name}: the single walks' triangle tests and at most 1 % more: {} against {}",
+            bundled.primitives,
+            single.primitives
+        );
         assert!(
             (bundled.nodes as f64) < 0.6 * single.nodes as f64,
             "{name}: packets of 8 parallel rays share node visits: {} against {}",

@@ -1,38 +1,47 @@
 //! Packet traversal (Wald, Slusallek, Benthin & Wagner 2001, the coherent ray tracing the
 //! visibility-field paper's CRT baseline is named after): up to [`WIDTH`] rays whose directions
-//! share a sign octant descend the tree together. At an inner node each lane takes the
-//! children its own [`walk::children`] would give it ([`split_lanes`]); the packet enters a
-//! child when any lane does, near child first (the same child for every lane: the octant fixes
-//! it). A leaf's triangles are tested against the lanes still open. Each lane therefore visits
-//! exactly the leaves of its single-ray walk, in the same order, and any-hit answers are the
-//! single queries'. A node is fetched once for the whole packet: the work counters count packet
-//! node visits and lane triangle tests.
+//! share a sign octant descend the tree together, one f32 SIMD lane each, as the CRT's SSE
+//! packets did. At an inner node every lane computes its entry into each child at once
+//! ([`Lanes::split`]); the packet enters a child when any lane does, near child first (the same
+//! child for every lane: the octant fixes it). A leaf's triangles are tested against the lanes
+//! still open, four f64 lanes at a time, with exactly the operations of
+//! [`crate::accel::intersect_edges`]: the same hits to the bit.
+//!
+//! The f32 walk is conservative: its planes are [`DELTA32`] thick where the f64 walk's are
+//! [`walk::DELTA`] thick, far more than f32 rounding moves a plane distance, so each lane's f32
+//! part of the ray contains its f64 part and the lane visits every leaf its single walk visits
+//! (and, rarely, a neighbour). Any-hit answers are therefore the single queries'. A node is
+//! fetched once for the whole packet: the work counters count packet node visits and lane
+//! triangle tests.
 
 use super::walk::{self, clip, STACK};
 use super::KdTree;
-use crate::accel::{intersect_edges, work, Query};
+use crate::accel::{work, Query};
 use glam::DVec3;
+use wide::{f32x8, f64x4, CmpGe, CmpGt, CmpLe, CmpLt, CmpNe};
 
-/// Rays per packet (the CRT's SSE packets held 4 f32 rays; 8 f64 lanes fill two AVX-512 or four
-/// AVX registers). The lanes are loops over fixed arrays, left to the compiler.
+/// Rays per packet: eight f32 lanes (one AVX register, two SSE ones).
 pub const WIDTH: usize = 8;
 
-/// Each lane's part of the ray, `(t_near, t_far)`.
-type Spans = [(f64, f64); WIDTH];
+/// Half-thickness of the f32 walk's planes and box, relative to the largest coordinate in play:
+/// 64 f32 epsilons (7.6e-6), about 30 times the rounding of a plane distance computed in f32
+/// from f32 coordinates (a few epsilons of at most twice the scale), so it covers the f64
+/// walk's 1e-9 with room to spare.
+const DELTA32: f64 = 64.0 * f32::EPSILON as f64;
+
+/// Coordinate scales the f32 walk takes (a packet outside is traced ray by ray): plane distances
+/// of twice the largest over components of [`MIN_COMPONENT`] stay inside f32 (2e18 x 1e18), and
+/// planes [`DELTA32`] of the smallest thick stay normal f32 numbers.
+const SCALES: std::ops::RangeInclusive<f64> = 1e-18..=1e18;
+
+/// Direction components below this are walked as parallel to the planes: over its part of the
+/// box (at most 4 scales long) such a ray moves less than 1e-17 of the scale along the axis.
+const MIN_COMPONENT: f64 = 1e-18;
 
 /// Bit a of the result set where `dir[a]` is negative (-0.0 counts as positive, as it does in
 /// [`walk::children`]'s near-child order).
 fn octant(dir: DVec3) -> u8 {
     (dir.x < 0.0) as u8 | ((dir.y < 0.0) as u8) << 1 | ((dir.z < 0.0) as u8) << 2
-}
-
-/// The lanes set in `mask`, lowest first.
-fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        let l = mask.trailing_zeros() as usize;
-        mask &= mask.wrapping_sub(1);
-        (l < 32).then_some(l)
-    })
 }
 
 /// Any hit for each query: grouped by octant (in issue order within one), traced in packets.
@@ -48,66 +57,177 @@ pub fn any_hits(tree: &KdTree, queries: &[Query], hits: &mut [bool]) {
     }
 }
 
-/// [`walk::children`] for every lane at once, in the packet's near-far order, computed the same
-/// way (so each lane's decision is its single walk's) but without branches, for the compiler to
-/// vectorise: each lane's part of the ray in the near and the far child and the lanes that enter
-/// each. A zero direction component enters a side when the origin lies within `delta` of it.
-fn split_lanes(
-    split: f64,
-    o: &[f64; WIDTH],
-    d: &[f64; WIDTH],
-    delta: &[f64; WIDTH],
-    span: &Spans,
-) -> (Spans, Spans, u32, u32) {
-    let (mut near, mut far) = (*span, *span);
-    let (mut near_mask, mut far_mask) = (0u32, 0u32);
-    for l in 0..WIDTH {
-        let (tn, tf) = span[l];
-        let (ta, tb) = ((split - delta[l] - o[l]) / d[l], (split + delta[l] - o[l]) / d[l]);
-        let (lo, hi) = (ta.min(tb), ta.max(tb));
-        let flat = d[l] == 0.0;
-        // Along the axis the near child is the left one (non-negative d) or the right one.
-        let (enter_near, enter_far) = if flat {
-            (o[l] <= split + delta[l], o[l] >= split - delta[l])
-        } else {
-            (tn <= hi, lo <= tf)
-        };
-        if !flat {
-            near[l].1 = tf.min(hi);
-            far[l].0 = tn.max(lo);
-        }
-        near_mask |= (enter_near as u32) << l;
-        far_mask |= (enter_far as u32) << l;
-    }
-    (near, far, near_mask, far_mask)
+/// A packet's rays lane by lane, in f32 for the walk and f64 for the triangle tests. Unused
+/// lanes hold a harmless ray along +x and are never opened.
+struct Lanes {
+    /// Origin by axis.
+    o: [f32x8; 3],
+    /// Reciprocal direction by axis (0 where the lane is flat on that axis).
+    inv: [f32x8; 3],
+    /// All-ones where the direction's component is below [`MIN_COMPONENT`]: parallel planes.
+    flat: [f32x8; 3],
+    /// Plane half-thickness ([`DELTA32`] of each lane's scale).
+    delta: f32x8,
+    /// Origins, directions and segment ends for the triangle tests, lanes 0-3 and 4-7.
+    o64: [[f64x4; 3]; 2],
+    d64: [[f64x4; 3]; 2],
+    tmax: [f64x4; 2],
+    /// The triangle each lane ignores.
+    skip: [u32; WIDTH],
 }
 
+/// Each lane's part of the ray: entry and exit distances.
+type Span = (f32x8, f32x8);
+
 /// A far child left for later: node, the lanes that enter it, their parts of the ray.
-type Deferred = (usize, u32, Spans);
+type Deferred = (usize, u32, Span);
+
+impl Lanes {
+    /// The lanes of `packet`, each clipped to the tree's box, with the mask of lanes that meet
+    /// it; None when a lane's scale or values are out of the f32 walk's range.
+    fn new(tree: &KdTree, queries: &[Query], packet: &[u32]) -> Option<(Self, Span, u32)> {
+        let (mut o, mut inv, mut flat) = ([[0f32; WIDTH]; 3], [[0f32; WIDTH]; 3], [[0f32; WIDTH]; 3]);
+        let (mut o64, mut d64) = ([[0f64; WIDTH]; 3], [[1f64; WIDTH]; 3]);
+        let (mut tmax, mut delta, mut skip) = ([0f64; WIDTH], [0f32; WIDTH], [u32::MAX; WIDTH]);
+        let (mut tn, mut tf) = ([0f32; WIDTH], [0f32; WIDTH]);
+        let mut open = 0u32;
+        for (l, &i) in packet.iter().enumerate() {
+            let q = &queries[i as usize];
+            let scale = walk::scale(tree, q.origin);
+            if !(SCALES.contains(&scale) && q.dir.is_finite()) || q.tmax.is_nan() {
+                return None;
+            }
+            let d32 = DELTA32 * scale;
+            for a in 0..3 {
+                o[a][l] = q.origin[a] as f32;
+                o64[a][l] = q.origin[a];
+                d64[a][l] = q.dir[a];
+                if q.dir[a].abs() < MIN_COMPONENT {
+                    flat[a][l] = f32::from_bits(u32::MAX);
+                } else {
+                    inv[a][l] = 1.0 / q.dir[a] as f32;
+                }
+            }
+            (tmax[l], skip[l], delta[l]) = (q.tmax, q.skip, d32 as f32);
+            // Clipped in f64 against the thicker box, then rounded outwards.
+            if let Some((t0, t1)) = clip(tree.bounds, q.origin, q.dir, q.tmax, d32) {
+                (tn[l], tf[l]) = (down(t0), up(t1));
+                open |= 1 << l;
+            }
+        }
+        let x8 = |v: [f32; WIDTH]| f32x8::new(v);
+        let x4 = |v: &[f64; WIDTH], half: usize| f64x4::new(v[4 * half..4 * half + 4].try_into().unwrap());
+        let lanes = Lanes {
+            o: o.map(x8),
+            inv: inv.map(x8),
+            flat: flat.map(x8),
+            delta: x8(delta),
+            o64: [0, 1].map(|h| [0, 1, 2].map(|a| x4(&o64[a], h))),
+            d64: [0, 1].map(|h| [0, 1, 2].map(|a| x4(&d64[a], h))),
+            tmax: [0, 1].map(|h| x4(&tmax, h)),
+            skip,
+        };
+        Some((lanes, (x8(tn), x8(tf)), open))
+    }
+
+    /// [`walk::children`] for every lane at once: each lane's exit from the near child and entry
+    /// into the far one across the plane `axis = split`, and the lanes that enter each (near and
+    /// far along the lane's own direction; a flat lane enters a side its origin lies within
+    /// `delta` of, keeping its span).
+    fn split(&self, axis: usize, split: f32, (tn, tf): Span) -> (f32x8, f32x8, u32, u32) {
+        let (o, flat) = (self.o[axis], self.flat[axis]);
+        let (below, above) = (f32x8::splat(split) - self.delta, f32x8::splat(split) + self.delta);
+        let (ta, tb) = ((below - o) * self.inv[axis], (above - o) * self.inv[axis]);
+        let (lo, hi) = (ta.fast_min(tb), ta.fast_max(tb));
+        // Along the axis the near child is the left one (non-negative d) or the right one; a
+        // flat lane's near child is the left one.
+        let enter_near = flat.blend(o.cmp_le(above), tn.cmp_le(hi));
+        let enter_far = flat.blend(o.cmp_ge(below), lo.cmp_le(tf));
+        let near_tf = flat.blend(tf, tf.fast_min(hi));
+        let far_tn = flat.blend(tn, tn.fast_max(lo));
+        (
+            near_tf,
+            far_tn,
+            enter_near.move_mask() as u32,
+            enter_far.move_mask() as u32,
+        )
+    }
+
+    /// The lanes of `mask` whose rays hit the triangle with corner `v0` and edges `e1`, `e2`
+    /// at `0 < t < tmax`: [`crate::accel::intersect_edges`] four lanes at a time, operation for
+    /// operation.
+    fn hits(&self, mask: u32, v0: DVec3, (e1, e2): (DVec3, DVec3)) -> u32 {
+        let mut hit = 0u32;
+        for half in 0..2 {
+            if (mask >> (4 * half)) & 0xf == 0 {
+                continue;
+            }
+            let ([ox, oy, oz], [dx, dy, dz]) = (self.o64[half], self.d64[half]);
+            let s = |v: f64| f64x4::splat(v);
+            // p = d x e2, det = e1 . p
+            let (px, py, pz) = (
+                dy * s(e2.z) - s(e2.y) * dz,
+                dz * s(e2.x) - s(e2.z) * dx,
+                dx * s(e2.y) - s(e2.x) * dy,
+            );
+            let det = s(e1.x) * px + s(e1.y) * py + s(e1.z) * pz;
+            let inv = s(1.0) / det;
+            let (sx, sy, sz) = (ox - s(v0.x), oy - s(v0.y), oz - s(v0.z));
+            let u = (sx * px + sy * py + sz * pz) * inv;
+            // q = s x e1
+            let (qx, qy, qz) = (
+                sy * s(e1.z) - s(e1.y) * sz,
+                sz * s(e1.x) - s(e1.z) * sx,
+                sx * s(e1.y) - s(e1.x) * sy,
+            );
+            let v = (dx * qx + dy * qy + dz * qz) * inv;
+            let t = (s(e2.x) * qx + s(e2.y) * qy + s(e2.z) * qz) * inv;
+            let inside =
+                det.cmp_ne(s(0.0)) & u.cmp_ge(s(0.0)) & u.cmp_le(s(1.0)) & !(v.cmp_lt(s(0.0)) | (u + v).cmp_gt(s(1.0)));
+            let found = inside & t.cmp_gt(s(0.0)) & t.cmp_lt(self.tmax[half]);
+            hit |= (found.move_mask() as u32) << (4 * half);
+        }
+        hit & mask
+    }
+
+    /// The lanes that ignore the triangle `index`.
+    fn skip_mask(&self, index: u32) -> u32 {
+        (0..WIDTH).filter(|&l| self.skip[l] == index).fold(0, |m, l| m | 1 << l)
+    }
+}
+
+/// The largest f32 not above finite `t`.
+fn down(t: f64) -> f32 {
+    -up(-t)
+}
+
+/// The smallest f32 not below finite `t`.
+fn up(t: f64) -> f32 {
+    let x = t as f32;
+    if (x as f64) >= t {
+        x
+    } else if x == 0.0 {
+        f32::from_bits(1)
+    } else if x > 0.0 {
+        f32::from_bits(x.to_bits() + 1)
+    } else {
+        f32::from_bits(x.to_bits() - 1)
+    }
+}
 
 /// One packet of `queries` (indices `packet`, one octant); `stack` is scratch space.
 fn trace(tree: &KdTree, queries: &[Query], packet: &[u32], hits: &mut [bool], stack: &mut Vec<Deferred>) {
-    let q = |l: usize| &queries[packet[l] as usize];
-    let negative = octant(q(0).dir);
-    let mut delta = [0.0; WIDTH];
-    let mut spans: Spans = [(0.0, 0.0); WIDTH];
-    // Origins and directions by axis, lane by lane (unused lanes: a harmless ray along +x).
-    let (mut o, mut d) = ([[0.0; WIDTH]; 3], [[1.0; WIDTH]; 3]);
-    let mut open = 0u32;
-    for l in 0..packet.len() {
-        for a in 0..3 {
-            o[a][l] = q(l).origin[a];
-            d[a][l] = q(l).dir[a];
+    let Some((lanes, span, mut open)) = Lanes::new(tree, queries, packet) else {
+        for &i in packet {
+            let q = &queries[i as usize];
+            hits[i as usize] = walk::walk(tree, &tree.triangles, q.origin, q.dir, q.tmax, q.skip, true).is_some();
         }
-        delta[l] = walk::delta(tree, q(l).origin);
-        if let Some(s) = clip(tree.bounds, q(l).origin, q(l).dir, q(l).tmax, delta[l]) {
-            spans[l] = s;
-            open |= 1 << l;
-        }
-    }
+        return;
+    };
+    let negative = octant(queries[packet[0] as usize].dir);
     let (mut nodes, mut prims) = (0u64, 0u64);
     stack.clear();
-    let mut current = (open != 0).then_some((0usize, open, spans));
+    let mut current = (open != 0).then_some((0usize, open, span));
     while open != 0 {
         let Some((mut node, mut mask, mut span)) = current.take() else {
             let Some((node, mask, span)) = stack.pop() else {
@@ -124,15 +244,15 @@ fn trace(tree: &KdTree, queries: &[Query], packet: &[u32], hits: &mut [bool], st
             } else {
                 (left, left + 1)
             };
-            let (near, far, near_mask, far_mask) = split_lanes(split, &o[axis], &d[axis], &delta, &span);
+            let (near_tf, far_tn, near_mask, far_mask) = lanes.split(axis, split as f32, span);
             let (near_mask, far_mask) = (near_mask & mask, far_mask & mask);
             match (near_mask, far_mask) {
                 (0, 0) => break,
-                (0, _) => (node, mask, span) = (far_node, far_mask, far),
-                (_, 0) => (node, mask, span) = (near_node, near_mask, near),
+                (0, _) => (node, mask, span) = (far_node, far_mask, (far_tn, span.1)),
+                (_, 0) => (node, mask, span) = (near_node, near_mask, (span.0, near_tf)),
                 _ => {
-                    stack.push((far_node, far_mask, far));
-                    (node, mask, span) = (near_node, near_mask, near);
+                    stack.push((far_node, far_mask, (far_tn, span.1)));
+                    (node, mask, span) = (near_node, near_mask, (span.0, near_tf));
                 }
             }
         }
@@ -143,18 +263,13 @@ fn trace(tree: &KdTree, queries: &[Query], packet: &[u32], hits: &mut [bool], st
         let (first, count) = tree.nodes[node].items();
         for &t in &tree.items[first..first + count] {
             let [v0, v1, v2] = tree.triangles.positions[t as usize];
-            let edges = (v1 - v0, v2 - v0);
-            for l in lanes(mask & open) {
-                let q = q(l);
-                if t == q.skip {
-                    continue;
-                }
-                prims += 1;
-                if intersect_edges(q.origin, q.dir, v0, edges).is_some_and(|x| x > 0.0 && x < q.tmax) {
-                    hits[packet[l] as usize] = true;
-                    open &= !(1 << l);
-                }
+            let testing = mask & open & !lanes.skip_mask(t);
+            prims += testing.count_ones() as u64;
+            let hit = lanes.hits(testing, v0, (v1 - v0, v2 - v0));
+            for l in (0..packet.len()).filter(|l| hit & 1 << l != 0) {
+                hits[packet[l] as usize] = true;
             }
+            open &= !hit;
             if mask & open == 0 {
                 break;
             }

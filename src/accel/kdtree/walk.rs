@@ -13,7 +13,7 @@ pub const STACK: usize = 64;
 
 /// Half-thickness of planes and box faces, relative to the largest coordinate in play: f64's
 /// rounding of a plane distance is a few 1e-16 of it.
-const DELTA: f64 = 1e-9;
+pub const DELTA: f64 = 1e-9;
 
 /// The segment `[t0, t1]` of `origin + t dir`, `0 <= t <= tmax`, inside `bounds` grown by
 /// `delta`, if any.
@@ -63,6 +63,12 @@ pub fn children(
 
 /// The plane half-thickness for rays from `origin`: [`DELTA`] of the largest coordinate in play.
 pub fn delta(tree: &KdTree, origin: DVec3) -> f64 {
+    DELTA * scale(tree, origin)
+}
+
+/// The largest coordinate in play for rays from `origin` (the tree's box and the origin), at
+/// least the smallest positive f64.
+pub fn scale(tree: &KdTree, origin: DVec3) -> f64 {
     let scale = tree
         .bounds
         .0
@@ -70,7 +76,7 @@ pub fn delta(tree: &KdTree, origin: DVec3) -> f64 {
         .max(tree.bounds.1.abs())
         .max(origin.abs())
         .max_element();
-    DELTA * scale.max(f64::MIN_POSITIVE)
+    scale.max(f64::MIN_POSITIVE)
 }
 
 /// Closest hit (or, with `any`, the first found) of triangles other than `skip` with

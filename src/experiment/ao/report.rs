@@ -504,7 +504,7 @@ pub fn open_question(spec: &AoSpec, rows: &[AoRow]) -> String {
             (s, Issue::Single),
         ));
     }
-    let mut md = "\n### The open question: SAH and ray bundles\n\nThe paper closes by asking how the field fares when a better split heuristic (SAH) and ray bundles are given to both algorithms. Each cell: the first named's frame time over the second's, median of per-round ratios with its 95 % interval, and the rule's word for the second (faster: above 1 beyond noise). Bundled: the AO rays of one grid line for 4096 receivers at a time, the field walking them in tile order, the kd-trees in packets of 8; a structure without bundles of its own (the BVHs) is timed with single rays only, its best order.\n\n| comparison |".to_string();
+    let mut md = "\n### The open question: SAH and ray bundles\n\nThe paper closes by asking how the field fares when a better split heuristic (SAH) and ray bundles are given to both algorithms. Each cell: the first named's frame time over the second's, median of per-round ratios with its 95 % interval, and the rule's word for the second (faster: above 1 beyond noise). Bundled: the AO rays of one grid line for 4096 receivers at a time, the field walking them in tile order, the kd-trees in packets of 8 (f32 SIMD lanes for the walk, f64 lanes for the triangle tests); a structure without bundles of its own (the BVHs) is timed with single rays only, its best order.\n\n| comparison |".to_string();
     for m in &spec.meshes {
         md += &format!(" {} |", m.name);
     }
