@@ -151,8 +151,8 @@ fn hard_bundles_match_brute_force() {
 
 /// The kd-tree packets' f32 walk at its edges: rays tilted off a wall or an axis by components
 /// from 1e-30 (walked as parallel) to 1e-6 (f32 rounds the plane distance hard), on boxes from
-/// 1e-30 to 1e25 across (outside the f32 walk's range the packet is traced ray by ray). Every
-/// answer is brute force's and the single walk's.
+/// 1e-30 to 1e25 across (outside the f32 walk's range the packet is traced ray by ray) and one
+/// far from the origin. Every answer is brute force's and the single walk's.
 #[test]
 fn kdtree_packets_hold_at_the_edges_of_f32() {
     let mut dirs = Vec::new();
@@ -169,10 +169,24 @@ fn kdtree_packets_hold_at_the_edges_of_f32() {
     }
     for scale in [1e-30, 1e-17, 1.0, 1e17, 1e25] {
         let qs = box_rays(scale, &dirs);
-        check(&format!("box x {scale:e}"), &walled_box(scale), &qs, |s| {
-            s.starts_with("kdtree")
-        });
+        check(&format!("box x {scale:e}"), &walled_box(scale), &qs, kd_trees);
     }
+    // Far from the origin: the packets walk from the box's corner, the single walk in absolute
+    // coordinates with planes 1e-9 of 2e6 thick.
+    let far = DVec3::new(1e6, -3e6, 2e6);
+    let moved = tris(walled_box(1.0).positions.iter().map(|t| t.map(|p| p + far)).collect());
+    let qs: Vec<Query> = box_rays(1.0, &dirs)
+        .into_iter()
+        .map(|q| Query {
+            origin: q.origin + far,
+            ..q
+        })
+        .collect();
+    check("box at (1e6, -3e6, 2e6)", &moved, &qs, kd_trees);
+}
+
+fn kd_trees(name: &str) -> bool {
+    name.starts_with("kdtree")
 }
 
 /// The field's bundle walk reorders memory traffic only: its work equals the single walks'. The

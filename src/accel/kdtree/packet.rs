@@ -7,10 +7,11 @@
 //! still open, four f64 lanes at a time, with exactly the operations of
 //! [`crate::accel::intersect_edges`]: the same hits to the bit.
 //!
-//! The f32 walk is conservative: its planes are [`DELTA32`] thick where the f64 walk's are
-//! [`walk::DELTA`] thick, far more than f32 rounding moves a plane distance, so each lane's f32
-//! part of the ray contains its f64 part and the lane visits every leaf its single walk visits
-//! (and, rarely, a neighbour). Any-hit answers are therefore the single queries'. A node is
+//! The f32 walk is conservative: it works from the box's low corner, where the tree stores its
+//! planes as f32 (exact), so a scene far from the origin walks as one at the origin, and its
+//! planes are [`DELTA32`] of the scene thicker than the f64 walk's [`walk::DELTA`], far more
+//! than f32 rounding moves a plane distance: each lane's f32 part of the ray contains its f64
+//! part and the lane visits every leaf its single walk visits (and, rarely, a neighbour). Any-hit answers are therefore the single queries'. A node is
 //! fetched once for the whole packet: the work counters count packet node visits and lane
 //! triangle tests.
 
@@ -23,10 +24,10 @@ use wide::{f32x8, f64x4, CmpGe, CmpGt, CmpLe, CmpLt, CmpNe};
 /// Rays per packet: eight f32 lanes (one AVX register, two SSE ones).
 pub const WIDTH: usize = 8;
 
-/// Half-thickness of the f32 walk's planes and box, relative to the largest coordinate in play:
-/// 64 f32 epsilons (7.6e-6), about 30 times the rounding of a plane distance computed in f32
-/// from f32 coordinates (a few epsilons of at most twice the scale), so it covers the f64
-/// walk's 1e-9 with room to spare.
+/// Half-thickness of the f32 walk's planes, relative to the largest coordinate in play measured
+/// from the tree's low corner (its extent, or the origin's offset): 64 f32 epsilons (7.6e-6),
+/// about 30 times the rounding of a plane distance computed in f32 (a few epsilons of at most
+/// twice the scale). The f64 walk's own half-thickness is added twice over on top.
 const DELTA32: f64 = 64.0 * f32::EPSILON as f64;
 
 /// Coordinate scales the f32 walk takes (a packet outside is traced ray by ray): plane distances
@@ -60,13 +61,13 @@ pub fn any_hits(tree: &KdTree, queries: &[Query], hits: &mut [bool]) {
 /// A packet's rays lane by lane, in f32 for the walk and f64 for the triangle tests. Unused
 /// lanes hold a harmless ray along +x and are never opened.
 struct Lanes {
-    /// Origin by axis.
+    /// Origin by axis, from the tree's low corner.
     o: [f32x8; 3],
     /// Reciprocal direction by axis (0 where the lane is flat on that axis).
     inv: [f32x8; 3],
     /// All-ones where the direction's component is below [`MIN_COMPONENT`]: parallel planes.
     flat: [f32x8; 3],
-    /// Plane half-thickness ([`DELTA32`] of each lane's scale).
+    /// Plane half-thickness ([`DELTA32`] of each lane's scale, and twice the f64 walk's).
     delta: f32x8,
     /// Origins, directions and segment ends for the triangle tests, lanes 0-3 and 4-7.
     o64: [[f64x4; 3]; 2],
@@ -93,13 +94,16 @@ impl Lanes {
         let mut open = 0u32;
         for (l, &i) in packet.iter().enumerate() {
             let q = &queries[i as usize];
-            let scale = walk::scale(tree, q.origin);
+            // Coordinates from the box's low corner, where the tree keeps its planes as f32.
+            let rel = q.origin - tree.bounds.0;
+            let scale = (tree.bounds.1 - tree.bounds.0).max(rel.abs()).max_element();
             if !(SCALES.contains(&scale) && q.dir.is_finite()) || q.tmax.is_nan() {
                 return None;
             }
-            let d32 = DELTA32 * scale;
+            // Thick enough to hold the f64 walk's plane (with its own rounding) and f32's.
+            let d32 = DELTA32 * scale + 2.0 * walk::delta(tree, q.origin);
             for a in 0..3 {
-                o[a][l] = q.origin[a] as f32;
+                o[a][l] = rel[a] as f32;
                 o64[a][l] = q.origin[a];
                 d64[a][l] = q.dir[a];
                 if q.dir[a].abs() < MIN_COMPONENT {
@@ -108,7 +112,7 @@ impl Lanes {
                     inv[a][l] = 1.0 / q.dir[a] as f32;
                 }
             }
-            (tmax[l], skip[l], delta[l]) = (q.tmax, q.skip, d32 as f32);
+            (tmax[l], skip[l], delta[l]) = (q.tmax, q.skip, up(d32));
             // Clipped in f64 against the thicker box, then rounded outwards.
             if let Some((t0, t1)) = clip(tree.bounds, q.origin, q.dir, q.tmax, d32) {
                 (tn[l], tf[l]) = (down(t0), up(t1));
@@ -237,7 +241,7 @@ fn trace(tree: &KdTree, queries: &[Query], packet: &[u32], hits: &mut [bool], st
             current = (mask & open != 0).then_some((node, mask & open, span));
             continue;
         };
-        while let Some((axis, split, left)) = tree.split(node) {
+        while let Some((axis, split, left)) = tree.nodes[node].inner() {
             nodes += 1;
             let (near_node, far_node) = if negative & (1 << axis) != 0 {
                 (left + 1, left)

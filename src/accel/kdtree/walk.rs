@@ -63,12 +63,6 @@ pub fn children(
 
 /// The plane half-thickness for rays from `origin`: [`DELTA`] of the largest coordinate in play.
 pub fn delta(tree: &KdTree, origin: DVec3) -> f64 {
-    DELTA * scale(tree, origin)
-}
-
-/// The largest coordinate in play for rays from `origin` (the tree's box and the origin), at
-/// least the smallest positive f64.
-pub fn scale(tree: &KdTree, origin: DVec3) -> f64 {
     let scale = tree
         .bounds
         .0
@@ -76,7 +70,7 @@ pub fn scale(tree: &KdTree, origin: DVec3) -> f64 {
         .max(tree.bounds.1.abs())
         .max(origin.abs())
         .max_element();
-    scale.max(f64::MIN_POSITIVE)
+    DELTA * scale.max(f64::MIN_POSITIVE)
 }
 
 /// Closest hit (or, with `any`, the first found) of triangles other than `skip` with
