@@ -185,6 +185,104 @@ fn kdtree_packets_hold_at_the_edges_of_f32() {
     check("box at (1e6, -3e6, 2e6)", &moved, &qs, kd_trees);
 }
 
+/// Walls that do not straddle the tree's planes, so a lane that enters the wrong child misses
+/// them: rays parallel to the planes up to a component of +-1e-20 (walked as flat) or +-1e-18 (the
+/// first not), in both directions; and small triangles far from the origin, hit from their own corners (on the
+/// split planes), where the f32 walk's planes must be thicker than the f64 walk's to hold.
+#[test]
+fn kdtree_packets_find_walls_they_cannot_enter_by_mistake() {
+    let mut out = Vec::new();
+    for k in 0..16 {
+        let z0 = k as f64;
+        out.push([v(2.0, -1.0, z0), v(2.0, 1.0, z0), v(2.0, 0.0, z0 + 0.5)]);
+        out.push([v(-2.0, -1.0, z0), v(-2.0, 1.0, z0), v(-2.0, 0.0, z0 + 0.5)]);
+    }
+    let mut rays = Vec::new();
+    for k in 0..16 {
+        for (x, tilt) in [1.0, -1.0]
+            .into_iter()
+            .flat_map(|x| [-1e-20, 1e-20, -1e-18, 1e-18].map(|t| (x, t)))
+        {
+            rays.push((v(0.0, 0.1, k as f64 + 0.25), v(x, 0.0, tilt), f64::INFINITY, u32::MAX));
+        }
+    }
+    check(
+        "stacked walls, dz = +-1e-20, +-1e-18",
+        &tris(out),
+        &queries(&rays),
+        kd_trees,
+    );
+    let far = DVec3::new(1e6, 1e6, -1e6);
+    let small = tris(
+        soup(600, 7)
+            .positions
+            .iter()
+            .map(|t| t.map(|p| p * 1e-3 + far))
+            .collect(),
+    );
+    let dirs = Directions::new(16);
+    for (kind, rays) in all_rays(&small, &dirs, 600, 8) {
+        check(&format!("small soup at 1e6 {kind}"), &small, &queries(&rays), kd_trees);
+    }
+}
+
+/// Seeded soups of large, small and axis-aligned triangles, at the origin and far from their
+/// own size from it, hit from triangle corners (on split planes) and from around them, towards
+/// other corners or anywhere, with zero, -0.0 and tiny components of either sign, tmax from 0
+/// to 1e300 and skipped triangles: every packet answer is brute force's and the single walk's.
+#[test]
+fn kdtree_packets_agree_on_corner_rays() {
+    for (seed, offset, size) in [(1, 0.0, 1.0), (2, 1e6, 1e-3), (3, 1e12, 1.0), (4, 1e-5, 1e-10)] {
+        let mut r = Rng(seed);
+        let far = v(offset, -0.7 * offset, 0.3 * offset);
+        let around = |r: &mut Rng, k: f64| v(r.range(-k, k), r.range(-k, k), r.range(-k, k));
+        let t = tris(
+            (0..400)
+                .map(|_| {
+                    let c = around(&mut r, size) + far;
+                    let s = size * [0.3, 0.03, 0.003][r.index(3)];
+                    let (mut a, mut b) = (around(&mut r, s), around(&mut r, s));
+                    if r.f() < 0.3 {
+                        let axis = r.index(3);
+                        (a[axis], b[axis]) = (0.0, 0.0);
+                    }
+                    [c, c + a, c + b]
+                })
+                .collect(),
+        );
+        let corner = |r: &mut Rng| t.positions[r.index(400)][r.index(3)];
+        let mut rays = Vec::new();
+        while rays.len() < 60_000 {
+            let o = match r.index(3) {
+                0 => corner(&mut r),
+                1 => far + around(&mut r, 1.5 * size),
+                _ => far + around(&mut r, 4.0 * size),
+            };
+            let target = corner(&mut r);
+            let mut d = if r.f() < 0.5 { target - o } else { around(&mut r, 1.0) };
+            for a in 0..3 {
+                let x = r.f();
+                if x < 0.25 {
+                    d[a] = if x < 0.15 { 0.0 } else { -0.0 };
+                } else if x < 0.4 {
+                    let tiny = [1e-30, 1e-19, 1e-18, 1e-17, 1e-12, 1e-9, 1e-6, 1e-4][r.index(8)];
+                    d[a] = if r.f() < 0.5 { tiny } else { -tiny };
+                }
+            }
+            let Some(d) = d.try_normalize() else { continue };
+            let tmax = [f64::INFINITY, 0.0, (target - o).length(), size * r.f(), 1e300][r.index(5)];
+            let skip = if r.f() < 0.2 { r.index(400) as u32 } else { u32::MAX };
+            rays.push((o, d, tmax, skip));
+        }
+        check(
+            &format!("corner rays, {size:e} at {offset:e}"),
+            &t,
+            &queries(&rays),
+            kd_trees,
+        );
+    }
+}
+
 fn kd_trees(name: &str) -> bool {
     name.starts_with("kdtree")
 }

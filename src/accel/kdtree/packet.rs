@@ -36,13 +36,21 @@ const DELTA32: f64 = 64.0 * f32::EPSILON as f64;
 const SCALES: std::ops::RangeInclusive<f64> = 1e-18..=1e18;
 
 /// Direction components below this are walked as parallel to the planes: over its part of the
-/// box (at most 4 scales long) such a ray moves less than 1e-17 of the scale along the axis.
+/// box (at most 4 scales long) such a unit ray moves less than 1e-17 of the scale along the
+/// axis. (A packet with a direction that is not unit is traced ray by ray.)
 const MIN_COMPONENT: f64 = 1e-18;
 
-/// Bit a of the result set where `dir[a]` is negative (-0.0 counts as positive, as it does in
-/// [`walk::children`]'s near-child order).
+/// Bit a of the result set where `dir[a]` is negative beyond [`MIN_COMPONENT`]: a component the
+/// walk takes as parallel to the planes (-0.0 included) counts as positive, so its near child is
+/// the left one, as [`Lanes::split`] takes it.
 fn octant(dir: DVec3) -> u8 {
-    (dir.x < 0.0) as u8 | ((dir.y < 0.0) as u8) << 1 | ((dir.z < 0.0) as u8) << 2
+    let negative = |c: f64| (c < 0.0 && !is_flat(c)) as u8;
+    negative(dir.x) | negative(dir.y) << 1 | negative(dir.z) << 2
+}
+
+/// Whether the walk takes a direction component as parallel to the planes.
+fn is_flat(c: f64) -> bool {
+    c.abs() < MIN_COMPONENT
 }
 
 /// Any hit for each query: grouped by octant (in issue order within one), traced in packets.
@@ -97,7 +105,9 @@ impl Lanes {
             // Coordinates from the box's low corner, where the tree keeps its planes as f32.
             let rel = q.origin - tree.bounds.0;
             let scale = (tree.bounds.1 - tree.bounds.0).max(rel.abs()).max_element();
-            if !(SCALES.contains(&scale) && q.dir.is_finite()) || q.tmax.is_nan() {
+            // MIN_COMPONENT's bound on the drift of a flat lane takes a unit direction.
+            let unit = (q.dir.length_squared() - 1.0).abs() <= 1e-6;
+            if !(SCALES.contains(&scale) && unit) || q.tmax.is_nan() {
                 return None;
             }
             // Thick enough to hold the f64 walk's plane (with its own rounding) and f32's.
@@ -106,7 +116,7 @@ impl Lanes {
                 o[a][l] = rel[a] as f32;
                 o64[a][l] = q.origin[a];
                 d64[a][l] = q.dir[a];
-                if q.dir[a].abs() < MIN_COMPONENT {
+                if is_flat(q.dir[a]) {
                     flat[a][l] = f32::from_bits(u32::MAX);
                 } else {
                     inv[a][l] = 1.0 / q.dir[a] as f32;
@@ -280,4 +290,116 @@ fn trace(tree: &KdTree, queries: &[Query], packet: &[u32], hits: &mut [bool], st
         }
     }
     work::add(nodes, prims);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::kdtree::KdSettings;
+    use crate::mesh::Triangles;
+    use crate::sampling::rng::Seeded;
+
+    /// The module's claim, plane by plane: down random chains of planes inside scenes at the
+    /// origin and far from their own size from it, every lane enters each child its f64 walk
+    /// ([`walk::children`]) enters, with an f32 part of the ray containing the f64 one.
+    #[test]
+    fn f32_spans_contain_the_f64_walks() {
+        let mut r = Seeded(11);
+        for (offset, size) in [(0.0, 1.0), (1e6, 1e-3), (1e12, 1.0), (1e-5, 1e-10)] {
+            let far = DVec3::new(offset, -0.7 * offset, 0.3 * offset);
+            let corner = |x: f64, y: f64, z: f64| far + DVec3::new(x, y, z) * size;
+            let triangles = Triangles {
+                positions: vec![[corner(-1., -1., -1.), corner(1., -1., 1.), corner(1., 1., 1.)]],
+                object_of: vec![0],
+            };
+            let tree = KdTree::build(&triangles, KdSettings::default());
+            let (lo, hi) = tree.bounds;
+            for _ in 0..2000 {
+                let queries: Vec<Query> = (0..WIDTH)
+                    .map(|_| Query {
+                        origin: lo + (hi - lo) * DVec3::new(r.f(), r.f(), r.f()),
+                        dir: r.unit(),
+                        tmax: f64::INFINITY,
+                        skip: u32::MAX,
+                    })
+                    .collect();
+                let packet: Vec<u32> = (0..WIDTH as u32).collect();
+                let (lanes, mut span, mut mask) = Lanes::new(&tree, &queries, &packet).unwrap();
+                let mut spans64: Vec<Option<(f64, f64)>> = queries
+                    .iter()
+                    .map(|q| clip(tree.bounds, q.origin, q.dir, q.tmax, walk::delta(&tree, q.origin)))
+                    .collect();
+                for _ in 0..12 {
+                    // A plane across one lane's part, rounded to the f32 the tree stores; each lane
+                    // then follows its near child or each its far one (lanes may differ in
+                    // octant here: `split` answers near and far along each lane's direction).
+                    let axis = r.index(3);
+                    let open: Vec<usize> = (0..WIDTH).filter(|&l| spans64[l].is_some()).collect();
+                    let Some(&l) = open.get(r.index(open.len().max(1))) else {
+                        break;
+                    };
+                    let (tn, tf) = spans64[l].unwrap();
+                    let q = &queries[l];
+                    let at = q.origin[axis] + q.dir[axis] * (tn + (tf - tn) * r.f());
+                    let s = ((at - lo[axis]) as f32) as f64;
+                    let (near_tf, far_tn, near, far) = lanes.split(axis, s as f32, span);
+                    let go_near = r.f() < 0.5;
+                    for (l, q) in queries.iter().enumerate() {
+                        let Some(s64) = spans64[l] else { continue };
+                        let [a, b] = walk::children(
+                            axis,
+                            lo[axis] + s,
+                            0,
+                            q.origin,
+                            q.dir,
+                            s64,
+                            walk::delta(&tree, q.origin),
+                        );
+                        // Child 0 is the left one; a lane's near child is the left one unless its
+                        // component is negative and not flat.
+                        let left = [a, b].into_iter().flatten().find(|c| c.0 == 0);
+                        let right = [a, b].into_iter().flatten().find(|c| c.0 == 1);
+                        let lane_near_is_left = q.dir[axis] >= 0.0 || is_flat(q.dir[axis]);
+                        let (near64, far64) = if lane_near_is_left {
+                            (left, right)
+                        } else {
+                            (right, left)
+                        };
+                        assert!(mask & 1 << l != 0);
+                        if let Some((_, _, tf)) = near64 {
+                            assert!(near & 1 << l != 0, "lane {l} enters the near child in f64");
+                            assert!(
+                                near_tf.to_array()[l] as f64 >= tf,
+                                "near exit {} < {tf}",
+                                near_tf.to_array()[l]
+                            );
+                        }
+                        if let Some((_, tn, _)) = far64 {
+                            assert!(far & 1 << l != 0, "lane {l} enters the far child in f64");
+                            assert!(
+                                far_tn.to_array()[l] as f64 <= tn,
+                                "far entry {} > {tn}",
+                                far_tn.to_array()[l]
+                            );
+                        }
+                        spans64[l] = if go_near {
+                            near64.map(|c| (c.1, c.2))
+                        } else {
+                            far64.map(|c| (c.1, c.2))
+                        };
+                    }
+                    (span, mask) = if go_near {
+                        ((span.0, near_tf), near & mask)
+                    } else {
+                        ((far_tn, span.1), far & mask)
+                    };
+                    for (l, s64) in spans64.iter().enumerate() {
+                        if s64.is_none() {
+                            mask &= !(1 << l);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
