@@ -11,9 +11,12 @@
 //! planes as f32 (exact), so a scene far from the origin walks as one at the origin, and its
 //! planes are [`DELTA32`] of the scene thicker than the f64 walk's [`walk::DELTA`], far more
 //! than f32 rounding moves a plane distance: each lane's f32 part of the ray contains its f64
-//! part and the lane visits every leaf its single walk visits (and, rarely, a neighbour). Any-hit answers are therefore the single queries'. A node is
-//! fetched once for the whole packet: the work counters count packet node visits and lane
-//! triangle tests.
+//! part and the lane visits every leaf its single walk visits (and, rarely, a neighbour).
+//! Any-hit answers are therefore the single queries'. A node is fetched once for the whole
+//! packet: the work counters count packet node visits and lane triangle tests.
+//!
+//! Measured (results/ao-bundles): on coherent AO bundles the packets visit 2.5-3.8x fewer nodes
+//! than single rays but with 28-48 % of their lanes open per visit, and run no faster.
 
 use super::walk::{self, clip, STACK};
 use super::KdTree;
