@@ -2,8 +2,9 @@
 //! and its own single queries, hit for hit, on every kind of ray and on the hard cases (zero and
 //! -0.0 direction components, rays that miss the bounds, mixed octants, empty and one-ray
 //! bundles); the field's bundle walk does exactly the single walks' work, the kd-tree's packets
-//! the same triangle tests (and at most 1 % more) in fewer node visits; and an AO frame issued direction-major is the
-//! single-ray frame to the bit.
+//! the same triangle tests (and at most 1 % more) in fewer node visits; and an AO frame issued
+//! direction-major is the single-ray frame to the bit. The packets' f32 walk is also tested
+//! plane by plane in `accel::kdtree::packet`.
 
 use crate::common;
 use crate::common::rays::*;
@@ -186,9 +187,9 @@ fn kdtree_packets_hold_at_the_edges_of_f32() {
 }
 
 /// Walls that do not straddle the tree's planes, so a lane that enters the wrong child misses
-/// them: rays parallel to the planes up to a component of +-1e-20 (walked as flat) or +-1e-18 (the
-/// first not), in both directions; and small triangles far from the origin, hit from their own corners (on the
-/// split planes), where the f32 walk's planes must be thicker than the f64 walk's to hold.
+/// them: rays parallel to the planes up to a component of +-1e-20 (walked as flat) or +-1e-18
+/// (the first not), in both directions; and small triangles far from the origin, hit from their
+/// own corners (on the split planes).
 #[test]
 fn kdtree_packets_find_walls_they_cannot_enter_by_mistake() {
     let mut out = Vec::new();

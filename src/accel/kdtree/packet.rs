@@ -15,7 +15,7 @@
 //! Any-hit answers are therefore the single queries'. A node is fetched once for the whole
 //! packet: the work counters count packet node visits and lane triangle tests.
 //!
-//! Measured (results/ao-bundles): on coherent AO bundles the packets visit 2.5-3.8x fewer nodes
+//! Measured (results/ao-bundles): on coherent AO bundles the packets visit 2.3-3.8x fewer nodes
 //! than single rays but with 28-48 % of their lanes open per visit, and run no faster.
 
 use super::walk::{self, clip, STACK};
