@@ -28,7 +28,9 @@ order=(
     sphere          # the main experiment first: the README's headline answer
     body            # the same sweep code on the dressed body's mesh
     body-structures # body's scene again, swept over the acceleration structures
-    fps             # the soft-shadow paper's Table 1; the last on the GPU backend
+    fps             # the soft-shadow paper's Table 1
+    realtime        # the same question asked as real-time renderers ask it: few rays, frames, filters
+    realtime-body   # ... on the body's narrow penumbrae; the last on the GPU backend
     ao              # the visibility-field paper's Table 1, CPU backend from here on
     ao-bundles      # the same workload with SAH and ray bundles: the paper's open question
     walkthrough     # Fig. 6, the classroom walk

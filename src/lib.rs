@@ -9,7 +9,7 @@
 //! ```
 //! use penumbra::sampling::{DiskScheme, Site};
 //! // The soft-shadow paper's 16 "pseudo-random" targets (eq. 2 + 3): the centre first.
-//! let pts = DiskScheme::Paper.points(16, Site::pixel(1, 0, [0, 0], 0));
+//! let pts = DiskScheme::Paper.points(16, Site::pixel(1, 0, [0, 0], 0, 0));
 //! assert_eq!(pts[0], glam::DVec2::ZERO);
 //! assert!(pts[1..].iter().all(|p| p.length() >= 0.3 - 1e-12 && p.length() <= 1.0));
 //! ```

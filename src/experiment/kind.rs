@@ -17,6 +17,9 @@ pub enum Kind {
     Ao,
     /// Frames along a camera path timed per acceleration structure ([`super::frames`]).
     Frames,
+    /// Real-time pipelines (few rays, accumulated, filtered) judged on the penumbra
+    /// ([`super::realtime`]).
+    Realtime,
 }
 
 impl Kind {
@@ -27,6 +30,7 @@ impl Kind {
             Kind::Fps => "fps",
             Kind::Ao => "ao",
             Kind::Frames => "frames",
+            Kind::Realtime => "realtime",
         }
     }
 

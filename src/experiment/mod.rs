@@ -21,6 +21,7 @@ pub mod kind;
 pub mod manifest;
 pub mod outputs;
 pub mod progress;
+pub mod realtime;
 pub mod sweep;
 pub mod timing;
 
@@ -125,5 +126,8 @@ pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
         Kind::Fps => Box::new(core::Declared(fps::FpsSpec::from_source(&source, header)?)),
         Kind::Ao => Box::new(core::Declared(ao::AoSpec::from_source(&source, header)?)),
         Kind::Frames => Box::new(core::Declared(frames::FramesSpec::from_source(&source, header)?)),
+        Kind::Realtime => Box::new(core::Declared(realtime::Realtime::new(
+            realtime::RealtimeSpec::from_source(&source, header)?,
+        ))),
     })
 }

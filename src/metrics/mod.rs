@@ -1,6 +1,7 @@
 //! Measurements of a rendered visibility image. Each formula is documented once, here or in
 //! the submodule that computes it; the runner combines them into one record per run.
 
+pub mod edge;
 pub mod error;
 pub mod extent;
 pub mod flip;

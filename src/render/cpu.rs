@@ -95,7 +95,7 @@ struct LightTargets {
 /// Pixel `pixel`'s sampling site for stream `light` (a light's index, or the ambient pass's).
 fn site(sampling: Sampling, light: u32, pixel: usize, width: u32) -> Site {
     let p = pixel as u32;
-    Site::pixel(sampling.seed, light, [p % width, p / width], p)
+    Site::pixel(sampling.seed, light, [p % width, p / width], p, sampling.frame)
 }
 
 impl LightTargets {
@@ -106,7 +106,7 @@ impl LightTargets {
             .enumerate()
             .map(|(i, l)| {
                 (sampling.pattern == Pattern::Shared)
-                    .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, i as u32))
+                    .then(|| shared_points(sampling.scheme, l.samples(), sampling.seed, i as u32, sampling.frame))
             })
             .collect();
         LightTargets {
@@ -172,9 +172,13 @@ fn ambient_image(
     width: u32,
 ) -> (Vec<f32>, u64, Work) {
     let shared = match (&ao.directions, sampling.pattern) {
-        (AoDirections::Disk(scheme), Pattern::Shared) => {
-            Some(shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM))
-        }
+        (AoDirections::Disk(scheme), Pattern::Shared) => Some(shared_points(
+            *scheme,
+            ao.rays,
+            sampling.seed,
+            AMBIENT_STREAM,
+            sampling.frame,
+        )),
         _ => None,
     };
     let at = |pixel: usize| site(sampling, AMBIENT_STREAM, pixel, width);

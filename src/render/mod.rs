@@ -7,6 +7,7 @@
 
 pub mod ambient;
 pub mod cpu;
+pub mod denoise;
 pub mod gpu;
 pub mod mirror;
 pub mod plan;
@@ -32,6 +33,9 @@ pub struct Sampling {
     pub pattern: Pattern,
     /// Seed of every random number in the frame.
     pub seed: u32,
+    /// Index of this frame in a temporal sequence, 0 for a single frame: what each scheme does
+    /// with it is [`DiskScheme::point`]'s business.
+    pub frame: u32,
 }
 
 /// What to render: a camera and an image size.
@@ -180,6 +184,18 @@ pub trait Backend {
         warmup: u32,
         repeats: u32,
     ) -> anyhow::Result<Timing>;
+
+    /// Reconstructs an accumulated shadow image with `filter` ([`denoise`]): the image, its taps
+    /// and the seconds the filter took. The CPU runs the f64 reference; the GPU its WGSL twin.
+    fn reconstruct(
+        &mut self,
+        filter: denoise::Filter,
+        input: &denoise::Input,
+    ) -> anyhow::Result<(denoise::Output, f64)> {
+        let start = std::time::Instant::now();
+        let out = denoise::cpu::apply(filter, input);
+        Ok((out, start.elapsed().as_secs_f64()))
+    }
 }
 
 /// Which renderer runs an experiment: the experiment file's `backend` key, or `--backend`.

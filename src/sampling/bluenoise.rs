@@ -172,6 +172,21 @@ pub fn offset(x: u32, y: u32, tile_seed: u32) -> (u32, u32) {
     (wrap(fix(m[0][i]), sx), wrap(fix(m[1][i]), sy))
 }
 
+/// The 2-D Kronecker (R2) increments as 24-bit fractions, round(2^24 / g) and round(2^24 / g^2)
+/// with g the plastic number: each frame adds them to a pixel's Cranley-Patterson offset, so over
+/// frames each offset walks a low-discrepancy sequence while every frame stays a blue-noise mask
+/// (the golden-ratio-style temporal rotation of a 2-D mask that Wolfe et al. 2022 compare their
+/// spatiotemporal masks against).
+pub const R2_STEP: (u32, u32) = (12_664_746, 9_560_334);
+
+/// [`offset`] at frame `frame` of a temporal sequence: moved by `frame` [`R2_STEP`]s, modulo 1;
+/// frame 0 is [`offset`] itself.
+pub fn offset_at(x: u32, y: u32, tile_seed: u32, frame: u32) -> (u32, u32) {
+    let (ox, oy) = offset(x, y, tile_seed);
+    let step = |o: u32, r: u32| o.wrapping_add(frame.wrapping_mul(r)) & 0x00ff_ffff;
+    (step(ox, R2_STEP.0), step(oy, R2_STEP.1))
+}
+
 /// Test integrands of the scramble optimisation: the disk light cut by one straight occluder
 /// edge, as (normal angle, signed distance of the edge from the centre in (-1, 1)), with the
 /// share of the disk's area beyond it (a circular segment, in closed form).
@@ -390,6 +405,12 @@ pub fn scramble(x: u32, y: u32, n: u32, tile_seed: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn r2_steps_are_the_plastic_numbers_inverse_powers() {
+        let fix = |a: f64| (a * (1u32 << 24) as f64).round() as u32;
+        assert_eq!(R2_STEP, (fix(0.754_877_666_246_692_7), fix(0.569_840_290_998_053_2)));
+    }
 
     #[test]
     fn a_mask_ranks_every_pixel_once() {

@@ -1,10 +1,10 @@
 //! Where shadow rays land on a disk light: the schemes compared by the sweep.
 //!
 //! Each scheme maps (sample count n, sample index k, the pixel's [`Site`]: its random stream,
-//! its position and the run's seed) to a point on the unit disk; the renderer scales it by the
-//! light's radius and places it in the light's plane. A scheme is evaluated one sample at a
-//! time so that the GPU can do the same; the schemes arranged over the screen read tables the
-//! GPU gets as a buffer ([`tables`]).
+//! its position, the run's seed and the frame's index) to a point on the unit disk; the renderer
+//! scales it by the light's radius and places it in the light's plane. A scheme is evaluated one
+//! sample at a time so that the GPU can do the same; the schemes arranged over the screen read
+//! tables the GPU gets as a buffer ([`tables`]).
 //!
 //! Adding a scheme: a variant in [`DiskScheme`] with its name in [`DiskScheme::ALL`], its point
 //! function in [`DiskScheme::point`], and the same function in
@@ -65,34 +65,40 @@ pub enum DiskScheme {
 }
 
 /// Where one pixel's samples come from: its random stream, and, for the schemes arranged over
-/// the screen, its position and the run's seed.
+/// the screen, its position and the run's seed; and which frame of a temporal sequence it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Site {
-    /// The pixel's (or the shared pattern's) random stream.
+    /// The pixel's (or the shared pattern's) random stream, as at frame 0.
     pub stream: Stream,
     /// Pixel column and row.
     pub pixel: [u32; 2],
     /// Seed of the blue-noise tile's shift, from the run's seed and the light
     /// ([`bluenoise::tile_seed`]), so that seeds and lights see independent arrangements.
     pub tile_seed: u32,
+    /// Index of the frame in a temporal sequence (0 for a single frame): what each scheme does
+    /// with it is [`DiskScheme::point`]'s business.
+    pub frame: u32,
 }
 
 impl Site {
-    /// The site of pixel `(x, y)` (index `index`) for light `light` in a run seeded with `seed`.
-    pub fn pixel(seed: u32, light: u32, [x, y]: [u32; 2], index: u32) -> Site {
+    /// The site of pixel `(x, y)` (index `index`) for light `light` in frame `frame` of a run
+    /// seeded with `seed`.
+    pub fn pixel(seed: u32, light: u32, [x, y]: [u32; 2], index: u32, frame: u32) -> Site {
         Site {
             stream: Stream::new(seed, light, Some(index)),
             pixel: [x, y],
             tile_seed: bluenoise::tile_seed(seed, light),
+            frame,
         }
     }
 
-    /// The site every pixel shares (the paper's precomputed buffer).
-    pub fn shared(seed: u32, light: u32) -> Site {
+    /// The site every pixel shares (the paper's precomputed buffer) in frame `frame`.
+    pub fn shared(seed: u32, light: u32, frame: u32) -> Site {
         Site {
             stream: Stream::new(seed, light, None),
             pixel: [0, 0],
             tile_seed: bluenoise::tile_seed(seed, light),
+            frame,
         }
     }
 }
@@ -167,6 +173,7 @@ impl DiskScheme {
     }
 
     /// The most samples per pixel the scheme can give (its table's size; otherwise unbounded).
+    /// A temporal run of F frames of n samples draws F n of them: the caller checks F n fits.
     pub fn max_samples(self) -> u32 {
         match self {
             DiskScheme::Pmj02 => pmj02::MAX_POINTS as u32,
@@ -194,10 +201,17 @@ impl DiskScheme {
         )
     }
 
-    /// Sample `k` of `n` on the unit disk for the pixel at `site`.
+    /// Sample `k` of `n` on the unit disk for the pixel at `site`, in its frame `f`: the
+    /// progressive sequences (Sobol', pmj02, blue-noise Sobol') continue at index f n + k under
+    /// the same scramble or shift, so F frames of n are the sequence's first F n points; the
+    /// per-pixel random schemes draw from a fresh stream ([`Stream::at_frame`]); bluenoise-cp
+    /// moves its offsets by f R2 steps ([`bluenoise::offset_at`]); a points set's tile seed is
+    /// re-keyed like a stream ([`rng::at_frame`]). Frame 0 is the single frame, unchanged.
     pub fn point(self, n: u32, k: u32, site: Site) -> DVec2 {
         debug_assert!(k < n);
-        let stream = site.stream;
+        // The re-seeded schemes' stream, and the progressive ones' index (wrapping, as on the GPU).
+        let stream = site.stream.at_frame(site.frame);
+        let index = site.frame.wrapping_mul(n).wrapping_add(k);
         match self {
             DiskScheme::Uniform => {
                 let (u, v) = (stream.unit(2 * k), stream.unit(2 * k + 1));
@@ -223,7 +237,7 @@ impl DiskScheme {
                 concentric(u, v)
             }
             DiskScheme::Sobol => {
-                let (x, y) = sobol::scrambled_sobol_2d(k, stream.u32(0x7fff_ffff));
+                let (x, y) = sobol::scrambled_sobol_2d(index, site.stream.u32(0x7fff_ffff));
                 concentric(rng::to_unit(x), rng::to_unit(y))
             }
             DiskScheme::Spiral => {
@@ -234,23 +248,26 @@ impl DiskScheme {
                 polar(r, TAU * rng::to_unit(turn))
             }
             DiskScheme::Pmj02 => {
-                let shift = (stream.u32(0x7fff_fffc) >> 8, stream.u32(0x7fff_fffb) >> 8);
-                let (u, v) = pmj02::point(k, shift);
+                let shift = (site.stream.u32(0x7fff_fffc) >> 8, site.stream.u32(0x7fff_fffb) >> 8);
+                let (u, v) = pmj02::point(index, shift);
                 concentric(u, v)
             }
             DiskScheme::BluenoiseCp => {
                 let [x, y] = site.pixel;
-                let (ox, oy) = bluenoise::offset(x, y, site.tile_seed);
+                let (ox, oy) = bluenoise::offset_at(x, y, site.tile_seed, site.frame);
                 let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
                 let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
                 concentric(wrap(sx, ox), wrap(sy, oy))
             }
             DiskScheme::SobolBluenoise => {
                 let [x, y] = site.pixel;
-                let (sx, sy) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
+                let (sx, sy) = sobol::scrambled_sobol_2d(index, bluenoise::scramble(x, y, n, site.tile_seed));
                 concentric(rng::to_unit(sx), rng::to_unit(sy))
             }
-            DiskScheme::Points(id) => id.loaded().point(k, site.pixel, site.tile_seed),
+            DiskScheme::Points(id) => {
+                let tile_seed = rng::at_frame(site.tile_seed, site.frame);
+                id.loaded().point(k, site.pixel, tile_seed)
+            }
         }
     }
 
@@ -403,9 +420,10 @@ impl Pattern {
 named_enum!(DiskScheme, "sampling scheme");
 named_enum!(Pattern, "pattern");
 
-/// Points on the unit disk for the shared pattern (the paper's precomputed buffer).
-pub fn shared_points(scheme: DiskScheme, n: u32, seed: u32, light: u32) -> Vec<DVec2> {
-    scheme.points(n, Site::shared(seed, light))
+/// Points on the unit disk for the shared pattern (the paper's precomputed buffer) in frame
+/// `frame`.
+pub fn shared_points(scheme: DiskScheme, n: u32, seed: u32, light: u32, frame: u32) -> Vec<DVec2> {
+    scheme.points(n, Site::shared(seed, light, frame))
 }
 
 #[cfg(test)]
@@ -434,7 +452,7 @@ mod tests {
 
     #[test]
     fn paper_scheme_small_counts_are_defined() {
-        let s = Site::pixel(1, 0, [0, 0], 0);
+        let s = Site::pixel(1, 0, [0, 0], 0, 0);
         assert_eq!(DiskScheme::Paper.points(1, s), vec![DVec2::ZERO]);
         let two = DiskScheme::Paper.points(2, s);
         assert_eq!(two[0], DVec2::ZERO);
@@ -445,7 +463,7 @@ mod tests {
 
     #[test]
     fn paper_angles_are_evenly_spaced() {
-        let s = Site::pixel(5, 0, [9, 0], 9);
+        let s = Site::pixel(5, 0, [9, 0], 9, 0);
         let p = DiskScheme::Paper.points(16, s);
         for (k, q) in p.iter().enumerate().skip(1) {
             let expected = TAU * k as f64 / 15.0;
@@ -456,7 +474,7 @@ mod tests {
 
     #[test]
     fn literal_reading_is_the_intended_one_shifted() {
-        let s = Site::pixel(2, 1, [3, 0], 3);
+        let s = Site::pixel(2, 1, [3, 0], 3, 0);
         let a = DiskScheme::Paper.points(16, s);
         let b = DiskScheme::PaperLiteral.points(16, s);
         assert_eq!(b[0], DVec2::ZERO);
@@ -465,6 +483,111 @@ mod tests {
             let r = a[k].length() - 0.3;
             assert!(((b[k] - DVec2::splat(0.3)).length() - r).abs() < 1e-12);
         }
+    }
+
+    /// Sample k of n at frame 0 as written before frames existed: every committed result was
+    /// drawn with these formulas.
+    fn single_frame(scheme: DiskScheme, n: u32, k: u32, site: Site) -> DVec2 {
+        let stream = site.stream;
+        let [x, y] = site.pixel;
+        match scheme {
+            DiskScheme::Uniform => polar(stream.unit(2 * k).sqrt(), TAU * stream.unit(2 * k + 1)),
+            DiskScheme::Paper | DiskScheme::PaperLiteral if k == 0 => DVec2::ZERO,
+            DiskScheme::Paper => polar(0.3 + 0.7 * stream.unit(2 * k).sqrt(), TAU * k as f64 / (n - 1) as f64),
+            DiskScheme::PaperLiteral => {
+                DVec2::splat(0.3) + polar(0.7 * stream.unit(2 * k).sqrt(), TAU * k as f64 / (n - 1) as f64)
+            }
+            DiskScheme::Jittered => {
+                let (rows, cols) = strata(n);
+                let u = ((k % cols) as f64 + stream.unit(2 * k)) / cols as f64;
+                concentric(u, ((k / cols) as f64 + stream.unit(2 * k + 1)) / rows as f64)
+            }
+            DiskScheme::Sobol => {
+                let (a, b) = sobol::scrambled_sobol_2d(k, stream.u32(0x7fff_ffff));
+                concentric(rng::to_unit(a), rng::to_unit(b))
+            }
+            DiskScheme::Spiral => {
+                let turn = k.wrapping_mul(GOLDEN_TURN).wrapping_add(stream.u32(0x7fff_fffe));
+                let r = ((k as f64 + stream.unit(0x7fff_fffd)) / n as f64).sqrt();
+                polar(r, TAU * rng::to_unit(turn))
+            }
+            DiskScheme::Pmj02 => {
+                let (u, v) = pmj02::point(k, (stream.u32(0x7fff_fffc) >> 8, stream.u32(0x7fff_fffb) >> 8));
+                concentric(u, v)
+            }
+            DiskScheme::BluenoiseCp => {
+                let (ox, oy) = bluenoise::offset(x, y, site.tile_seed);
+                let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
+                let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
+                concentric(wrap(sx, ox), wrap(sy, oy))
+            }
+            DiskScheme::SobolBluenoise => {
+                let (a, b) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
+                concentric(rng::to_unit(a), rng::to_unit(b))
+            }
+            DiskScheme::Points(_) => unreachable!("not a built-in"),
+        }
+    }
+
+    /// Frame 0 gives every built-in scheme's points bit for bit as before frames existed, per
+    /// pixel and shared; a points set's re-keyed tile seed is its own at frame 0.
+    #[test]
+    fn frame_zero_is_the_single_frame() {
+        for scheme in DiskScheme::ALL {
+            for n in [1u32, 2, 7, 16, 33] {
+                for site in [Site::pixel(3, 1, [5, 9], 581, 0), Site::shared(3, 1, 0)] {
+                    for k in 0..n {
+                        let (got, want) = (scheme.point(n, k, site), single_frame(scheme, n, k, site));
+                        assert_eq!(got.to_array().map(f64::to_bits), want.to_array().map(f64::to_bits));
+                    }
+                }
+            }
+        }
+        assert_eq!(rng::at_frame(0x1234_5678, 0), 0x1234_5678);
+        assert_eq!(bluenoise::offset_at(5, 9, 77, 0), bluenoise::offset(5, 9, 77));
+    }
+
+    /// Sobol' and pmj02 continue their sequences: frames 0..F of n samples are exactly the first
+    /// F n samples of frame 0 (their points do not depend on n).
+    #[test]
+    fn progressive_frames_continue_the_sequence() {
+        let site = |frame| Site::pixel(8, 0, [17, 4], 273, frame);
+        for scheme in [DiskScheme::Sobol, DiskScheme::Pmj02] {
+            for (frames, n) in [(4u32, 1u32), (5, 3), (8, 16), (3, 64)] {
+                let all = scheme.points(frames * n, site(0));
+                let walked: Vec<DVec2> = (0..frames).flat_map(|f| scheme.points(n, site(f))).collect();
+                assert_eq!(walked, all, "{scheme}: {frames} frames of {n}");
+            }
+        }
+        // Blue-noise Sobol' (whose scramble table depends on n) walks the same way under its own n.
+        let s = DiskScheme::SobolBluenoise;
+        let (x, y) = sobol::scrambled_sobol_2d(3 * 16 + 5, bluenoise::scramble(17, 4, 16, bluenoise::tile_seed(8, 0)));
+        assert_eq!(s.point(16, 5, site(3)), concentric(rng::to_unit(x), rng::to_unit(y)));
+    }
+
+    /// The re-seeded schemes draw frame f from the stream's frame-f key, bluenoise-cp moves its
+    /// offset by f R2 steps; frame 1 differs from frame 0 for every built-in scheme.
+    #[test]
+    fn other_frames_reseed_or_move() {
+        use DiskScheme::{Jittered, Paper, PaperLiteral, Spiral, Uniform};
+        let site = |frame| Site::pixel(8, 2, [40, 7], 488, frame);
+        for scheme in DiskScheme::ALL {
+            let n = 16;
+            assert_ne!(scheme.points(n, site(1)), scheme.points(n, site(0)), "{scheme}");
+            if [Uniform, Paper, PaperLiteral, Jittered, Spiral].contains(&scheme) {
+                for f in [1u32, 5, u32::MAX] {
+                    let fresh = Site {
+                        stream: site(0).stream.at_frame(f),
+                        ..site(0)
+                    };
+                    assert_eq!(scheme.points(n, site(f)), scheme.points(n, fresh), "{scheme} frame {f}");
+                }
+            }
+        }
+        let (ox, oy) = bluenoise::offset(40, 7, bluenoise::tile_seed(8, 2));
+        let (r1, r2) = bluenoise::R2_STEP;
+        let moved = ((ox + 5 * r1) & 0x00ff_ffff, (oy + 5 * r2) & 0x00ff_ffff);
+        assert_eq!(bluenoise::offset_at(40, 7, bluenoise::tile_seed(8, 2), 5), moved);
     }
 
     #[test]

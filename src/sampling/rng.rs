@@ -13,6 +13,21 @@ pub fn pcg(v: u32) -> u32 {
     (word >> 22) ^ word
 }
 
+/// The constant a frame index is offset by before it is hashed into a key ([`at_frame`]):
+/// distinct from the pixel's and the index's.
+pub const FRAME_KEY: u32 = 0x2545_f491;
+
+/// `key` re-keyed for frame `frame` of a temporal sequence: unchanged at frame 0 (a single frame
+/// draws what it always did), else hashed with the frame ([`Stream::at_frame`], points' tile seed).
+#[inline]
+pub fn at_frame(key: u32, frame: u32) -> u32 {
+    if frame == 0 {
+        key
+    } else {
+        pcg(key ^ pcg(frame.wrapping_add(FRAME_KEY)))
+    }
+}
+
 /// A stream of independent random numbers, identified by a 32-bit key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stream(pub u32);
@@ -26,6 +41,12 @@ impl Stream {
             Some(p) => Stream(pcg(base ^ pcg(p.wrapping_add(0x1b56_c4e9)))),
             None => Stream(pcg(base ^ 0x5bd1_e995)),
         }
+    }
+
+    /// The stream of frame `frame` of a temporal sequence: frame 0 is this stream unchanged (so a
+    /// single frame draws what it always did), every other frame a fresh key hashed from both.
+    pub fn at_frame(self, frame: u32) -> Self {
+        Stream(at_frame(self.0, frame))
     }
 
     /// The `index`-th 32-bit value of the stream.
@@ -138,6 +159,15 @@ mod tests {
         assert_ne!(a, Stream::new(1, 1, Some(5)));
         assert_ne!(a, Stream::new(2, 0, Some(5)));
         assert_ne!(Stream::new(1, 0, None), Stream::new(2, 0, None));
+    }
+
+    #[test]
+    fn frame_zero_is_the_stream_and_other_frames_differ() {
+        let s = Stream::new(4, 1, Some(77));
+        assert_eq!(s.at_frame(0), s);
+        assert_eq!(s.at_frame(1), Stream(pcg(s.0 ^ pcg(1u32.wrapping_add(0x2545_f491)))));
+        let keys: std::collections::HashSet<u32> = (0..64).map(|f| s.at_frame(f).0).collect();
+        assert_eq!(keys.len(), 64);
     }
 
     #[test]

@@ -86,6 +86,7 @@ fn sampling() -> Sampling {
         scheme: DiskScheme::Jittered,
         pattern: Pattern::PerPixel,
         seed: 5,
+        frame: 0,
     }
 }
 

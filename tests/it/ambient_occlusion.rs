@@ -24,6 +24,7 @@ const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 1,
+    frame: 0,
 };
 
 /// A sphere (or, with `mesh`, a triangulated sphere from that OBJ) of radius 0.5 at height 1
@@ -59,6 +60,7 @@ const JITTERED: Sampling = Sampling {
     scheme: DiskScheme::Jittered,
     pattern: Pattern::PerPixel,
     seed: 7,
+    frame: 0,
 };
 
 fn render(s: &Scene) -> Frame {
@@ -437,7 +439,7 @@ fn the_grids_error_depends_on_position_and_normal() {
                         triangle: u32::MAX,
                     };
                     let pixel = (k * 961 + i * 31 + j) as u32;
-                    let site = Site::pixel(3, AMBIENT_STREAM, [i as u32, (k * 31 + j) as u32], pixel);
+                    let site = Site::pixel(3, AMBIENT_STREAM, [i as u32, (k * 31 + j) as u32], pixel, 0);
                     let e = occlusion(&s, &r, &ao, None, site).0 - exact;
                     lo = lo.min(e);
                     hi = hi.max(e);

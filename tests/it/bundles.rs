@@ -350,6 +350,7 @@ fn a_bundled_ao_frame_is_the_single_frame() {
         scheme: penumbra::sampling::DiskScheme::Uniform,
         pattern: penumbra::sampling::Pattern::PerPixel,
         seed: 3,
+        frame: 0,
     };
     for name in ["vlf", "kdtree", "bvh"] {
         for (directions, rays) in [
@@ -586,6 +587,7 @@ fn a_bundled_ao_frame_with_spheres_and_planes_is_the_single_frame() {
             scheme: penumbra::sampling::DiskScheme::Uniform,
             pattern,
             seed: 5,
+            frame: 0,
         };
         for name in ["vlf", "kdtree-sah"] {
             for (directions, rays) in [

@@ -22,11 +22,12 @@ fn compare(a: &Frame, b: &Frame) -> (f64, f64, usize) {
 /// GPU (f32) and CPU (f64) agree on the same sample pattern: the same object hit everywhere but
 /// a handful of silhouette pixels, and visibility differing only where a shadow ray grazes the
 /// sphere closely enough for f32 rounding to flip it (at most 1 ray in 16, in under 1 % of pixels).
+/// A single frame and frame 3 of a temporal sequence alike: both draw frame f's samples.
 #[test]
 fn gpu_matches_cpu_on_the_sphere_scene() {
     let Some(mut gpu) = common::gpu() else { return };
     let scene = Scene::load(&common::repo("experiments/scenes/sphere.toml")).unwrap();
-    for camera in ["measure", "picture"] {
+    for (camera, frame) in [("measure", 0), ("picture", 0), ("measure", 3)] {
         for (scheme, pattern) in [
             (DiskScheme::Uniform, Pattern::PerPixel),
             (DiskScheme::Paper, Pattern::Shared),
@@ -44,40 +45,50 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
                 scheme,
                 pattern,
                 seed: 11,
+                frame,
             };
             let g = gpu.render(&scene, view, s).unwrap();
             let c = CpuBackend::default().render(&scene, view, s).unwrap();
             let hit_diff = g.hit.iter().zip(&c.hit).filter(|(a, b)| a != b).count();
             assert!(
                 hit_diff <= 4,
-                "{camera} {scheme}: {hit_diff} pixels hit different objects"
+                "{camera} frame {frame} {scheme}: {hit_diff} pixels hit different objects"
             );
             let (mean, max, differing) = compare(&g, &c);
-            assert!(mean < 1e-3, "{camera} {scheme}/{pattern}: mean |dV| = {mean}");
+            assert!(
+                mean < 1e-3,
+                "{camera} frame {frame} {scheme}/{pattern}: mean |dV| = {mean}"
+            );
             assert!(
                 max <= 1.0 / 16.0 + 1e-6,
-                "{camera} {scheme}/{pattern}: max |dV| = {max}"
+                "{camera} frame {frame} {scheme}/{pattern}: max |dV| = {max}"
             );
             assert!(
                 differing * 100 <= g.hit.len(),
-                "{camera} {scheme}/{pattern}: {differing} pixels differ"
+                "{camera} frame {frame} {scheme}/{pattern}: {differing} pixels differ"
             );
             assert_eq!(g.rays.primary, c.rays.primary);
             let (gr, cr) = (g.rays.shadow_total() as f64, c.rays.shadow_total() as f64);
-            assert!((gr - cr).abs() <= 1e-3 * cr, "{camera}: shadow rays {gr} vs {cr}");
+            assert!(
+                (gr - cr).abs() <= 1e-3 * cr,
+                "{camera} frame {frame}: shadow rays {gr} vs {cr}"
+            );
             let lit: Vec<_> = (0..g.radiance.len()).filter(|&i| c.radiance[i] > 0.0).collect();
             let rel = lit
                 .iter()
                 .map(|&i| ((g.radiance[i] - c.radiance[i]) / c.radiance[i]).abs() as f64)
                 .sum::<f64>()
                 / lit.len() as f64;
-            assert!(rel < 2e-3, "{camera}: mean relative radiance difference {rel}");
+            assert!(
+                rel < 2e-3,
+                "{camera} frame {frame}: mean relative radiance difference {rel}"
+            );
         }
     }
 }
 
 /// The WGSL sampler returns the points the Rust sampler does, to f32 rounding, for every
-/// scheme and several counts including n = 1 and n = 2.
+/// scheme and several counts including n = 1 and n = 2, in frames 0, 1 and 5.
 /// The tests that call the GPU's test hooks (here, in gpu_resources.rs, mesh_scene.rs and
 /// accelerators.rs) exist only with the `test-hooks` feature, which scripts/test.sh enables:
 /// without it this test fails rather than letting them vanish.
@@ -93,13 +104,15 @@ fn wgsl_samplers_match_rust() {
     let Some(mut gpu) = common::gpu() else { return };
     for scheme in DiskScheme::ALL {
         for n in [1u32, 2, 3, 7, 16, 64, 257] {
-            let (seed, pixel) = (1234, 77);
-            let g = gpu.disk_points(scheme, n, seed, pixel).unwrap();
-            let c = scheme.points(n, common::hook_site(seed, pixel));
-            assert_eq!(g.len(), c.len(), "{scheme} n={n}: one GPU point per sample");
-            for (k, (a, b)) in g.iter().zip(&c).enumerate() {
-                let d = ((a[0] as f64 - b.x).powi(2) + (a[1] as f64 - b.y).powi(2)).sqrt();
-                assert!(d < 2e-6, "{scheme} n={n} k={k}: gpu {a:?} cpu {b}");
+            for frame in [0u32, 1, 5] {
+                let (seed, pixel) = (1234, 77);
+                let g = gpu.disk_points_at(scheme, n, seed, pixel, frame).unwrap();
+                let c = scheme.points(n, common::hook_site(seed, pixel, frame));
+                assert_eq!(g.len(), c.len(), "{scheme} n={n}: one GPU point per sample");
+                for (k, (a, b)) in g.iter().zip(&c).enumerate() {
+                    let d = ((a[0] as f64 - b.x).powi(2) + (a[1] as f64 - b.y).powi(2)).sqrt();
+                    assert!(d < 2e-6, "{scheme} n={n} frame {frame} k={k}: gpu {a:?} cpu {b}");
+                }
             }
         }
     }

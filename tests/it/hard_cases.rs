@@ -43,6 +43,7 @@ fn render(b: &mut dyn Backend, scene: &Scene, camera: &Camera, size: u32, scheme
             scheme,
             pattern: Pattern::PerPixel,
             seed: 5,
+            frame: 0,
         },
     )
     .unwrap()

@@ -158,6 +158,14 @@ fn frames_in_blocks_sharded_merged_and_resumed_give_the_whole_runs_tables() {
 }
 
 #[test]
+fn realtime_sharded_merged_and_resumed_gives_the_whole_runs_tables() {
+    whole_sharded_and_resumed_agree(
+        &common::repo("experiments/realtime-ci.toml"),
+        &["runs.csv", "summary.csv", "timings.csv"],
+    );
+}
+
+#[test]
 fn fps_sharded_merged_and_resumed_gives_the_whole_runs_table() {
     whole_sharded_and_resumed_agree(&common::repo("experiments/fps-ci.toml"), &["fps.csv"]);
 }

@@ -176,6 +176,7 @@ fn backends_render_the_body_alike() {
             scheme: DiskScheme::Sobol,
             pattern: Pattern::PerPixel,
             seed: 3,
+            frame: 0,
         };
         let (g, c) = (
             gpu.render(&s, view, sampling).unwrap(),
@@ -269,6 +270,7 @@ fn long_shadow_loops_run_to_the_end() {
         scheme: DiskScheme::Uniform,
         pattern: Pattern::PerPixel,
         seed: 1,
+        frame: 0,
     };
     let (g, c) = (
         gpu.render(&s, view, sampling).unwrap(),
@@ -309,6 +311,7 @@ fn the_visibility_field_renders_the_body_as_the_bvh_does() {
                 scheme: DiskScheme::Paper,
                 pattern: Pattern::PerPixel,
                 seed: 5,
+                frame: 0,
             };
             let (a, b) = (
                 b.render(&bvh, view, sampling).unwrap(),
@@ -357,6 +360,7 @@ fn both_lights_carry_a_share_of_the_measured_error() {
             scheme,
             pattern: Pattern::PerPixel,
             seed,
+            frame: 0,
         };
         CpuBackend::default().render(s, view, sampling).unwrap()
     };

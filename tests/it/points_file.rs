@@ -37,7 +37,18 @@ fn render(backend: &mut dyn Backend, scene: &Scene, scheme: DiskScheme, pattern:
         width: 80,
         height: 72,
     };
-    backend.render(scene, view, Sampling { scheme, pattern, seed }).unwrap()
+    backend
+        .render(
+            scene,
+            view,
+            Sampling {
+                scheme,
+                pattern,
+                seed,
+                frame: 0,
+            },
+        )
+        .unwrap()
 }
 
 /// The shipped sphere scene (its light sampled 16 times).
@@ -72,7 +83,7 @@ fn a_points_file_holding_a_built_in_schemes_points_renders_its_images_bit_for_bi
     );
     // pmj02's shared pattern of seed 5: its sequence under that seed's one digital shift.
     let seed = 5;
-    let stream = Site::shared(seed, 0).stream;
+    let stream = Site::shared(seed, 0, 0).stream;
     let shift = (stream.u32(0x7fff_fffc) >> 8, stream.u32(0x7fff_fffb) >> 8);
     let shared = dir.path().join("pmj02.csv");
     let q = |x: f64| (x * (1u32 << 24) as f64) as u32;

@@ -160,6 +160,7 @@ fn traced_rays_match_an_independent_count() {
         scheme: DiskScheme::Uniform,
         pattern: Pattern::PerPixel,
         seed: 3,
+        frame: 0,
     };
     let meshed = with_quad(s.clone());
     let check = |name: &str, b: &mut dyn Backend, s: &Scene| {
@@ -203,6 +204,7 @@ fn each_backend_runs_the_plans_passes_and_nothing_else() {
         scheme: DiskScheme::Uniform,
         pattern: Pattern::PerPixel,
         seed: 3,
+        frame: 0,
     };
     let check = |name: &str, b: &mut dyn Backend| {
         let mut count = |s: &Scene, frames: u32| {

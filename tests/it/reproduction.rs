@@ -47,6 +47,7 @@ const SWEEP_AXES: &[&str] = &[
     "accelerator",
     "seed",
 ];
+const REALTIME_ID: &[&str] = &["variant", "scheme", "rays", "frames", "accumulation", "filter", "seed"];
 const FRAME_ID: &[&str] = &["triangles", "structure", "update", "shading", "viewpoint", "frame"];
 
 fn kind_of(name: &str) -> Kind {
@@ -62,6 +63,11 @@ fn kind_of(name: &str) -> Kind {
         "fps" => Kind {
             units: "fps.csv",
             tables: &[("fps.csv", &["scene", "lights", "width", "height"])],
+            gpu: true,
+        },
+        "realtime" | "realtime-body" => Kind {
+            units: "runs.csv",
+            tables: &[("runs.csv", REALTIME_ID)],
             gpu: true,
         },
         "ao" | "ao-bundles" => Kind {
@@ -216,6 +222,13 @@ fn reproduce(name: &str) -> Option<Vec<String>> {
     timing.insert("warmup".into(), toml::Value::Integer(0));
     let mut filters: Vec<String> = Vec::new();
     match kind.units {
+        "runs.csv" if kind.tables[0].1 == REALTIME_ID => {
+            // One seed of one (variant, scheme, rays) unit: its frames are one sequence, whole.
+            timing.insert("repeats".into(), toml::Value::Integer(6));
+            for axis in ["variant", "scheme", "rays", "seed"] {
+                filters.push(format!("{axis}={}", unit[axis]));
+            }
+        }
         "runs.csv" => {
             timing.insert("repeats".into(), toml::Value::Integer(0));
             filters.extend(SWEEP_AXES.iter().map(|a| format!("{a}={}", unit[*a])));
@@ -325,6 +338,8 @@ const FOLDERS: &[&str] = &[
     "body-structures",
     "dynamic",
     "fps",
+    "realtime",
+    "realtime-body",
     "scaling",
     "sphere",
     "walkthrough",
@@ -365,6 +380,8 @@ reproduces! {
     body_structures_reproduces: "body-structures",
     dynamic_reproduces: "dynamic",
     fps_reproduces: "fps",
+    realtime_reproduces: "realtime",
+    realtime_body_reproduces: "realtime-body",
     scaling_reproduces: "scaling",
     sphere_reproduces: "sphere",
     walkthrough_reproduces: "walkthrough",

@@ -8,7 +8,7 @@ use proptest::prelude::*;
 
 /// Pixel `pixel` of an image 256 wide, light 0.
 fn site(seed: u32, pixel: u32) -> Site {
-    Site::pixel(seed, 0, [pixel % 256, pixel / 256], pixel)
+    Site::pixel(seed, 0, [pixel % 256, pixel / 256], pixel, 0)
 }
 
 fn inside(scheme: DiskScheme, p: DVec2) -> bool {
@@ -23,9 +23,9 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
     #[test]
-    fn points_stay_on_their_disk_and_repeat_per_seed(scheme_i in 0usize..DiskScheme::ALL.len(), n in 1u32..300, seed: u32, pixel: u32, light in 0u32..4) {
+    fn points_stay_on_their_disk_and_repeat_per_seed(scheme_i in 0usize..DiskScheme::ALL.len(), n in 1u32..300, seed: u32, pixel: u32, light in 0u32..4, frame in prop_oneof![Just(0u32), any::<u32>()]) {
         let scheme = DiskScheme::ALL[scheme_i];
-        let s = Site::pixel(seed, light, [pixel % 4096, pixel / 4096], pixel);
+        let s = Site::pixel(seed, light, [pixel % 4096, pixel / 4096], pixel, frame);
         let pts = scheme.points(n, s);
         prop_assert_eq!(pts.len(), n as usize);
         for p in &pts {
@@ -68,7 +68,7 @@ fn area_uniform_schemes_pass_chi_square() {
             let pts: Vec<DVec2> = if scheme.uses_tables() {
                 let tile = penumbra::sampling::bluenoise::TILE as u32;
                 (0..tile * tile)
-                    .flat_map(|p| scheme.points(n, Site::pixel(9, 0, [p % tile, p / tile], p)))
+                    .flat_map(|p| scheme.points(n, Site::pixel(9, 0, [p % tile, p / tile], p, 0)))
                     .collect()
             } else {
                 (0..40_000 / n)
@@ -95,7 +95,13 @@ fn screen_arranged_samples_are_uniform_over_seeds() {
         for pixel in [[0u32, 0], [63, 0], [1000, 777]] {
             for (n, k) in [(1u32, 0u32), (16, 5), (16, 15)] {
                 let pts: Vec<DVec2> = (0..3000u32)
-                    .map(|seed| scheme.point(n, k, Site::pixel(seed.wrapping_mul(0x9e37_79b9) ^ 0x5eed, 1, pixel, 7)))
+                    .map(|seed| {
+                        scheme.point(
+                            n,
+                            k,
+                            Site::pixel(seed.wrapping_mul(0x9e37_79b9) ^ 0x5eed, 1, pixel, 7, 0),
+                        )
+                    })
                     .collect();
                 let (x2, dof) = chi_square(&pts, 4, 8);
                 assert!(

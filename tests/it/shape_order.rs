@@ -21,6 +21,7 @@ const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 3,
+    frame: 0,
 };
 
 fn top_down(width: f64) -> Camera {

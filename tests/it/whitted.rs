@@ -18,6 +18,7 @@ const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 7,
+    frame: 0,
 };
 
 const LIGHT: DVec3 = DVec3::new(2.0, -1.0, 3.0);

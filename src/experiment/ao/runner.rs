@@ -105,6 +105,7 @@ const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 1,
+    frame: 0,
 };
 
 /// The scene of `mesh` indexed by the structure `settings` name, with the experiment's AO pass.

@@ -213,6 +213,7 @@ impl FpsSpec {
                 scheme: f.scheme,
                 pattern: f.pattern,
                 seed: 1,
+                frame: 0,
             },
             resolutions: f.resolutions,
             scenes,

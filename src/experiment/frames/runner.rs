@@ -32,6 +32,7 @@ pub const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
     pattern: Pattern::PerPixel,
     seed: 1,
+    frame: 0,
 };
 
 /// One frame of one structure, timed.

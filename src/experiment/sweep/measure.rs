@@ -56,6 +56,7 @@ pub fn measure_run(
         scheme: run.scheme,
         pattern: run.pattern,
         seed: run.seed,
+        frame: 0,
     };
     let frame = backend.render(&scene, view, sampling).context("render")?;
     let image = shadow_image(&frame.visibility);

@@ -38,7 +38,16 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
                 width: f.width,
                 height: f.height,
             };
-            let frame = backend.render(&scene, view, Sampling { scheme, pattern, seed })?;
+            let frame = backend.render(
+                &scene,
+                view,
+                Sampling {
+                    scheme,
+                    pattern,
+                    seed,
+                    frame: 0,
+                },
+            )?;
             Ok(Picture { samples, frame })
         };
     let ground_truth = render(

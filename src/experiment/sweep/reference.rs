@@ -91,6 +91,7 @@ impl Reference {
                     scheme: DiskScheme::Jittered,
                     pattern: Pattern::PerPixel,
                     seed: GROUND_TRUTH_SEED,
+                    frame: 0,
                 };
                 let f = backend
                     .render(&scene, view, sampling)

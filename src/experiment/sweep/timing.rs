@@ -137,6 +137,7 @@ pub fn time_groups(
             scheme: run.scheme,
             pattern: run.pattern,
             seed: run.seed,
+            frame: 0,
         };
         let timing = backend.time(&scene, view, sampling, t.warmup, 1)?;
         let c = &mut out[slot];

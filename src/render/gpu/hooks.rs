@@ -80,16 +80,29 @@ impl GpuBackend {
     /// 0) with `seed`, computed by the WGSL sampler: lets tests compare it with the Rust one
     /// ([`DiskScheme::point`] at [`crate::sampling::Site::pixel`]).
     pub fn disk_points(&mut self, scheme: DiskScheme, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
-        self.sample_disk(scheme.gpu_id(), Some(scheme), n, seed, pixel)
+        self.disk_points_at(scheme, n, seed, pixel, 0)
+    }
+
+    /// [`GpuBackend::disk_points`] in frame `frame` of a temporal sequence ([`Sampling::frame`]).
+    pub fn disk_points_at(
+        &mut self,
+        scheme: DiskScheme,
+        n: u32,
+        seed: u32,
+        pixel: u32,
+        frame: u32,
+    ) -> anyhow::Result<Vec<[f32; 2]>> {
+        self.sample_disk(scheme.gpu_id(), Some(scheme), n, seed, pixel, frame)
     }
 
     /// [`GpuBackend::disk_points`] for a raw scheme id, known or not (an unknown id must give
     /// NaN points, never another scheme's).
     pub fn disk_points_of_id(&mut self, id: u32, n: u32, seed: u32, pixel: u32) -> anyhow::Result<Vec<[f32; 2]>> {
-        self.sample_disk(id, DiskScheme::ALL.get(id as usize).copied(), n, seed, pixel)
+        self.sample_disk(id, DiskScheme::ALL.get(id as usize).copied(), n, seed, pixel, 0)
     }
 
-    /// Runs the sampler hook for scheme id `id`, with the tables of `scheme` where known.
+    /// Runs the sampler hook for scheme id `id` in frame `frame`, with the tables of `scheme`
+    /// where known.
     fn sample_disk(
         &mut self,
         id: u32,
@@ -97,6 +110,7 @@ impl GpuBackend {
         n: u32,
         seed: u32,
         pixel: u32,
+        frame: u32,
     ) -> anyhow::Result<Vec<[f32; 2]>> {
         let scene = crate::scene::Scene::analytic(vec![], vec![], vec![]);
         let cam = dummy_camera();
@@ -109,6 +123,7 @@ impl GpuBackend {
             scheme: DiskScheme::Uniform,
             pattern: crate::sampling::Pattern::PerPixel,
             seed,
+            frame,
         };
         let mut packed = pack(&scene, view, sampling)?;
         packed.params.scheme = id;
@@ -136,6 +151,7 @@ impl GpuBackend {
             scheme: DiskScheme::Uniform,
             pattern: crate::sampling::Pattern::PerPixel,
             seed: 0,
+            frame: 0,
         };
         let mut packed = pack(scene, view, sampling)?;
         packed.params.width = rays.len() as u32;

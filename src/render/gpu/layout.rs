@@ -40,6 +40,9 @@ pub struct Params {
     pub ao_scheme: u32,
     /// Farthest AO occluder, local units (infinite: none).
     pub ao_max_distance: f32,
+    /// Index of the frame in a temporal sequence ([`Sampling::frame`]).
+    pub frame: u32,
+    pub _pad: [u32; 3],
 }
 
 /// How the AO kernel makes and weights its directions (`AO_*` in render.wgsl).
@@ -119,7 +122,7 @@ pub struct PassInfo {
 /// Bytes per pixel of the hit buffer (WGSL `Hit`).
 pub const HIT_BYTES: u64 = 48;
 
-const _: () = assert!(std::mem::size_of::<Params>() == 112);
+const _: () = assert!(std::mem::size_of::<Params>() == 128);
 const _: () = assert!(std::mem::size_of::<GpuMeshTri>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuSphere>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuPlane>() == 32);
@@ -207,6 +210,8 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         ao_mode: AoMode::None as u32,
         ao_scheme: 0,
         ao_max_distance: f32::INFINITY,
+        frame: sampling.frame,
+        _pad: [0; 3],
     };
     let mut ao_dirs = Vec::new();
     if let Some(ao) = &scene.ambient {
@@ -226,7 +231,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
             (AoDirections::Disk(scheme), w) => {
                 params.ao_scheme = scheme.gpu_id();
                 if sampling.pattern == Pattern::Shared {
-                    ao_dirs = shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM)
+                    ao_dirs = shared_points(*scheme, ao.rays, sampling.seed, AMBIENT_STREAM, sampling.frame)
                         .iter()
                         .map(|p| [p.x as f32, p.y as f32, 0.0, 0.0])
                         .collect();
@@ -280,7 +285,7 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
                 let (u, v) = d.basis();
                 if sampling.pattern == Pattern::Shared {
                     shared.extend(
-                        shared_points(sampling.scheme, d.samples, sampling.seed, i as u32)
+                        shared_points(sampling.scheme, d.samples, sampling.seed, i as u32, sampling.frame)
                             .iter()
                             .map(|p| p.as_vec2().to_array()),
                     );

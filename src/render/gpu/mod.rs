@@ -7,6 +7,7 @@
 //! that cap loop iterations, several) with a timestamp pair
 //! around each pass when the adapter supports timestamp queries, and reads the outputs back.
 
+mod denoise;
 #[cfg(feature = "test-hooks")]
 mod hooks;
 mod layout;
@@ -60,6 +61,8 @@ pub struct GpuBackend {
     static_uploads: u64,
     /// Compute dispatches recorded so far (all passes, all frames).
     dispatches: std::cell::Cell<u64>,
+    /// The reconstruction filters' pipelines, compiled on first use.
+    denoise: Option<denoise::Pipelines>,
 }
 
 impl GpuBackend {
@@ -121,6 +124,7 @@ impl GpuBackend {
             scene: None,
             static_uploads: 0,
             dispatches: Default::default(),
+            denoise: None,
         })
     }
 
@@ -354,6 +358,14 @@ fn refuse_unsupported(scene: &crate::scene::Scene) -> anyhow::Result<()> {
 impl Backend for GpuBackend {
     fn adapter(&self) -> &AdapterInfo {
         &self.info
+    }
+
+    fn reconstruct(
+        &mut self,
+        filter: super::denoise::Filter,
+        input: &super::denoise::Input,
+    ) -> anyhow::Result<(super::denoise::Output, f64)> {
+        self.filter(filter, input)
     }
 
     fn dispatches(&self) -> u64 {

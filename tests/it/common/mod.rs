@@ -246,9 +246,9 @@ impl penumbra::render::Backend for Flaky {
 }
 
 /// The sampling site the GPU's `disk_points` hook uses for pixel index `pixel` (light 0, an image
-/// 64 wide), for comparing it with the CPU's points.
-pub fn hook_site(seed: u32, pixel: u32) -> penumbra::sampling::Site {
-    penumbra::sampling::Site::pixel(seed, 0, [pixel % 64, pixel / 64], pixel)
+/// 64 wide) in frame `frame`, for comparing it with the CPU's points.
+pub fn hook_site(seed: u32, pixel: u32, frame: u32) -> penumbra::sampling::Site {
+    penumbra::sampling::Site::pixel(seed, 0, [pixel % 64, pixel / 64], pixel, frame)
 }
 
 /// Columns whose values come from the clock (timing phases, builds, updates).

@@ -2,8 +2,8 @@
 // sampler and the acceleration structure's queries to tests, bound at their own group 3.
 
 // Test hook: the unit-disk points a scheme gives pixel `params.height` (at column height % 64,
-// row height / 64 of a notional image 64 wide), for the CPU/GPU sampler agreement test. Writes
-// params.width points into `visibility`.
+// row height / 64 of a notional image 64 wide) in frame `params.frame`, for the CPU/GPU sampler
+// agreement test. Writes params.width points into `visibility`.
 @compute @workgroup_size(64)
 fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let k = gid.x;
@@ -12,7 +12,7 @@ fn dump_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let stream = stream_pixel(params.seed, 0u, params.height);
     let pixel = vec2<u32>(params.height % 64u, params.height / 64u);
-    let s = disk_point(params.scheme, params.width, k, stream, pixel, tile_seed(params.seed, 0u));
+    let s = disk_point(params.scheme, params.width, k, stream, pixel, tile_seed(params.seed, 0u), params.frame);
     visibility[2u * k] = s.x;
     visibility[2u * k + 1u] = s.y;
 }

@@ -26,6 +26,10 @@ struct Params {
     ao_mode: u32,
     ao_scheme: u32,
     ao_max_distance: f32,
+    frame: u32,
+    _f0: u32,
+    _f1: u32,
+    _f2: u32,
 }
 
 struct Light {
@@ -249,7 +253,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
                 if (params.shared_pattern != 0u) {
                     s = shared_points[light.shared_offset + k];
                 } else {
-                    s = disk_point(params.scheme, light.samples, k, stream, gid.xy, tile_seed(params.seed, li));
+                    s = disk_point(params.scheme, light.samples, k, stream, gid.xy, tile_seed(params.seed, li), params.frame);
                 }
                 let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
                 let d = q - p;
@@ -332,7 +336,7 @@ fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (params.shared_pattern != 0u) {
                 s = ao_dirs[k].xy;
             } else {
-                s = disk_point(params.ao_scheme, params.ao_rays, k, stream, gid.xy, tile_seed(params.seed, AMBIENT_STREAM));
+                s = disk_point(params.ao_scheme, params.ao_rays, k, stream, gid.xy, tile_seed(params.seed, AMBIENT_STREAM), params.frame);
             }
             let r2 = min(dot(s, s), 1.0);
             var l: vec3<f32>;

@@ -20,6 +20,14 @@ fn stream_pixel(seed: u32, light: u32, pixel: u32) -> u32 {
     return pcg(base ^ pcg(pixel + 0x1b56c4e9u));
 }
 
+// A key re-keyed for frame `frame` of a temporal sequence: unchanged at frame 0 (rng::at_frame).
+fn at_frame(key: u32, frame: u32) -> u32 {
+    if (frame == 0u) {
+        return key;
+    }
+    return pcg(key ^ pcg(frame + 0x2545f491u));
+}
+
 fn stream_u32(stream: u32, index: u32) -> u32 {
     return pcg(stream ^ pcg(index + 0x9e3779b9u));
 }
@@ -142,13 +150,17 @@ fn cp_shift(tile_seed: u32) -> vec2<u32> {
     return vec2<u32>(pcg(tile_seed ^ 0x0c9a5e01u) >> 8u, pcg(tile_seed ^ 0x5b1d93c7u) >> 8u);
 }
 
-// A pixel's Cranley-Patterson offset: the two masks' values plus the tile seed's shared shift,
-// 24-bit (bluenoise::offset).
-fn bluenoise_offset(pixel: vec2<u32>, tile_seed: u32) -> vec2<u32> {
+// The 2-D Kronecker (R2) steps a pixel's offset takes per frame, 24-bit (bluenoise::R2_STEP).
+const R2_STEP: vec2<u32> = vec2<u32>(12664746u, 9560334u);
+
+// A pixel's Cranley-Patterson offset in frame `frame`: the two masks' values plus the tile
+// seed's shared shift plus `frame` R2 steps, 24-bit (bluenoise::offset_at).
+fn bluenoise_offset(pixel: vec2<u32>, tile_seed: u32, frame: u32) -> vec2<u32> {
     let i = tile_index(pixel, tile_seed);
     let m = scheme_tables[1];
     let mask = vec2<u32>(scheme_tables[m + i], scheme_tables[m + BLUE_TILE * BLUE_TILE + i]);
-    return (mask + cp_shift(tile_seed)) & vec2<u32>(0x00ffffffu);
+    let o = (mask + cp_shift(tile_seed)) & vec2<u32>(0x00ffffffu);
+    return (o + frame * R2_STEP) & vec2<u32>(0x00ffffffu);
 }
 
 // Where the scramble table serving n rays starts in scheme_tables, or 0 (the header's place,
@@ -196,8 +208,12 @@ fn points_point(k: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
 }
 
 // Sample k of n on the unit disk for the pixel at `pixel` under the tile shift of `tile_seed`,
-// drawing its randomness from `stream` (see DiskScheme::point and Site).
-fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
+// drawing its randomness from `stream` (as at frame 0), in frame `frame` of a temporal sequence
+// (see DiskScheme::point and Site): progressive sequences continue at index frame n + k,
+// random schemes re-key their stream, bluenoise-cp moves its offset, points re-key the tile seed.
+fn disk_point(scheme: u32, n: u32, k: u32, stream_0: u32, pixel: vec2<u32>, tile_seed: u32, frame: u32) -> vec2<f32> {
+    let stream = at_frame(stream_0, frame);
+    let index = frame * n + k;
     switch scheme {
         case SCHEME_UNIFORM: {
             let u = stream_unit(stream, 2u * k);
@@ -223,7 +239,7 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_s
             return concentric(u, v);
         }
         case SCHEME_SOBOL: {
-            let s = scrambled_sobol_2d(k, stream_u32(stream, 0x7fffffffu));
+            let s = scrambled_sobol_2d(index, stream_u32(stream_0, 0x7fffffffu));
             return concentric(to_unit(s.x), to_unit(s.y));
         }
         case SCHEME_SPIRAL: {
@@ -233,12 +249,12 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_s
             return polar(r, TAU * to_unit(turn));
         }
         case SCHEME_PMJ02: {
-            let shift = vec2<u32>(stream_u32(stream, 0x7ffffffcu) >> 8u, stream_u32(stream, 0x7ffffffbu) >> 8u);
-            let p = pmj02_point(k, shift);
+            let shift = vec2<u32>(stream_u32(stream_0, 0x7ffffffcu) >> 8u, stream_u32(stream_0, 0x7ffffffbu) >> 8u);
+            let p = pmj02_point(index, shift);
             return concentric(p.x, p.y);
         }
         case SCHEME_BLUENOISE_CP: {
-            let o = bluenoise_offset(pixel, tile_seed);
+            let o = bluenoise_offset(pixel, tile_seed, frame);
             let sx = reverseBits(k) >> 8u;
             let sy = sobol_dim1(k) >> 8u;
             let u = to_unit(((sx + o.x) & 0x00ffffffu) << 8u);
@@ -252,11 +268,11 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream: u32, pixel: vec2<u32>, tile_s
                 // NaN, which no test or metric mistakes for a point.
                 return vec2<f32>(bitcast<f32>(0x7fc00000u));
             }
-            let s = scrambled_sobol_2d(k, scheme_tables[table + tile_index(pixel, tile_seed)]);
+            let s = scrambled_sobol_2d(index, scheme_tables[table + tile_index(pixel, tile_seed)]);
             return concentric(to_unit(s.x), to_unit(s.y));
         }
         case SCHEME_POINTS: {
-            return points_point(k, pixel, tile_seed);
+            return points_point(k, pixel, at_frame(tile_seed, frame));
         }
         default: {
             // An id no scheme has: NaN, which no test or metric mistakes for a point.

@@ -1,0 +1,610 @@
+//! Outputs of a real-time experiment: runs.csv (one row per pipeline, frame count and seed),
+//! summary.csv (means with 95 % intervals over seeds, lag, frame time), timings.csv, a plot of
+//! error against frames, report.md with the verdict at fixed frame-time budgets, and the page
+//! with every filter's picture beside the exact image.
+
+use super::runner::{Outcome, Picture, Row, Series, Timed, REFERENCE};
+use super::spec::RealtimeSpec;
+use crate::experiment::sweep::reference::has_exact_answer;
+use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, RULE};
+use crate::experiment::RunContext;
+use crate::files::write_atomic;
+use crate::metrics::stats::{mean_ci, MeanCi};
+use crate::output::page::{self, Gallery, Page, Shot, Tone};
+use crate::output::plots::{line_plot, Axes, Series as PlotSeries};
+use crate::output::table::write_rows;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// One pipeline at one frame count over its seeds: a row of summary.csv.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub variant: String,
+    pub scheme: String,
+    pub rays: u32,
+    pub frames: u32,
+    pub accumulation: String,
+    pub filter: String,
+    pub seeds: usize,
+    pub rmse: f64,
+    pub rmse_ci95: f64,
+    pub flip: f64,
+    pub flip_ci95: f64,
+    /// Width over the exact width.
+    pub width_ratio: f64,
+    pub width_ratio_ci95: f64,
+    pub area_ratio: f64,
+    pub lost_share: f64,
+    pub stability: f64,
+    pub stability_ci95: f64,
+    /// Moving variant: the most frames any seed took after the stop to come down to the lag
+    /// bound ([`lag`]); NaN when a seed never did (censored at the last frame).
+    pub lag_frames: f64,
+    /// Seeds that never came within the bound.
+    pub lag_censored: usize,
+    /// Render plus filter per frame, median and 95 % interval over rounds (s).
+    pub frame_s: f64,
+    pub frame_s_lo: f64,
+    pub frame_s_hi: f64,
+    pub shadow_rays: u64,
+    pub taps_per_pixel: f64,
+}
+
+/// A timed slot as a row of timings.csv.
+#[derive(Serialize)]
+struct TimingRow<'a> {
+    what: &'a str,
+    scheme: &'a str,
+    rays: u32,
+    filter: &'a str,
+    frame_s: f64,
+    frame_s_lo: f64,
+    frame_s_hi: f64,
+    timed_frames: usize,
+    work: u64,
+    work_unit: &'a str,
+}
+
+/// Everything the units measured.
+struct Measured {
+    rows: Vec<Row>,
+    series: Vec<Series>,
+    pictures: Vec<Picture>,
+    slots: Vec<Timed>,
+}
+
+fn gather(outcomes: Vec<Outcome>) -> Measured {
+    let mut m = Measured {
+        rows: vec![],
+        series: vec![],
+        pictures: vec![],
+        slots: vec![],
+    };
+    for o in outcomes {
+        match o {
+            Outcome::Measured { rows, series, pictures } => {
+                m.rows.extend(rows);
+                m.series.extend(series);
+                m.pictures.extend(pictures);
+            }
+            Outcome::Timed { slots } => m.slots.extend(slots),
+        }
+    }
+    m
+}
+
+impl Measured {
+    /// Per-round seconds of a pipeline's frame: its render plus its filter (none: nothing).
+    fn frame_seconds(&self, scheme: &str, rays: u32, filter: &str) -> Option<Vec<f64>> {
+        let render = self
+            .slots
+            .iter()
+            .find(|s| s.what == "render" && s.scheme == scheme && s.rays == rays)?;
+        if filter == "none" {
+            return Some(render.seconds.clone());
+        }
+        let f = self.slots.iter().find(|s| s.what == "filter" && s.filter == filter)?;
+        Some(render.seconds.iter().zip(&f.seconds).map(|(a, b)| a + b).collect())
+    }
+}
+
+fn of(v: &[f64]) -> MeanCi {
+    mean_ci(v)
+}
+
+/// summary.csv's rows, in runs.csv's order of first appearance.
+fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
+    let mut keys: Vec<(String, String, u32, u32, String, String)> = Vec::new();
+    for r in &m.rows {
+        let k = (
+            r.variant.clone(),
+            r.scheme.clone(),
+            r.rays,
+            r.frames,
+            r.accumulation.clone(),
+            r.filter.clone(),
+        );
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.iter()
+        .map(|(variant, scheme, rays, frames, acc, filter)| {
+            let rows: Vec<&Row> = m
+                .rows
+                .iter()
+                .filter(|r| {
+                    &r.variant == variant
+                        && &r.scheme == scheme
+                        && r.rays == *rays
+                        && r.frames == *frames
+                        && &r.accumulation == acc
+                        && &r.filter == filter
+                })
+                .collect();
+            let col = |f: fn(&Row) -> f64| rows.iter().map(|r| f(r)).collect::<Vec<f64>>();
+            let (rmse, flip) = (of(&col(|r| r.rmse)), of(&col(|r| r.flip)));
+            let width = of(&col(|r| r.width_px / r.exact_width_px));
+            let stability = of(&col(|r| r.stability));
+            let (lag_frames, lag_censored) = match variant.as_str() {
+                "moving" => lag(spec, m, scheme, *rays, acc, filter),
+                _ => (f64::NAN, 0),
+            };
+            let time = m
+                .frame_seconds(scheme, *rays, filter)
+                .map_or(Estimate::NAN, |s| median_interval(&s));
+            Summary {
+                variant: variant.clone(),
+                scheme: scheme.clone(),
+                rays: *rays,
+                frames: *frames,
+                accumulation: acc.clone(),
+                filter: filter.clone(),
+                seeds: rows.len(),
+                rmse: rmse.mean,
+                rmse_ci95: rmse.ci95,
+                flip: flip.mean,
+                flip_ci95: flip.ci95,
+                width_ratio: width.mean,
+                width_ratio_ci95: width.ci95,
+                area_ratio: of(&col(|r| r.area_ratio)).mean,
+                lost_share: of(&col(|r| r.lost_share)).mean,
+                stability: stability.mean,
+                stability_ci95: stability.ci95,
+                lag_frames,
+                lag_censored,
+                frame_s: time.median,
+                frame_s_lo: time.lo,
+                frame_s_hi: time.hi,
+                shadow_rays: rows.first().map_or(0, |r| r.shadow_rays),
+                taps_per_pixel: rows.first().map_or(0.0, |r| r.taps_per_pixel),
+            }
+        })
+        .collect()
+}
+
+/// Lag of a moving pipeline: per seed, the frames after the occluder stops until its error
+/// against the current exact image is down to the bound `settled + lag_fraction (stop -
+/// settled)`, where `stop` is its error at the stop and `settled` the same pipeline's static
+/// error at the last frame count (same seed); the most over seeds, and how many seeds never got
+/// there.
+fn lag(spec: &RealtimeSpec, m: &Measured, scheme: &str, rays: u32, acc: &str, filter: &str) -> (f64, usize) {
+    let last = spec.max_frames();
+    let (mut worst, mut censored) = (0.0f64, 0usize);
+    let mut any = false;
+    for s in m
+        .series
+        .iter()
+        .filter(|s| s.scheme == scheme && s.rays == rays && s.accumulation == acc && s.filter == filter)
+    {
+        let Some(settled) = m.rows.iter().find(|r| {
+            r.variant == "static"
+                && r.scheme == scheme
+                && r.rays == rays
+                && r.frames == last
+                && r.accumulation == acc
+                && r.filter == filter
+                && r.seed == s.seed
+        }) else {
+            return (f64::NAN, 0);
+        };
+        let Some(&at_stop) = s.rmse.first() else {
+            return (f64::NAN, 0);
+        };
+        any = true;
+        let bound = settled.rmse + spec.lag_fraction * (at_stop - settled.rmse).max(0.0);
+        match s.rmse.iter().position(|&e| e <= bound) {
+            Some(k) => worst = worst.max(k as f64),
+            None => censored += 1,
+        }
+    }
+    match (any, censored) {
+        (false, _) => (f64::NAN, 0),
+        (true, 0) => (worst, 0),
+        (true, c) => (f64::NAN, c),
+    }
+}
+
+fn show(m: f64, ci: f64, digits: usize) -> String {
+    if m.is_nan() {
+        "n/a".into()
+    } else if ci.is_nan() {
+        format!("{m:.digits$}")
+    } else {
+        format!("{m:.digits$} +- {ci:.digits$}")
+    }
+}
+
+fn pipeline(s: &Summary) -> String {
+    format!(
+        "{} x {} ray(s), {} frame(s), {}, {}",
+        s.scheme, s.rays, s.frames, s.accumulation, s.filter
+    )
+}
+
+/// The verdict at one budget: the least-error static pipeline that is not slower than the budget
+/// frame and keeps its width within the tolerance.
+fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme: &str, rays: u32) -> String {
+    let mut out = String::new();
+    let Some(budget) = m.frame_seconds(scheme, rays, "none") else {
+        return format!("- budget {scheme} x {rays} raw: not run (filtered out)\n");
+    };
+    let b = median_interval(&budget).scaled(1e3);
+    let _ = writeln!(
+        out,
+        "\n### Budget: one raw frame of {scheme} x {rays} ray(s), {} ms [{:.3}, {:.3}]\n",
+        show(b.median, f64::NAN, 3),
+        b.lo,
+        b.hi
+    );
+    let mut eligible: Vec<(&Summary, Estimate)> = summary
+        .iter()
+        .filter(|s| s.variant == "static")
+        .filter_map(|s| {
+            let t = m.frame_seconds(&s.scheme, s.rays, &s.filter)?;
+            let ratio = paired_ratio(&t, &budget);
+            (Comparison::of(&ratio) != Comparison::Slower).then_some((s, ratio))
+        })
+        .collect();
+    let within = |s: &Summary| (s.width_ratio - 1.0).abs() <= spec.width_tolerance;
+    eligible.sort_by(|a, b| a.0.rmse.total_cmp(&b.0.rmse));
+    let _ = writeln!(
+        out,
+        "Pipelines whose frame (render + filter) is not slower than the budget by the timing rule, least RMSE first; width within {:.0} % of exact marked ok:\n",
+        100.0 * spec.width_tolerance
+    );
+    let _ = writeln!(
+        out,
+        "| pipeline | RMSE | FLIP | width / exact | time / budget | width ok |"
+    );
+    let _ = writeln!(out, "| --- | --- | --- | --- | --- | --- |");
+    for (s, ratio) in eligible.iter().take(8) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} |",
+            pipeline(s),
+            show(s.rmse, s.rmse_ci95, 4),
+            show(s.flip, s.flip_ci95, 4),
+            show(s.width_ratio, s.width_ratio_ci95, 3),
+            ratio.show_ratio(2),
+            if within(s) { "ok" } else { "no" }
+        );
+    }
+    match eligible.iter().find(|(s, _)| within(s)) {
+        Some((s, ratio)) => {
+            let _ = writeln!(
+                out,
+                "\n**Answer:** at this budget the least error with the width within {:.0} % is **{}**: RMSE {}, width {} of exact, time {} of the budget.",
+                100.0 * spec.width_tolerance,
+                pipeline(s),
+                show(s.rmse, s.rmse_ci95, 4),
+                show(s.width_ratio, s.width_ratio_ci95, 3),
+                ratio.show_ratio(2)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "\n**Answer:** no pipeline within this budget keeps the width within {:.0} % of exact.",
+                100.0 * spec.width_tolerance
+            );
+        }
+    }
+    out
+}
+
+/// The paper's claim restated: 16 raw rays of its pattern in one frame against 1-4 rays of blue
+/// noise accumulated and filtered, per frame count: paired differences over the same seeds.
+fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> String {
+    let mut out = String::from("\n## The paper's claim restated\n\n");
+    let paper: Vec<&Row> = m
+        .rows
+        .iter()
+        .filter(|r| r.variant == "static" && r.scheme == "paper" && r.rays == 16 && r.frames == 1 && r.filter == "none")
+        .collect();
+    let first_acc = spec.accumulations.first().map(|a| a.name()).unwrap_or("mean");
+    let paper: Vec<&Row> = paper.into_iter().filter(|r| r.accumulation == first_acc).collect();
+    if paper.is_empty() {
+        out += "Not answered: the paper's pipeline (paper x 16 rays, 1 frame, no filter) is not in this run.\n";
+        return out;
+    }
+    let blue = ["bluenoise-cp", "sobol-bluenoise"];
+    let _ = writeln!(
+        out,
+        "Does 16 raw rays of the paper's pattern (one frame, no filter) beat 1-4 rays of blue noise accumulated and filtered? For each frame count, the blue-noise pipeline with the least mean RMSE (any scheme of {}, rays <= 4, any accumulation and filter) against the paper's, by the paired per-seed difference (blue noise - paper) with its 95 % interval; a word needs the interval to exclude 0. (The candidate is chosen on the same seeds it is judged on, which favours it slightly.)\n",
+        blue.join(", ")
+    );
+    let _ = writeln!(out, "| frames | blue-noise pipeline | RMSE difference | quality | width / exact (blue; paper) | closer to the exact width |");
+    let _ = writeln!(out, "| --- | --- | --- | --- | --- | --- |");
+    let paper_width = of(&paper.iter().map(|r| r.width_px / r.exact_width_px).collect::<Vec<_>>());
+    for &frames in &spec.frames {
+        let best = summary
+            .iter()
+            .filter(|s| s.variant == "static" && blue.contains(&s.scheme.as_str()) && s.rays <= 4 && s.frames == frames)
+            .min_by(|a, b| a.rmse.total_cmp(&b.rmse));
+        let Some(best) = best else { continue };
+        let diffs: Vec<f64> = paper
+            .iter()
+            .filter_map(|p| {
+                m.rows
+                    .iter()
+                    .find(|r| {
+                        r.variant == "static"
+                            && r.scheme == best.scheme
+                            && r.rays == best.rays
+                            && r.frames == frames
+                            && r.accumulation == best.accumulation
+                            && r.filter == best.filter
+                            && r.seed == p.seed
+                    })
+                    .map(|r| r.rmse - p.rmse)
+            })
+            .collect();
+        let d = of(&diffs);
+        let word = if d.ci95.is_nan() {
+            "not clearly (too few seeds for an interval)"
+        } else if d.mean + d.ci95 < 0.0 {
+            "blue noise better"
+        } else if d.mean - d.ci95 > 0.0 {
+            "paper better"
+        } else {
+            "equal within noise"
+        };
+        let wider = if (best.width_ratio - 1.0).abs() < (paper_width.mean - 1.0).abs() {
+            "blue noise closer to exact"
+        } else {
+            "paper closer to exact"
+        };
+        let _ = writeln!(
+            out,
+            "| {frames} | {} | {} | {word} | {}; {} | {wider} |",
+            pipeline(best),
+            show(d.mean, d.ci95, 4),
+            show(best.width_ratio, best.width_ratio_ci95, 3),
+            show(paper_width.mean, paper_width.ci95, 3),
+        );
+    }
+    out
+}
+
+/// Writes every output into the run's staging folder.
+pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
+    let dir = run.out.dir();
+    let m = gather(outcomes);
+    write_rows(&dir.join("runs.csv"), m.rows.iter())?;
+    let summary = summarise(spec, &m);
+    write_rows(&dir.join("summary.csv"), summary.iter())?;
+    write_rows(
+        &dir.join("timings.csv"),
+        m.slots.iter().map(|s| TimingRow {
+            what: &s.what,
+            scheme: &s.scheme,
+            rays: s.rays,
+            filter: &s.filter,
+            frame_s: s.time.median,
+            frame_s_lo: s.time.lo,
+            frame_s_hi: s.time.hi,
+            timed_frames: s.seconds.len(),
+            work: s.work,
+            work_unit: &s.work_unit,
+        }),
+    )?;
+    plot(spec, &summary, dir)?;
+    let adapter = run.backend.adapter().clone();
+    let mut md = format!(
+        "# Real-time soft shadows: {}\n\n{} at {} x {} px on {} ({}); {} seed(s); frames judged at {:?}; EMA alpha {}; filters: {}.\n",
+        spec.header.name,
+        spec.scene_path.display(),
+        spec.width,
+        spec.height,
+        adapter.name,
+        adapter.backend,
+        spec.seeds.len(),
+        spec.frames,
+        spec.accumulations
+            .iter()
+            .find_map(|a| match a {
+                crate::render::denoise::Accumulation::Ema(alpha) => Some(alpha.to_string()),
+                _ => None,
+            })
+            .unwrap_or("-".into()),
+        spec.filters.iter().map(|f| f.name()).collect::<Vec<_>>().join(", ")
+    );
+    md += "\nErrors are against the exact image of the current frame (quadrature) over its penumbra, or against a high-sample render where the scene has no exact answer; width is the 10-90 % width across the exact half-shadow contour (metrics::edge); means +- 95 % intervals over seeds. Frame time = render + filter, medians over interleaved rounds with 95 % intervals; ";
+    md += RULE;
+    md += "\n\n## Verdict at a fixed frame-time budget\n";
+    for (scheme, rays) in &spec.budgets {
+        md += &budget_section(spec, &m, &summary, scheme.name(), *rays);
+    }
+    md += &claim_section(spec, &m, &summary);
+    md += &cost_section(&m);
+    md += &lag_section(spec, &summary);
+    md += "\n![RMSE against frames](plots/rmse_frames.svg)\n";
+    write_atomic(&dir.join("report.md"), md.as_bytes())?;
+    let galleries = galleries(spec, &m);
+    for g in &galleries {
+        page::write_shots(dir, g)?;
+    }
+    page::write(
+        dir,
+        &Page {
+            title: format!("{} (realtime)", spec.header.name),
+            report: md,
+            galleries,
+        },
+    )?;
+    let mut details = toml::Table::new();
+    details.insert("rows".into(), (m.rows.len() as i64).into());
+    details.insert("timed_slots".into(), (m.slots.len() as i64).into());
+    Ok(details)
+}
+
+fn cost_section(m: &Measured) -> String {
+    let mut out = String::from("\n## Cost per frame\n\n| what | median ms [95 %] | work |\n| --- | --- | --- |\n");
+    for s in &m.slots {
+        let t = s.time.scaled(1e3);
+        let name = match s.what.as_str() {
+            "render" => format!("render {} x {} ray(s)", s.scheme, s.rays),
+            _ => format!("filter {}", s.filter),
+        };
+        let _ = writeln!(out, "| {name} | {} | {} {} |", t.show(3), s.work, s.work_unit);
+    }
+    out
+}
+
+fn lag_section(spec: &RealtimeSpec, summary: &[Summary]) -> String {
+    let Some(motion) = &spec.motion else {
+        return String::new();
+    };
+    let last = spec.max_frames();
+    let rows: Vec<&Summary> = summary
+        .iter()
+        .filter(|s| s.variant == "moving" && s.frames == last)
+        .collect();
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut out = format!(
+        "\n## Moving occluder: lag\n\nThe sphere moves {:.4} m per frame for {} frames, then stops. Lag: frames after the stop until the error against the current exact image has shed {:.0} % of its excess at the stop over the same pipeline's static error at {last} frames (the ghost's decay; most over seeds; `never` when a seed is still above the bound at frame {last}).\n\n| pipeline | lag (frames) | RMSE at {last} | stability |\n| --- | --- | --- | --- |\n",
+        motion.step.length(),
+        motion.frames,
+        100.0 * (1.0 - spec.lag_fraction)
+    );
+    for s in rows {
+        let lag = match s.lag_censored {
+            0 => show(s.lag_frames, f64::NAN, 0),
+            c => format!("never ({c} seed(s))"),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {lag} | {} | {} |",
+            pipeline(s),
+            show(s.rmse, s.rmse_ci95, 4),
+            show(s.stability, s.stability_ci95, 4)
+        );
+    }
+    out
+}
+
+/// RMSE against frames on the static variant at the fewest rays, one line per (scheme, filter)
+/// at the first accumulation.
+fn plot(spec: &RealtimeSpec, summary: &[Summary], dir: &std::path::Path) -> anyhow::Result<()> {
+    let acc = spec.accumulations.first().map(|a| a.name()).unwrap_or("mean");
+    let mut lines: Vec<(usize, PlotSeries)> = Vec::new();
+    let rays = spec.rays[0];
+    for s in summary
+        .iter()
+        .filter(|s| s.variant == "static" && s.accumulation == acc && s.rays == rays)
+    {
+        let name = format!("{}, {}", s.scheme, s.filter);
+        match lines.iter_mut().find(|(_, l)| l.name == name) {
+            Some((_, l)) => l.points.push((s.frames as f64, s.rmse, s.rmse_ci95)),
+            None => {
+                let i = lines.len();
+                lines.push((
+                    i,
+                    PlotSeries {
+                        name,
+                        points: vec![(s.frames as f64, s.rmse, s.rmse_ci95)],
+                        dashed: s.filter == "none",
+                    },
+                ))
+            }
+        }
+    }
+    std::fs::create_dir_all(dir.join("plots"))?;
+    line_plot(
+        &dir.join("plots/rmse_frames.svg"),
+        &Axes {
+            title: &format!("static, {rays} ray(s) a frame: RMSE against exact over the penumbra ({acc})"),
+            x: "frames accumulated",
+            y: "RMSE",
+            log_x: true,
+            log_y: true,
+            x_range: None,
+        },
+        &lines,
+        &[],
+    )
+}
+
+/// Per variant: the exact image, then every picture the units kept (first seed, first
+/// accumulation, at the first and last frame counts).
+fn galleries(spec: &RealtimeSpec, m: &Measured) -> Vec<Gallery> {
+    let mut out = Vec::new();
+    for &variant in &spec.variants {
+        let of_variant = |p: &&Picture| p.variant == variant.name();
+        let Some(reference) = m.pictures.iter().filter(of_variant).find(|p| p.filter == REFERENCE) else {
+            continue;
+        };
+        let exact = has_exact_answer(&spec.scene);
+        let mut shots = vec![Shot {
+            label: format!("exact ({})", if exact { "quadrature" } else { "high-sample render" }),
+            exr: format!("images/{}_exact.exr", variant.name()),
+            png: format!("images/{}_exact.png", variant.name()),
+            values: reference.values.clone(),
+            key: vec![("variant".into(), variant.name().into())],
+        }];
+        for p in m.pictures.iter().filter(of_variant).filter(|p| p.filter != REFERENCE) {
+            let stem = format!(
+                "{}_{}_{}_{}f_{}_{}",
+                variant.name(),
+                p.scheme,
+                p.rays,
+                p.frames,
+                p.accumulation,
+                p.filter
+            );
+            shots.push(Shot {
+                label: format!(
+                    "{} x {}, {} frame(s), {}, {}",
+                    p.scheme, p.rays, p.frames, p.accumulation, p.filter
+                ),
+                exr: format!("images/{stem}.exr"),
+                png: format!("images/{stem}.png"),
+                values: p.values.clone(),
+                key: vec![
+                    ("variant".into(), p.variant.clone()),
+                    ("scheme".into(), p.scheme.clone()),
+                    ("rays".into(), p.rays.to_string()),
+                    ("frames".into(), p.frames.to_string()),
+                    ("accumulation".into(), p.accumulation.clone()),
+                    ("filter".into(), p.filter.clone()),
+                ],
+            });
+        }
+        out.push(Gallery {
+            title: format!(
+                "{}: receiver plane, seed {}: the fewest rays after every frame with each filter, and one raw frame of the most rays",
+                variant.name(),
+                spec.seeds[0]
+            ),
+            width: spec.width,
+            height: spec.height,
+            tone: Tone::Linear,
+            reference: Some(0),
+            shots,
+        });
+    }
+    out
+}

@@ -1,0 +1,516 @@
+//! One real-time unit measured: every seed's frames rendered in sequence (frame f draws the
+//! scheme's samples at f), accumulated, filtered at each judged frame count and measured against
+//! the exact image of the current frame; or the timing unit, every render and filter timed in
+//! interleaved rounds.
+
+use super::reference::{RefFrame, References};
+use super::spec::{RealtimeSpec, Variant};
+use crate::experiment::progress::Progress;
+use crate::experiment::sweep::reference::shadow_image;
+use crate::experiment::timing::{median_interval, Estimate};
+use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
+use crate::metrics::{penumbra_coverage, ErrorMetrics};
+use crate::output::images::grey;
+use crate::render::denoise::penumbra::{blocker_distance, kernel_sigma};
+use crate::render::denoise::{Accumulation, Accumulator, Filter, GBuffer, Input};
+use crate::render::shading::Receiver;
+use crate::render::{Backend, Sampling, View};
+use crate::sampling::{DiskScheme, Pattern, Site};
+use crate::scene::{Light, Scene};
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+/// One pipeline at one frame count and seed: a row of runs.csv.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Row {
+    pub variant: String,
+    pub scheme: String,
+    pub rays: u32,
+    pub frames: u32,
+    pub accumulation: String,
+    pub filter: String,
+    pub seed: u32,
+    /// RMSE against the current frame's exact image over its penumbra.
+    pub rmse: f64,
+    /// Mean FLIP of the grey picture against the exact one.
+    pub flip: f64,
+    /// 10-90 % width across the exact half-shadow contour, pixels ([`crate::metrics::edge`]).
+    pub width_px: f64,
+    /// The exact image's.
+    pub exact_width_px: f64,
+    /// Penumbra area (EPS < V < 1 - EPS) over the exact image's.
+    pub area_ratio: f64,
+    /// Share of the exact penumbra shown fully lit or dark.
+    pub lost_share: f64,
+    /// RMS change from the previous frame's output over the penumbra where the exact image did
+    /// not change (NaN at one frame).
+    pub stability: f64,
+    /// Shadow rays per frame.
+    pub shadow_rays: u64,
+    /// Filter taps per receiver pixel.
+    pub taps_per_pixel: f64,
+    /// The device that rendered and filtered (its f32 rounding is in every number).
+    pub adapter: String,
+    /// Its driver.
+    pub driver: String,
+}
+
+/// A moving run's error after the occluder stops, one value per frame: what lag is read from.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Series {
+    pub scheme: String,
+    pub rays: u32,
+    pub accumulation: String,
+    pub filter: String,
+    pub seed: u32,
+    /// RMSE at frames stop, stop + 1, ..., the last.
+    pub rmse: Vec<f64>,
+}
+
+/// An output image kept for the page (first seed, first accumulation): at the fewest rays after
+/// the last frame count with each filter, and one raw frame at the most rays (the paper's use).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Picture {
+    pub variant: String,
+    pub scheme: String,
+    pub rays: u32,
+    pub frames: u32,
+    pub accumulation: String,
+    pub filter: String,
+    /// Visibility on the receiver plane, row-major.
+    pub values: Vec<f32>,
+}
+
+/// The `filter` of the picture that holds the reference itself (exact, or the high-sample
+/// render where the scene has none).
+pub const REFERENCE: &str = "reference";
+
+/// One timed slot: a render of (scheme, rays) or a filter.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Timed {
+    /// `render` or `filter`.
+    pub what: String,
+    pub scheme: String,
+    pub rays: u32,
+    pub filter: String,
+    /// Seconds per round.
+    pub seconds: Vec<f64>,
+    pub time: Estimate,
+    /// Shadow rays of a render; taps of a filter.
+    pub work: u64,
+    pub work_unit: String,
+}
+
+/// What a unit yields.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum Outcome {
+    /// A measured (variant, scheme, rays) unit.
+    Measured {
+        rows: Vec<Row>,
+        series: Vec<Series>,
+        pictures: Vec<Picture>,
+    },
+    /// The timing unit.
+    Timed { slots: Vec<Timed> },
+}
+
+/// Per light, per pixel: the distance to the blocker met by the frame's first shadow ray.
+fn blockers(scene: &Scene, receivers: &[Option<Receiver>], sampling: Sampling, rays: u32, width: u32) -> Vec<Vec<f64>> {
+    use rayon::prelude::*;
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(l, light)| {
+            let Light::Disk(d) = light else {
+                return vec![f64::NAN; receivers.len()];
+            };
+            let (u, v) = d.basis();
+            receivers
+                .par_iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let Some(r) = r else { return f64::NAN };
+                    let p = i as u32;
+                    let site = Site::pixel(sampling.seed, l as u32, [p % width, p / width], p, sampling.frame);
+                    let s = sampling.scheme.point(rays, 0, site);
+                    let target = d.center + d.radius * (u * s.x + v * s.y);
+                    blocker_distance(scene, r, target).unwrap_or(f64::NAN)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The reference pixels only: everything else [`crate::render::NO_RECEIVER`], so metrics see
+/// the receiver plane.
+fn on_receivers(image: &[f32], reference: &RefFrame) -> Vec<f32> {
+    let mut out = vec![crate::render::NO_RECEIVER; image.len()];
+    for &(i, _) in &reference.receivers.pixels {
+        out[i] = image[i];
+    }
+    out
+}
+
+/// What one seed's pipeline state holds per accumulation.
+struct History {
+    accumulation: Accumulation,
+    image: Accumulator,
+    /// One per light, for the blocker estimate.
+    blockers: Vec<Accumulator>,
+}
+
+/// Measures one (variant, scheme, rays) unit over every seed.
+pub fn measure(
+    spec: &RealtimeSpec,
+    refs: &References,
+    variant: Variant,
+    scheme: DiskScheme,
+    rays: u32,
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<Outcome> {
+    let (w, h) = (spec.width, spec.height);
+    let last = spec.max_frames();
+    let stop = match variant {
+        Variant::Moving => spec.motion.as_ref().map_or(0, |m| m.frames),
+        Variant::Static => u32::MAX,
+    };
+    let penumbra = spec.filters.contains(&Filter::Penumbra);
+    let (mut rows, mut series, mut pictures) = (Vec::new(), Vec::new(), Vec::new());
+    let bar = progress.bar(
+        &format!("{} {scheme} {rays} rays", variant.name()),
+        spec.seeds.len() as u64 * last as u64,
+    );
+    for &seed in &spec.seeds {
+        let mut histories: Vec<History> = spec
+            .accumulations
+            .iter()
+            .map(|&a| History {
+                accumulation: a,
+                image: Accumulator::new(a, (w * h) as usize),
+                blockers: spec
+                    .scene
+                    .lights
+                    .iter()
+                    .map(|_| Accumulator::new(a, (w * h) as usize))
+                    .collect(),
+            })
+            .collect();
+        // Per (accumulation, filter): the previous frame's output and the errors after the stop.
+        let mut previous: Vec<Option<Vec<f32>>> = vec![None; histories.len() * spec.filters.len()];
+        let mut after_stop: Vec<Vec<f64>> = vec![vec![]; histories.len() * spec.filters.len()];
+        for f in 0..last {
+            let frames = f + 1;
+            let scene = RealtimeSpec::with_rays(&spec.scene_at(variant, f), rays);
+            let view = View {
+                camera: &scene.cameras[&spec.camera],
+                width: w,
+                height: h,
+            };
+            let sampling = Sampling {
+                scheme,
+                pattern: Pattern::PerPixel,
+                seed,
+                frame: f,
+            };
+            let frame = backend
+                .render(&scene, view, sampling)
+                .with_context(|| format!("frame {f}"))?;
+            let image = shadow_image(&frame.visibility);
+            let guides = refs.guides(spec, variant, f)?;
+            let blocker = match penumbra {
+                true => blockers(&scene, &guides.receivers, sampling, rays, w),
+                false => vec![vec![f64::NAN; image.len()]; scene.lights.len()],
+            };
+            for hist in &mut histories {
+                hist.image.add(&image, &blocker[0]);
+                for (acc, b) in hist.blockers.iter_mut().zip(&blocker) {
+                    acc.add(&image, b);
+                }
+            }
+            let judged = spec.frames.contains(&frames);
+            let before_judged = spec.frames.contains(&(frames + 1)) && frames >= 1;
+            let settled = frames > stop;
+            if !(judged || before_judged || settled) {
+                bar.inc(1);
+                continue;
+            }
+            let reference = refs.reference(spec, variant, f, backend)?;
+            for (a, hist) in histories.iter().enumerate() {
+                let accumulated = hist.image.image();
+                let variance = hist.image.variance_or_spatial(w, h);
+                let sigma = match penumbra {
+                    true => pixel_sigma(spec, &scene, &guides.gbuffer, &hist.blockers),
+                    false => vec![0.0; accumulated.len()],
+                };
+                for (k, &filter) in spec.filters.iter().enumerate() {
+                    let input = Input {
+                        width: w,
+                        height: h,
+                        image: &accumulated,
+                        variance: &variance,
+                        gbuffer: &guides.gbuffer,
+                        sigma: &sigma,
+                        settings: spec.settings,
+                    };
+                    let (out, _) = backend
+                        .reconstruct(filter, &input)
+                        .with_context(|| format!("filter {filter}"))?;
+                    let slot = a * spec.filters.len() + k;
+                    let measured = on_receivers(&out.image, &reference);
+                    let rmse = ErrorMetrics::measure(&measured, &reference.image, &reference.mask).rmse;
+                    if settled {
+                        after_stop[slot].push(rmse);
+                    }
+                    if judged {
+                        let stability = match (&previous[slot], f) {
+                            (Some(prev), f) if f > 0 => {
+                                let before = refs.reference(spec, variant, f - 1, backend)?;
+                                stability(&measured, prev, &reference, &before)
+                            }
+                            _ => f64::NAN,
+                        };
+                        let (area_ratio, lost_share) =
+                            penumbra_coverage(&measured, &reference.mask, &reference.receivers);
+                        let flip = flip_mean(
+                            &grey(&reference.image, w, h).data,
+                            &grey(&measured, w, h).data,
+                            w,
+                            h,
+                            PIXELS_PER_DEGREE,
+                        )?;
+                        rows.push(Row {
+                            variant: variant.name().into(),
+                            scheme: scheme.name().into(),
+                            rays,
+                            frames,
+                            accumulation: hist.accumulation.name().into(),
+                            filter: filter.name().into(),
+                            seed,
+                            rmse,
+                            flip,
+                            width_px: reference.edge.width_10_90(&measured),
+                            exact_width_px: reference.width_px,
+                            area_ratio,
+                            lost_share,
+                            stability,
+                            shadow_rays: frame.rays.shadow_total(),
+                            taps_per_pixel: out.taps as f64 / reference.receivers.pixels.len().max(1) as f64,
+                            adapter: backend.adapter().name.clone(),
+                            driver: backend.adapter().driver.clone(),
+                        });
+                    }
+                    if seed == spec.seeds[0] && a == 0 && k == 0 && frames == last {
+                        pictures.push(Picture {
+                            variant: variant.name().into(),
+                            scheme: String::new(),
+                            rays: 0,
+                            frames,
+                            accumulation: String::new(),
+                            filter: REFERENCE.into(),
+                            values: reference.image.clone(),
+                        });
+                    }
+                    let fewest = rays == spec.rays[0] && frames == last;
+                    let raw = rays == *spec.rays.last().expect("validated") && frames == 1 && filter == Filter::None;
+                    let kept = seed == spec.seeds[0] && a == 0 && (fewest || raw);
+                    if judged && kept {
+                        pictures.push(Picture {
+                            variant: variant.name().into(),
+                            scheme: scheme.name().into(),
+                            rays,
+                            frames,
+                            accumulation: hist.accumulation.name().into(),
+                            filter: filter.name().into(),
+                            values: measured.clone(),
+                        });
+                    }
+                    previous[slot] = Some(measured);
+                }
+            }
+            bar.inc(1);
+        }
+        if variant == Variant::Moving {
+            for (a, hist) in histories.iter().enumerate() {
+                for (k, &filter) in spec.filters.iter().enumerate() {
+                    series.push(Series {
+                        scheme: scheme.name().into(),
+                        rays,
+                        accumulation: hist.accumulation.name().into(),
+                        filter: filter.name().into(),
+                        seed,
+                        rmse: std::mem::take(&mut after_stop[a * spec.filters.len() + k]),
+                    });
+                }
+            }
+        }
+    }
+    bar.finish();
+    Ok(Outcome::Measured { rows, series, pictures })
+}
+
+/// The penumbra filter's per-pixel sigma: the widest any light's blocker estimate asks for.
+fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[Accumulator]) -> Vec<f32> {
+    let mut sigma = vec![0f32; gbuffer.depth.len()];
+    for (light, acc) in scene.lights.iter().zip(blockers) {
+        let Light::Disk(d) = light else { continue };
+        let s = kernel_sigma(
+            acc.blocker(),
+            gbuffer,
+            d,
+            spec.width,
+            spec.height,
+            spec.settings.penumbra_scale,
+            spec.settings.penumbra_max_sigma,
+        );
+        for (a, b) in sigma.iter_mut().zip(s) {
+            *a = a.max(b);
+        }
+    }
+    sigma
+}
+
+/// RMS of the change between two outputs over the current penumbra where the exact image did not
+/// change between their frames; NaN where nothing qualifies.
+fn stability(now: &[f32], before: &[f32], reference: &RefFrame, earlier: &RefFrame) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for &i in &reference.mask.pixels {
+        if reference.image[i] == earlier.image[i] {
+            sum += (now[i] as f64 - before[i] as f64).powi(2);
+            n += 1;
+        }
+    }
+    if n == 0 {
+        f64::NAN
+    } else {
+        (sum / n as f64).sqrt()
+    }
+}
+
+/// The timing unit: every (scheme, rays) render of the static scene and every filter on a
+/// four-frame accumulation, one timed call each per interleaved round.
+pub fn time(
+    spec: &RealtimeSpec,
+    refs: &References,
+    backend: &mut dyn Backend,
+    progress: &Progress,
+) -> anyhow::Result<Outcome> {
+    let (w, h) = (spec.width, spec.height);
+    let schedule = spec.header.schedule;
+    let guides = refs.guides(spec, Variant::Static, 0)?;
+    let rays0 = spec.rays[0];
+    let scene0 = RealtimeSpec::with_rays(&spec.scene, rays0);
+    let mut image = Accumulator::new(Accumulation::Mean, (w * h) as usize);
+    let mut blocker_accs = vec![];
+    for f in 0..4 {
+        let sampling = Sampling {
+            scheme: spec.schemes[0],
+            pattern: Pattern::PerPixel,
+            seed: spec.seeds[0],
+            frame: f,
+        };
+        let view = View {
+            camera: &scene0.cameras[&spec.camera],
+            width: w,
+            height: h,
+        };
+        let frame = backend.render(&scene0, view, sampling)?;
+        let shadow = shadow_image(&frame.visibility);
+        let b = blockers(&scene0, &guides.receivers, sampling, rays0, w);
+        image.add(&shadow, &b[0]);
+        if blocker_accs.is_empty() {
+            blocker_accs = b
+                .iter()
+                .map(|_| Accumulator::new(Accumulation::Mean, (w * h) as usize))
+                .collect();
+        }
+        for (acc, bl) in blocker_accs.iter_mut().zip(&b) {
+            acc.add(&shadow, bl);
+        }
+    }
+    let accumulated = image.image();
+    let variance = image.variance_or_spatial(w, h);
+    let sigma = pixel_sigma(spec, &scene0, &guides.gbuffer, &blocker_accs);
+    let input = Input {
+        width: w,
+        height: h,
+        image: &accumulated,
+        variance: &variance,
+        gbuffer: &guides.gbuffer,
+        sigma: &sigma,
+        settings: spec.settings,
+    };
+    let mut slots = Vec::new();
+    let mut renders = Vec::new();
+    for &scheme in &spec.schemes {
+        for &rays in &spec.rays {
+            let scene = RealtimeSpec::with_rays(&spec.scene, rays);
+            let view = View {
+                camera: &scene.cameras[&spec.camera],
+                width: w,
+                height: h,
+            };
+            let sampling = Sampling {
+                scheme,
+                pattern: Pattern::PerPixel,
+                seed: spec.seeds[0],
+                frame: 0,
+            };
+            let shadow_rays = backend.render(&scene, view, sampling)?.rays.shadow_total();
+            slots.push(Timed {
+                what: "render".into(),
+                scheme: scheme.name().into(),
+                rays,
+                filter: String::new(),
+                seconds: vec![],
+                time: Estimate::NAN,
+                work: shadow_rays,
+                work_unit: "shadow rays".into(),
+            });
+            renders.push((scene, sampling));
+        }
+    }
+    let filters: Vec<Filter> = spec.filters.iter().copied().filter(|&f| f != Filter::None).collect();
+    for &filter in &filters {
+        slots.push(Timed {
+            what: "filter".into(),
+            scheme: String::new(),
+            rays: 0,
+            filter: filter.name().into(),
+            seconds: vec![],
+            time: Estimate::NAN,
+            work: input.taps(filter),
+            work_unit: "taps".into(),
+        });
+    }
+    let bar = progress.bar(
+        "timed renders and filters",
+        slots.len() as u64 * schedule.repeats as u64,
+    );
+    let times = schedule.run(slots.len(), |i| -> anyhow::Result<f64> {
+        let seconds = if i < renders.len() {
+            let (scene, sampling) = &renders[i];
+            let view = View {
+                camera: &scene.cameras[&spec.camera],
+                width: w,
+                height: h,
+            };
+            backend.time(scene, view, *sampling, schedule.warmup, 1)?.seconds[0]
+        } else {
+            let filter = filters[i - renders.len()];
+            for _ in 0..schedule.warmup {
+                backend.reconstruct(filter, &input)?;
+            }
+            backend.reconstruct(filter, &input)?.1
+        };
+        bar.inc(1);
+        Ok(seconds)
+    })?;
+    bar.finish();
+    for (slot, seconds) in slots.iter_mut().zip(times) {
+        slot.time = median_interval(&seconds);
+        slot.seconds = seconds;
+    }
+    Ok(Outcome::Timed { slots })
+}

@@ -1,0 +1,174 @@
+//! The filters in f64: the reference the WGSL kernels (`gpu/shaders/denoise.wgsl`) follow line
+//! for line in f32; change both together.
+
+use super::{gaussian_radius, Filter, Input, Output, B3, LUMINANCE_EPSILON, MIN_SIGMA};
+use rayon::prelude::*;
+
+/// Runs `filter` on `input`.
+pub fn apply(filter: Filter, input: &Input) -> Output {
+    let image = match filter {
+        Filter::None => input.image.to_vec(),
+        Filter::Gaussian => {
+            let sigma = input.settings.gaussian_sigma;
+            per_pixel(input, |x, y| gaussian_at(input, x, y, sigma, false))
+        }
+        Filter::Penumbra => per_pixel(input, |x, y| {
+            let sigma = input.sigma[index(input, x, y)] as f64;
+            if sigma < MIN_SIGMA {
+                input.image[index(input, x, y)] as f64
+            } else {
+                gaussian_at(input, x, y, sigma, true)
+            }
+        }),
+        Filter::Atrous => atrous(input),
+    };
+    Output {
+        image,
+        taps: input.taps(filter),
+    }
+}
+
+fn index(input: &Input, x: i32, y: i32) -> usize {
+    (y as u32 * input.width + x as u32) as usize
+}
+
+/// `value(x, y)` at every receiver pixel, [`crate::render::NO_RECEIVER`] elsewhere.
+fn per_pixel(input: &Input, value: impl Fn(i32, i32) -> f64 + Sync) -> Vec<f32> {
+    (0..input.pixels())
+        .into_par_iter()
+        .map(|i| {
+            if !input.receives(i) {
+                return crate::render::NO_RECEIVER;
+            }
+            let w = input.width as usize;
+            value((i % w) as i32, (i / w) as i32) as f32
+        })
+        .collect()
+}
+
+/// Whether (x, y) is inside the image and has a receiver.
+fn usable(input: &Input, x: i32, y: i32) -> bool {
+    x >= 0 && y >= 0 && x < input.width as i32 && y < input.height as i32 && input.receives(index(input, x, y))
+}
+
+/// A normalised Gaussian of `sigma` pixels over the receiver pixels of its window, weighted by
+/// the geometry where `guided`.
+fn gaussian_at(input: &Input, x: i32, y: i32, sigma: f64, guided: bool) -> f64 {
+    let r = gaussian_radius(sigma);
+    let (mut sum, mut weight) = (0.0, 0.0);
+    let slope = depth_slope(input, x, y);
+    for dy in -r..=r {
+        for dx in -r..=r {
+            let (qx, qy) = (x + dx, y + dy);
+            if !usable(input, qx, qy) {
+                continue;
+            }
+            let d2 = (dx * dx + dy * dy) as f64;
+            let mut w = (-d2 / (2.0 * sigma * sigma)).exp();
+            if guided {
+                w *= geometry_weight(input, x, y, qx, qy, slope, d2.sqrt());
+            }
+            sum += w * input.image[index(input, qx, qy)] as f64;
+            weight += w;
+        }
+    }
+    sum / weight
+}
+
+/// The depth change per pixel at (x, y): the larger central (or one-sided, at an edge of the
+/// image or of the receivers) difference of the two axes.
+fn depth_slope(input: &Input, x: i32, y: i32) -> f64 {
+    let z = |x: i32, y: i32| input.gbuffer.depth[index(input, x, y)] as f64;
+    let axis = |dx: i32, dy: i32| {
+        let (a, b) = ((x - dx, y - dy), (x + dx, y + dy));
+        match (usable(input, a.0, a.1), usable(input, b.0, b.1)) {
+            (true, true) => (z(b.0, b.1) - z(a.0, a.1)).abs() / 2.0,
+            (true, false) => (z(x, y) - z(a.0, a.1)).abs(),
+            (false, true) => (z(b.0, b.1) - z(x, y)).abs(),
+            (false, false) => 0.0,
+        }
+    };
+    axis(1, 0).max(axis(0, 1))
+}
+
+/// SVGF's edge-stopping by geometry (eqs. 3, 4): depth differences against the local slope
+/// times the distance, and the normals' cosine to the power sigma_n.
+fn geometry_weight(input: &Input, x: i32, y: i32, qx: i32, qy: i32, slope: f64, distance: f64) -> f64 {
+    let s = &input.settings;
+    let (p, q) = (index(input, x, y), index(input, qx, qy));
+    let (zp, zq) = (input.gbuffer.depth[p] as f64, input.gbuffer.depth[q] as f64);
+    let scale = (s.atrous_sigma_depth * slope * distance).max(1e-3 * zp);
+    let wz = (-(zp - zq).abs() / scale).exp();
+    let (np, nq) = (input.gbuffer.normal[p], input.gbuffer.normal[q]);
+    let cos = np[0] as f64 * nq[0] as f64 + np[1] as f64 * nq[1] as f64 + np[2] as f64 * nq[2] as f64;
+    wz * cos.max(0.0).powf(s.atrous_sigma_normal)
+}
+
+/// SVGF's a-trous iterations (eqs. 1, 2, 5): each a 5 x 5 B3-spline kernel at step 2^k, weighted
+/// by geometry and by value differences against the 3 x 3-blurred standard deviation, which
+/// each iteration filters with the squared weights.
+fn atrous(input: &Input) -> Vec<f32> {
+    let mut image: Vec<f64> = input.image.iter().map(|&v| v as f64).collect();
+    let mut variance: Vec<f64> = input.variance.iter().map(|&v| v as f64).collect();
+    for k in 0..input.settings.atrous_iterations {
+        let step = 1i32 << k;
+        let next: Vec<(f64, f64)> = (0..input.pixels())
+            .into_par_iter()
+            .map(|i| {
+                if !input.receives(i) {
+                    return (crate::render::NO_RECEIVER as f64, 0.0);
+                }
+                let w = input.width as usize;
+                atrous_at(input, &image, &variance, (i % w) as i32, (i / w) as i32, step)
+            })
+            .collect();
+        image = next.iter().map(|v| v.0).collect();
+        variance = next.iter().map(|v| v.1).collect();
+    }
+    image.iter().map(|&v| v as f32).collect()
+}
+
+/// One a-trous tap set at (x, y): the filtered value and variance.
+fn atrous_at(input: &Input, image: &[f64], variance: &[f64], x: i32, y: i32, step: i32) -> (f64, f64) {
+    let s = &input.settings;
+    let p = index(input, x, y);
+    let sd = blurred_variance(input, variance, x, y).sqrt();
+    let denom = s.atrous_sigma_luminance * sd + LUMINANCE_EPSILON;
+    let slope = depth_slope(input, x, y);
+    let (mut sum, mut weight, mut var) = (0.0, 0.0, 0.0);
+    for j in -2..=2i32 {
+        for i in -2..=2i32 {
+            let (qx, qy) = (x + step * i, y + step * j);
+            if !usable(input, qx, qy) {
+                continue;
+            }
+            let q = index(input, qx, qy);
+            let distance = (step as f64) * ((i * i + j * j) as f64).sqrt();
+            let h = B3[(i + 2) as usize] * B3[(j + 2) as usize];
+            let w = h
+                * geometry_weight(input, x, y, qx, qy, slope, distance)
+                * (-(image[p] - image[q]).abs() / denom).exp();
+            sum += w * image[q];
+            weight += w;
+            var += w * w * variance[q];
+        }
+    }
+    (sum / weight, var / (weight * weight))
+}
+
+/// The variance at (x, y) under a 3 x 3 binomial blur over receiver pixels (SVGF's prefilter of
+/// the luminance weight's variance).
+fn blurred_variance(input: &Input, variance: &[f64], x: i32, y: i32) -> f64 {
+    const K: [f64; 3] = [0.25, 0.5, 0.25];
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for j in -1..=1i32 {
+        for i in -1..=1i32 {
+            if usable(input, x + i, y + j) {
+                let w = K[(i + 1) as usize] * K[(j + 1) as usize];
+                sum += w * variance[index(input, x + i, y + j)];
+                weight += w;
+            }
+        }
+    }
+    sum / weight
+}

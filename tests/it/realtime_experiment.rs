@@ -1,0 +1,204 @@
+//! The real-time kind: frames continue each scheme's sequence through accumulation, a still
+//! scene converges and a moving occluder leaves a ghost the running mean keeps, the CI twin's
+//! outputs hold what the report claims, and bad files are refused at their key.
+
+use crate::common;
+use penumbra::render::cpu::CpuBackend;
+use penumbra::render::denoise::{Accumulation, Accumulator};
+use penumbra::render::{Backend, Sampling, View};
+use penumbra::sampling::{DiskScheme, Pattern};
+use penumbra::scene::{Light, Scene};
+use std::ffi::OsStr;
+
+fn sphere(rays: u32) -> Scene {
+    let mut scene = Scene::load(&common::repo("experiments/scenes/sphere.toml")).unwrap();
+    for l in &mut scene.lights {
+        if let Light::Disk(d) = l {
+            d.samples = rays;
+        }
+    }
+    scene
+}
+
+fn shadow(backend: &mut dyn Backend, scene: &Scene, scheme: DiskScheme, frame: u32) -> Vec<f32> {
+    let view = View {
+        camera: &scene.cameras["measure"],
+        width: 24,
+        height: 24,
+    };
+    let sampling = Sampling {
+        scheme,
+        pattern: Pattern::PerPixel,
+        seed: 7,
+        frame,
+    };
+    backend.render(scene, view, sampling).unwrap().visibility[0].clone()
+}
+
+/// Progressive schemes continue their sequence: the running mean of frames 0..4 of n rays is the
+/// one frame of 4n rays, to f32 rounding, where the scheme's points do not depend on n (blue-noise
+/// Sobol' continues too, but under the scramble fitted for n); re-seeded schemes draw new rays
+/// each frame.
+fn frames_continue_on(backend: &mut dyn Backend) {
+    for scheme in [DiskScheme::Sobol, DiskScheme::Pmj02] {
+        let (few, many) = (sphere(4), sphere(16));
+        let mut acc = Accumulator::new(Accumulation::Mean, 24 * 24);
+        let none = vec![f64::NAN; 24 * 24];
+        for f in 0..4 {
+            acc.add(&shadow(backend, &few, scheme, f), &none);
+        }
+        let whole = shadow(backend, &many, scheme, 0);
+        let accumulated = acc.image();
+        let partial = whole.iter().filter(|&&v| v > 0.0 && v < 1.0).count();
+        assert!(
+            partial > 20,
+            "{scheme}: {partial} penumbra pixels; the view misses the edge"
+        );
+        for (i, (a, b)) in accumulated.iter().zip(&whole).enumerate() {
+            assert!(
+                (a - b).abs() < 1e-6,
+                "{scheme}: pixel {i}: 4 frames of 4 rays {a}, one of 16 {b}"
+            );
+        }
+    }
+    let few = sphere(4);
+    let (f0, f1) = (
+        shadow(backend, &few, DiskScheme::Uniform, 0),
+        shadow(backend, &few, DiskScheme::Uniform, 1),
+    );
+    assert_ne!(f0, f1, "uniform re-seeds each frame");
+}
+
+#[test]
+fn frames_continue_each_schemes_sequence_through_accumulation() {
+    frames_continue_on(&mut CpuBackend::default());
+    if let Some(mut gpu) = common::gpu() {
+        frames_continue_on(&mut *gpu);
+    }
+}
+
+fn read(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            header
+                .iter()
+                .map(String::from)
+                .zip(rec.iter().map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::repo("experiments/realtime-ci.toml");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), dir.path().as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    for file in [
+        "runs.csv",
+        "summary.csv",
+        "timings.csv",
+        "report.md",
+        "index.html",
+        "plots/rmse_frames.svg",
+    ] {
+        assert!(dir.path().join(file).exists(), "{file} missing");
+    }
+    let summary = read(&dir.path().join("summary.csv"));
+    let rmse = |variant: &str, scheme: &str, frames: &str, acc: &str, filter: &str| -> f64 {
+        summary
+            .iter()
+            .find(|r| {
+                r["variant"] == variant
+                    && r["scheme"] == scheme
+                    && r["rays"] == "4"
+                    && r["frames"] == frames
+                    && r["accumulation"] == acc
+                    && r["filter"] == filter
+            })
+            .unwrap_or_else(|| panic!("{variant} {scheme} {frames} {acc} {filter} missing"))["rmse"]
+            .parse()
+            .unwrap()
+    };
+    // Uniform is unbiased: eight frames of four rays have about a third of one frame's error.
+    let (one, eight) = (
+        rmse("static", "uniform", "1", "mean", "none"),
+        rmse("static", "uniform", "8", "mean", "none"),
+    );
+    assert!(eight < 0.5 * one, "static uniform: {one} at 1 frame, {eight} at 8");
+    // The running mean keeps the three moving frames' ghost; the EMA (alpha 0.25) forgets it
+    // faster, so after the stop the mean is further from the current exact image.
+    let (mean, ema) = (
+        rmse("moving", "uniform", "8", "mean", "none"),
+        rmse("moving", "uniform", "8", "ema", "none"),
+    );
+    assert!(
+        mean > eight && mean > ema,
+        "moving: mean {mean}, ema {ema}, still {eight}"
+    );
+    // Every filter changes the still one-frame image, and every row has a finite width.
+    let runs = read(&dir.path().join("runs.csv"));
+    assert_eq!(
+        runs.len(),
+        2 * 2 * 2 * 3 * 2 * 4 * 4,
+        "variants x schemes x rays x frames x acc x filters x seeds"
+    );
+    assert!(runs.iter().all(|r| r["width_px"].parse::<f64>().unwrap().is_finite()));
+    let report = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    assert!(report.contains("**Answer:**") && report.contains("## The paper's claim restated"));
+    assert!(
+        report.contains("| paper x 16 ray(s)") || report.contains("paper x 16"),
+        "{report}"
+    );
+}
+
+#[test]
+fn bad_realtime_files_are_refused_at_their_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::repo("experiments/realtime-ci.toml"))
+        .unwrap()
+        .replace(
+            "\"scenes/",
+            &format!("\"{}/", common::repo("experiments/scenes").display()),
+        );
+    for (edit, key, says) in [
+        (
+            ("\"atrous\"", "\"bilateral\""),
+            "sweep.filters[2]",
+            "unknown filter `bilateral`",
+        ),
+        (
+            ("frames = 3", "frames = 8"),
+            "motion.frames",
+            "must stop before the last frame",
+        ),
+        (("shape = 0", "shape = 1"), "motion.shape", "not a sphere"),
+        (("ema_alpha = 0.25", "ema_alpha = 0.0"), "sweep.ema_alpha", "(0, 1]"),
+        (
+            ("[timing]", "[verdict]\nbudget_schemes = [[\"sobol\", 4]]\n\n[timing]"),
+            "verdict.budget_schemes[0]",
+            "not swept",
+        ),
+        (
+            ("frames = [1, 2, 8]", "frames = [2, 1, 8]"),
+            "sweep.frames[1]",
+            "ascending",
+        ),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, text.replace(edit.0, edit.1)).unwrap();
+        let out = dir.path().join("out");
+        let (code, err) = common::sweep(&[path.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
+        assert_eq!(code, 2, "{edit:?}: {err}");
+        assert!(
+            err.contains(&format!("key `{key}`")) && err.contains(says),
+            "{edit:?}: {err}"
+        );
+        assert!(err.contains("bad.toml:"), "{edit:?}: no file and line: {err}");
+        assert!(!out.join("manifest.toml").exists());
+    }
+}
