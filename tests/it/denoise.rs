@@ -94,6 +94,9 @@ fn gpu_filters_match_the_cpu_reference() {
     }
 }
 
+/// Standard deviation of 4 a-trous steps of the B3 kernel: the variances 1, 4, 16, 64 add.
+const ATROUS_SIGMA: f64 = 9.219544457292887;
+
 /// The 10-90 % width (pixels) of a linear ramp `ramp` pixels long convolved with a Gaussian of
 /// standard deviation `sigma` (0: none), by quadrature and bisection: what the kernel predicts.
 fn predicted_width(ramp: f64, sigma: f64) -> f64 {
@@ -151,24 +154,31 @@ fn each_filter_widens_a_straight_edge_as_its_kernel_predicts() {
             (Filter::Penumbra, 2.5),
             (Filter::Penumbra, 0.0),
             (Filter::Atrous, 0.0),
+            (Filter::Atrous, ATROUS_SIGMA),
         ] {
             let sigmas = vec![sigma as f32; n];
+            // The a-trous case with sigma > 0 has unit variance and a luminance sigma so large that
+            // no difference stops it: the bare cascade of B3 kernels.
+            let blind = filter == Filter::Atrous && sigma > 0.0;
+            let unit = vec![1f32; n];
             let input = Input {
                 width: w,
                 height: h,
                 image: &image,
-                variance: &zero,
+                variance: if blind { &unit } else { &zero },
                 gbuffer: &g,
                 sigma: &sigmas,
                 settings: FilterSettings {
                     gaussian_sigma: if filter == Filter::Gaussian { sigma } else { 1.5 },
+                    atrous_sigma_luminance: if blind { 1e9 } else { 4.0 },
                     ..FilterSettings::default()
                 },
             };
             let out = cpu::apply(filter, &input);
             let measured = edge.width_10_90(&out.image);
             // The a-trous filter with zero variance stops at every value difference above its
-            // epsilon: the kernel predicts no widening. The others: the continuous Gaussian.
+            // epsilon: the kernel predicts no widening; blind to values, its 4 steps of B3 (each
+            // of variance 4^k) add to a near-Gaussian of variance 85. The others: the Gaussian.
             let predicted = predicted_width(ramp, sigma);
             let tolerance = 0.03 * predicted + 0.25;
             assert!(

@@ -144,16 +144,20 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     let runs = read(&dir.path().join("runs.csv"));
     assert_eq!(
         runs.len(),
-        2 * 2 * 2 * 3 * 2 * 4 * 4,
+        2 * 3 * 2 * 3 * 2 * 4 * 4,
         "variants x schemes x rays x frames x acc x filters x seeds"
     );
     assert!(runs.iter().all(|r| r["width_px"].parse::<f64>().unwrap().is_finite()));
     let report = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(report.contains("**Answer:**") && report.contains("## The paper's claim restated"));
-    assert!(
-        report.contains("| paper x 16 ray(s)") || report.contains("paper x 16"),
-        "{report}"
-    );
+    // The claim's table: one row per frame count, each a blue-noise pipeline at 4 rays.
+    let claim = &report[report.find("## The paper's claim restated").unwrap()..];
+    let claim = &claim[..claim[3..].find("\n## ").map_or(claim.len(), |e| e + 3)];
+    let rows = claim
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains("bluenoise-cp x 4"))
+        .count();
+    assert_eq!(rows, 3, "{claim}");
 }
 
 #[test]

@@ -47,7 +47,7 @@ pub struct Row {
     pub stability: f64,
     /// Shadow rays per frame.
     pub shadow_rays: u64,
-    /// Filter taps per receiver pixel.
+    /// Filter taps per pixel with a receiver (every surface the view sees).
     pub taps_per_pixel: f64,
     /// The device that rendered and filtered (its f32 rounding is in every number).
     pub adapter: String,
@@ -114,7 +114,10 @@ pub enum Outcome {
     Timed { slots: Vec<Timed> },
 }
 
-/// Per light, per pixel: the distance to the blocker met by the frame's first shadow ray.
+/// Per light, per pixel: the mean distance to the blockers the frame's shadow rays meet (NaN
+/// where none meets one), over the same targets the render drew. A GPU renderer would return
+/// these with its shadow rays (a closest hit instead of any hit); here the CPU traces them
+/// beside the render, for both backends alike, outside the frame time.
 fn blockers(scene: &Scene, receivers: &[Option<Receiver>], sampling: Sampling, rays: u32, width: u32) -> Vec<Vec<f64>> {
     use rayon::prelude::*;
     scene
@@ -133,9 +136,19 @@ fn blockers(scene: &Scene, receivers: &[Option<Receiver>], sampling: Sampling, r
                     let Some(r) = r else { return f64::NAN };
                     let p = i as u32;
                     let site = Site::pixel(sampling.seed, l as u32, [p % width, p / width], p, sampling.frame);
-                    let s = sampling.scheme.point(rays, 0, site);
-                    let target = d.center + d.radius * (u * s.x + v * s.y);
-                    blocker_distance(scene, r, target).unwrap_or(f64::NAN)
+                    let (mut sum, mut n) = (0.0, 0u32);
+                    for k in 0..rays {
+                        let s = sampling.scheme.point(rays, k, site);
+                        let target = d.center + d.radius * (u * s.x + v * s.y);
+                        if let Some(t) = blocker_distance(scene, r, target) {
+                            (sum, n) = (sum + t, n + 1);
+                        }
+                    }
+                    if n == 0 {
+                        f64::NAN
+                    } else {
+                        sum / n as f64
+                    }
                 })
                 .collect()
         })
@@ -237,6 +250,7 @@ pub fn measure(
                 continue;
             }
             let reference = refs.reference(spec, variant, f, backend)?;
+            let receiving = image.iter().filter(|&&v| v != crate::render::NO_RECEIVER).count();
             for (a, hist) in histories.iter().enumerate() {
                 let accumulated = hist.image.image();
                 let variance = hist.image.variance_or_spatial(w, h);
@@ -296,7 +310,7 @@ pub fn measure(
                             lost_share,
                             stability,
                             shadow_rays: frame.rays.shadow_total(),
-                            taps_per_pixel: out.taps as f64 / reference.receivers.pixels.len().max(1) as f64,
+                            taps_per_pixel: out.taps as f64 / receiving.max(1) as f64,
                             adapter: backend.adapter().name.clone(),
                             driver: backend.adapter().driver.clone(),
                         });

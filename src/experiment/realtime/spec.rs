@@ -279,10 +279,10 @@ impl RealtimeSpec {
             ));
         }
         for (i, &r) in s.rays.iter().enumerate() {
-            if !(1..=MAX_SAMPLES).contains(&r) || s.rays[..i].contains(&r) {
+            if !(1..=MAX_SAMPLES).contains(&r) || (i > 0 && r <= s.rays[i - 1]) {
                 return Err(source.error(
                     &key_path!["sweep", "rays", i],
-                    format!("must be in 1..={MAX_SAMPLES} and listed once, got {r}"),
+                    format!("ray counts must be in 1..={MAX_SAMPLES} and ascending, got {r}"),
                 ));
             }
         }

@@ -63,6 +63,8 @@ impl FromStr for Accumulation {
 pub struct Accumulator {
     mode: Accumulation,
     frames: u32,
+    /// Frames in each pixel's history: a pixel that had no receiver starts afresh when it gets one.
+    history: Vec<u32>,
     m1: Vec<f64>,
     m2: Vec<f64>,
     blocker: Vec<f64>,
@@ -75,6 +77,7 @@ impl Accumulator {
         Accumulator {
             mode,
             frames: 0,
+            history: vec![0; pixels],
             m1: vec![0.0; pixels],
             m2: vec![0.0; pixels],
             blocker: vec![f64::NAN; pixels],
@@ -91,12 +94,14 @@ impl Accumulator {
     /// distance to the blockers its shadow rays met (NaN where none met one).
     pub fn add(&mut self, image: &[f32], blocker: &[f64]) {
         self.frames += 1;
-        let w = self.mode.weight(self.frames);
         for (i, &v) in image.iter().enumerate() {
             if v == NO_RECEIVER {
                 self.m1[i] = NO_RECEIVER as f64;
+                self.history[i] = 0;
                 continue;
             }
+            self.history[i] += 1;
+            let w = self.mode.weight(self.history[i]);
             let v = v as f64;
             self.m1[i] += w * (v - self.m1[i]);
             self.m2[i] += w * (v * v - self.m2[i]);
@@ -127,19 +132,20 @@ impl Accumulator {
             .collect()
     }
 
-    /// The variance the a-trous filter is guided by: the temporal one once four frames are in
-    /// (SVGF, sec. 4.2), before that the spatial variance of the accumulated image over the
-    /// receiver pixels of a 5 x 5 window.
+    /// The variance the a-trous filter is guided by: the temporal one where a pixel's history
+    /// holds four frames (SVGF, sec. 4.2), before that the spatial variance of the accumulated
+    /// image over the receiver pixels of a 5 x 5 window.
     pub fn variance_or_spatial(&self, width: u32, height: u32) -> Vec<f32> {
-        if self.frames >= 4 {
-            return self.variance();
-        }
+        let temporal = self.variance();
         let (w, h) = (width as i64, height as i64);
         (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
                 if self.m1[i as usize] < 0.0 {
                     return 0.0;
+                }
+                if self.history[i as usize] >= 4 {
+                    return temporal[i as usize];
                 }
                 let (mut s1, mut s2, mut n) = (0.0, 0.0, 0.0);
                 for qy in (y - 2).max(0)..=(y + 2).min(h - 1) {
@@ -184,6 +190,15 @@ mod tests {
         assert!((ema.image()[0] as f64 - reference).abs() < 1e-7);
         // Bernoulli frames: the temporal variance of the mean history is p (1 - p).
         assert!((mean.variance()[0] as f64 - exact_mean * (1.0 - exact_mean)).abs() < 1e-7);
+    }
+
+    #[test]
+    fn a_pixel_that_gains_a_receiver_starts_its_history_afresh() {
+        let mut a = Accumulator::new(Accumulation::Mean, 1);
+        a.add(&[NO_RECEIVER], &[f64::NAN]);
+        a.add(&[0.25], &[f64::NAN]);
+        a.add(&[0.75], &[f64::NAN]);
+        assert_eq!(a.image(), vec![0.5]);
     }
 
     #[test]

@@ -64,7 +64,8 @@ fn gaussian_at(input: &Input, x: i32, y: i32, sigma: f64, guided: bool) -> f64 {
                 continue;
             }
             let d2 = (dx * dx + dy * dy) as f64;
-            let mut w = (-d2 / (2.0 * sigma * sigma)).exp();
+            let s = sigma as f32 as f64;
+            let mut w = (-d2 / (2.0 * s * s)).exp();
             if guided {
                 w *= geometry_weight(input, x, y, qx, qy, slope, d2.sqrt());
             }

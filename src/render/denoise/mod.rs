@@ -132,9 +132,11 @@ impl FilterSettings {
 /// Largest Gaussian standard deviation any filter takes, pixels (its window is 3 sigma wide).
 pub const MAX_SIGMA: f64 = 16.0;
 
-/// Half-width of a Gaussian window of standard deviation `sigma` pixels: 3 sigma, rounded up.
+/// Half-width of a Gaussian window of standard deviation `sigma` pixels: 3 sigma, rounded up, in
+/// f32 as the WGSL kernels round it (an f64 3 sigma can land just above a whole number that the
+/// f32 one equals, and the windows would differ by a ring).
 pub fn gaussian_radius(sigma: f64) -> i32 {
-    (3.0 * sigma).ceil() as i32
+    (3.0f32 * sigma as f32).ceil() as i32
 }
 
 /// Below this standard deviation (pixels) the penumbra filter leaves a pixel as it is: a

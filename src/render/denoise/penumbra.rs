@@ -86,6 +86,36 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_kernel_follows_the_penumbra_and_reaches_lit_neighbours() {
+        // A 9 x 1 floor row under a light 2 m up, 1 mm pixels; a blocker 0.5 m up is seen by
+        // pixel 4 only.
+        let mut g = GBuffer::flat(9, 2.0, 0.001);
+        g.point = (0..9).map(|i| DVec3::new(i as f64 * 0.001, 0.0, 0.0)).collect();
+        let light = DiskLight {
+            center: DVec3::new(0.004, 0.0, 2.0),
+            normal: DVec3::NEG_Z,
+            radius: 0.02,
+            power: 1.0,
+            samples: 1,
+        };
+        let mut blocker = vec![f64::NAN; 9];
+        blocker[4] = 0.5;
+        let sigma = kernel_sigma(&blocker, &g, &light, 9, 1, 0.25, 8.0);
+        // 2 a b / (D - b) = 0.04 * 0.5 / 1.5 m = 13.3 px; a quarter of it.
+        assert!(
+            (sigma[4] as f64 - 0.25 * 0.04 * 0.5 / 1.5 / 0.001).abs() < 1e-4,
+            "{sigma:?}"
+        );
+        // The 5 x 5 dilation reaches two pixels each way, with the neighbour's own distance to
+        // the light; beyond it nothing.
+        assert!(sigma[2] > 3.0 && sigma[6] > 3.0, "{sigma:?}");
+        assert_eq!((sigma[1], sigma[7]), (0.0, 0.0));
+        // Capped.
+        let capped = kernel_sigma(&blocker, &g, &light, 9, 1, 10.0, 8.0);
+        assert_eq!(capped[4], 8.0);
+    }
+
+    #[test]
     fn similar_triangles_give_the_closed_form() {
         // A blocker half way: the penumbra is the light's diameter.
         assert!((penumbra_width(0.02, 2.0, 1.0) - 0.04).abs() < 1e-15);

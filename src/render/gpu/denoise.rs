@@ -1,7 +1,7 @@
 //! The reconstruction filters on the GPU (`shaders/denoise.wgsl`): one pipeline per filter,
-//! compiled on first use; a filter's inputs are uploaded, its dispatches timed on the wall
-//! clock around submit and wait (uploads and the read-back outside the time), its image read
-//! back.
+//! compiled on first use; a filter's inputs are uploaded, its pass timed by timestamp queries
+//! where the adapter has them (as frames are), else on the wall clock around submit and wait
+//! (uploads and the read-back outside the time either way), its image read back.
 
 use super::GpuBackend;
 use crate::render::denoise::{Filter, Input, Output, LUMINANCE_EPSILON, MIN_SIGMA};
@@ -177,10 +177,34 @@ impl GpuBackend {
                 })
             })
             .collect();
+        // Timestamps around the filter's pass where the adapter has them: the clock its renders
+        // are timed by, so a pipeline's render and filter add up.
+        let queries = self.timestamps.then(|| {
+            let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("denoise timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("denoise timestamp resolve"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolve)
+        });
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let timestamp_writes = queries.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(0),
+                end_of_pass_write_index: Some(1),
+            });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("denoise"),
+                timestamp_writes,
+            });
             pass.set_pipeline(pipeline);
             for g in &groups {
                 pass.set_bind_group(0, g, &[]);
@@ -188,9 +212,17 @@ impl GpuBackend {
             }
         }
         self.dispatches.set(self.dispatches.get() + groups.len() as u64);
+        if let Some((set, resolve)) = &queries {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        }
         let start = Instant::now();
         self.submit(encoder, scope)?;
-        let seconds = start.elapsed().as_secs_f64();
+        let mut seconds = start.elapsed().as_secs_f64();
+        if let Some((_, resolve)) = &queries {
+            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(resolve, 16)?);
+            let period = self.queue.get_timestamp_period() as f64;
+            seconds = ticks[1].saturating_sub(ticks[0]) as f64 * period * 1e-9;
+        }
         let last = &outputs[(groups.len() - 1) % 2].0;
         let image: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(last, pixels * 4)?);
         Ok((
