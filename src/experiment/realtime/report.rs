@@ -9,7 +9,7 @@ use crate::experiment::sweep::reference::has_exact_answer;
 use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, MARGIN, RULE};
 use crate::experiment::RunContext;
 use crate::files::write_atomic;
-use crate::metrics::stats::{mean_ci, MeanCi};
+use crate::metrics::stats::mean_ci;
 use crate::output::page::{self, Gallery, Page, Shot, Tone};
 use crate::output::plots::{line_plot, Axes, Series as PlotSeries};
 use crate::output::table::write_rows;
@@ -19,34 +19,54 @@ use std::fmt::Write as _;
 /// One pipeline at one frame count over its seeds: a row of summary.csv.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
+    /// `static` or `moving`.
     pub variant: String,
+    /// Disk scheme.
     pub scheme: String,
+    /// Shadow rays per pixel per light per frame.
     pub rays: u32,
+    /// Frames accumulated.
     pub frames: u32,
+    /// `mean` or `ema`.
     pub accumulation: String,
+    /// Reconstruction filter.
     pub filter: String,
+    /// Seeds behind the means.
     pub seeds: usize,
+    /// Mean RMSE against the exact image over its penumbra.
     pub rmse: f64,
+    /// Half-width of its 95 % interval.
     pub rmse_ci95: f64,
+    /// Mean FLIP against the exact picture.
     pub flip: f64,
+    /// Half-width of its 95 % interval.
     pub flip_ci95: f64,
-    /// Width over the exact width.
+    /// Mean 10-90 % width over the exact width.
     pub width_ratio: f64,
+    /// Half-width of its 95 % interval.
     pub width_ratio_ci95: f64,
+    /// Mean penumbra area over the exact one's.
     pub area_ratio: f64,
+    /// Mean share of the exact penumbra shown fully lit or dark.
     pub lost_share: f64,
+    /// Mean RMS frame-to-frame change where the exact image holds still.
     pub stability: f64,
+    /// Half-width of its 95 % interval.
     pub stability_ci95: f64,
     /// Moving variant: the most frames any seed took after the stop to come down to the lag
     /// bound ([`lag`]); NaN when a seed never did (censored at the last frame).
     pub lag_frames: f64,
     /// Seeds that never came within the bound.
     pub lag_censored: usize,
-    /// Render plus filter per frame, median and 95 % interval over rounds (s).
+    /// Render plus filter per frame, median over rounds (s).
     pub frame_s: f64,
+    /// Lower end of its 95 % interval.
     pub frame_s_lo: f64,
+    /// Upper end of its 95 % interval.
     pub frame_s_hi: f64,
+    /// Shadow rays per frame.
     pub shadow_rays: u64,
+    /// Filter taps per pixel with a receiver.
     pub taps_per_pixel: f64,
 }
 
@@ -108,10 +128,6 @@ impl Measured {
     }
 }
 
-fn of(v: &[f64]) -> MeanCi {
-    mean_ci(v)
-}
-
 /// summary.csv's rows, in runs.csv's order of first appearance.
 fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
     let mut keys: Vec<(String, String, u32, u32, String, String)> = Vec::new();
@@ -143,9 +159,9 @@ fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
                 })
                 .collect();
             let col = |f: fn(&Row) -> f64| rows.iter().map(|r| f(r)).collect::<Vec<f64>>();
-            let (rmse, flip) = (of(&col(|r| r.rmse)), of(&col(|r| r.flip)));
-            let width = of(&col(|r| r.width_px / r.exact_width_px));
-            let stability = of(&col(|r| r.stability));
+            let (rmse, flip) = (mean_ci(&col(|r| r.rmse)), mean_ci(&col(|r| r.flip)));
+            let width = mean_ci(&col(|r| r.width_px / r.exact_width_px));
+            let stability = mean_ci(&col(|r| r.stability));
             let (lag_frames, lag_censored) = match variant.as_str() {
                 "moving" => lag(spec, m, scheme, *rays, acc, filter),
                 _ => (f64::NAN, 0),
@@ -167,8 +183,8 @@ fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
                 flip_ci95: flip.ci95,
                 width_ratio: width.mean,
                 width_ratio_ci95: width.ci95,
-                area_ratio: of(&col(|r| r.area_ratio)).mean,
-                lost_share: of(&col(|r| r.lost_share)).mean,
+                area_ratio: mean_ci(&col(|r| r.area_ratio)).mean,
+                lost_share: mean_ci(&col(|r| r.lost_share)).mean,
                 stability: stability.mean,
                 stability_ci95: stability.ci95,
                 lag_frames,
@@ -339,7 +355,7 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
     );
     let _ = writeln!(out, "| frames | blue-noise pipeline | RMSE difference | quality | width / exact (blue; paper) | closer to the exact width |");
     let _ = writeln!(out, "| --- | --- | --- | --- | --- | --- |");
-    let paper_width = of(&paper.iter().map(|r| r.width_px / r.exact_width_px).collect::<Vec<_>>());
+    let paper_width = mean_ci(&paper.iter().map(|r| r.width_px / r.exact_width_px).collect::<Vec<_>>());
     let mut answered = 0;
     for &frames in &spec.frames {
         let best = summary
@@ -364,7 +380,7 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
                     .map(|r| r.rmse - p.rmse)
             })
             .collect();
-        let d = of(&diffs);
+        let d = mean_ci(&diffs);
         let word = if d.ci95.is_nan() {
             "not clearly (too few seeds for an interval)"
         } else if d.mean + d.ci95 < 0.0 {

@@ -23,12 +23,19 @@ use serde::{Deserialize, Serialize};
 /// One pipeline at one frame count and seed: a row of runs.csv.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
+    /// `static` or `moving`.
     pub variant: String,
+    /// Disk scheme.
     pub scheme: String,
+    /// Shadow rays per pixel per light per frame.
     pub rays: u32,
+    /// Frames accumulated.
     pub frames: u32,
+    /// `mean` or `ema`.
     pub accumulation: String,
+    /// Reconstruction filter.
     pub filter: String,
+    /// Seed of the sequence.
     pub seed: u32,
     /// RMSE against the current frame's exact image over its penumbra.
     pub rmse: f64,
@@ -58,10 +65,15 @@ pub struct Row {
 /// A moving run's error after the occluder stops, one value per frame: what lag is read from.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Series {
+    /// Disk scheme.
     pub scheme: String,
+    /// Shadow rays per pixel per light per frame.
     pub rays: u32,
+    /// `mean` or `ema`.
     pub accumulation: String,
+    /// Reconstruction filter.
     pub filter: String,
+    /// Seed of the sequence.
     pub seed: u32,
     /// RMSE at frames stop, stop + 1, ..., the last.
     pub rmse: Vec<f64>,
@@ -71,11 +83,17 @@ pub struct Series {
 /// the last frame count with each filter, and one raw frame at the most rays (the paper's use).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Picture {
+    /// `static` or `moving`.
     pub variant: String,
+    /// Disk scheme (empty for the reference).
     pub scheme: String,
+    /// Shadow rays per pixel per light per frame.
     pub rays: u32,
+    /// Frames accumulated.
     pub frames: u32,
+    /// `mean` or `ema`.
     pub accumulation: String,
+    /// Reconstruction filter, or [`REFERENCE`].
     pub filter: String,
     /// Visibility on the receiver plane, row-major.
     pub values: Vec<f32>,
@@ -90,14 +108,19 @@ pub const REFERENCE: &str = "reference";
 pub struct Timed {
     /// `render` or `filter`.
     pub what: String,
+    /// A render's scheme.
     pub scheme: String,
+    /// A render's rays per pixel.
     pub rays: u32,
+    /// A filter's name.
     pub filter: String,
     /// Seconds per round.
     pub seconds: Vec<f64>,
+    /// Their median and 95 % interval.
     pub time: Estimate,
     /// Shadow rays of a render; taps of a filter.
     pub work: u64,
+    /// What `work` counts.
     pub work_unit: String,
 }
 
@@ -106,12 +129,18 @@ pub struct Timed {
 pub enum Outcome {
     /// A measured (variant, scheme, rays) unit.
     Measured {
+        /// One per pipeline, judged frame count and seed.
         rows: Vec<Row>,
+        /// The moving variant's errors after the stop.
         series: Vec<Series>,
+        /// Images kept for the page.
         pictures: Vec<Picture>,
     },
     /// The timing unit.
-    Timed { slots: Vec<Timed> },
+    Timed {
+        /// Every render and filter timed.
+        slots: Vec<Timed>,
+    },
 }
 
 /// Per light, per pixel: the mean distance to the blockers the frame's shadow rays meet (NaN
