@@ -441,10 +441,17 @@
           td.textContent = numeric[c] && v.length > 10 ? Number(v).toPrecision(6) : v;
           if (td.textContent !== v) td.title = v;
         });
-        const shot = shots.findIndex((s) => Object.keys(s.key).length && Object.entries(s.key).every(([k, v]) => {
-          const c = t.header.indexOf(k);
-          return c >= 0 && r[c] === v;
-        }));
+        // The most specific shot whose key the row holds (a reference keyed by its variant
+        // alone must not take the rows of the shots keyed by every column).
+        let shot = -1;
+        shots.forEach((s, i) => {
+          const entries = Object.entries(s.key);
+          const holds = entries.length && entries.every(([k, v]) => {
+            const c = t.header.indexOf(k);
+            return c >= 0 && r[c] === v;
+          });
+          if (holds && (shot < 0 || entries.length > Object.keys(shots[shot].key).length)) shot = i;
+        });
         if (shot >= 0) {
           linked.add(shot);
           tr.className = 'linked';
