@@ -102,11 +102,27 @@ pub fn write_png(path: &Path, img: &Rgb) -> anyhow::Result<()> {
 
 /// Writes a one-channel float EXR (channel `Y`) atomically.
 pub fn write_exr(path: &Path, values: &[f32], width: u32, height: u32) -> anyhow::Result<()> {
+    write_exr_as(path, values, width, height, |v| v)
+}
+
+/// Writes a one-channel EXR at half precision: for pictures that are looked at, not measured
+/// (the page stores them at the same precision, so its readouts equal the file).
+pub fn write_exr_half(path: &Path, values: &[f32], width: u32, height: u32) -> anyhow::Result<()> {
+    write_exr_as(path, values, width, height, half::f16::from_f32)
+}
+
+fn write_exr_as<T: exr::prelude::IntoSample>(
+    path: &Path,
+    values: &[f32],
+    width: u32,
+    height: u32,
+    sample: impl Fn(f32) -> T + Sync,
+) -> anyhow::Result<()> {
     use exr::prelude::*;
     let w = width as usize;
     let channels = SpecificChannels::build()
         .with_channel("Y")
-        .with_pixel_fn(|p: Vec2<usize>| (values[p.y() * w + p.x()],));
+        .with_pixel_fn(|p: Vec2<usize>| (sample(values[p.y() * w + p.x()]),));
     let image = Image::from_channels((w, height as usize), channels);
     let mut bytes = Cursor::new(Vec::new());
     image

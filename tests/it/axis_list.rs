@@ -87,7 +87,7 @@ fn reports_hold_an_axis_they_do_not_name_at_each_value() {
     ]);
     assert_eq!(code, 0, "{e}");
     for lights in [1, 2] {
-        assert!(out.join(format!("plots/rmse_vs_samples_{lights}lights.png")).is_file());
+        assert!(out.join(format!("plots/rmse_vs_samples_lights-{lights}.png")).is_file());
     }
     assert!(!out.join("plots/rmse_vs_samples.png").exists());
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();

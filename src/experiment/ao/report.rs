@@ -374,6 +374,7 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
                 height: spec.height,
                 tone: Tone::Linear,
                 reference: Some(reference),
+                against: None,
                 shots,
             })
         })

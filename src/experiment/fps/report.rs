@@ -5,7 +5,7 @@ use super::{FpsRow, FpsSpec};
 use crate::experiment::timing::RULE;
 use crate::files::write_atomic;
 use crate::output::page::{self, Page};
-use crate::output::plots::{line_plot, Axes, Reference, Series};
+use crate::output::plots::{line_plot, Axes, Point, Reference, Series};
 use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
 use serde::Serialize;
@@ -34,33 +34,37 @@ pub fn write_fps(
             .iter()
             .filter(|r| &r.scene == scene && r.lights == *lights)
             .collect();
+        // Each frame rate with the interval of its timed frames, as fps.csv and the table give it.
         let points = of
             .iter()
-            .map(|r| ((r.width * r.height) as f64 / 1e6, r.fps().median, f64::NAN))
+            .map(|r| {
+                let fps = r.fps();
+                Point::between((r.width * r.height) as f64 / 1e6, fps.median, fps.lo, fps.hi)
+            })
             .collect();
-        series.push((
-            i,
-            Series {
-                name: format!("{scene}, {lights} light(s): ours"),
-                points,
-                dashed: false,
-            },
-        ));
+        series.push(Series {
+            name: format!("{scene}, {lights} light(s): ours"),
+            look: i,
+            points,
+        });
         if let Some(r) = of.first() {
             refs.push(Reference {
-                name: format!("{scene}, {lights} light(s): paper (GTX 560M)"),
+                name: format!("{scene}, {lights} light(s): paper"),
                 points: vec![(lo, r.paper_fps), (hi, r.paper_fps)],
                 colour: Some(i),
             });
         }
     }
     let title = format!(
-        "Table 1 on {}: {} shadow rays per pixel per light",
+        "Table 1 on {} (paper: GTX 560M): {} shadow rays per pixel per light",
         adapter.name, spec.samples
     );
     line_plot(
         &out.join("plots/fps.png"),
-        &Axes::new(&title, "megapixels", "frames per second", true, true),
+        &Axes {
+            interval: "95 % interval over the timed frames",
+            ..Axes::new(&title, "megapixels", "frames per second (median)", true, true)
+        },
         &series,
         &refs,
     )?;

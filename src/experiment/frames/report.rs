@@ -5,15 +5,15 @@
 
 use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{Cameras, FramesSpec, Generator};
-use super::verdict::{label, labels, median_at, over_frames, verdict};
+use super::verdict::{label, labels, over_frames, verdict};
 use crate::accel::settings::ParameterColumns;
-use crate::experiment::timing::{median_interval, Estimate, RULE};
+use crate::experiment::timing::{coverage, median_interval, Estimate, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
 use crate::output::numbers::thousands;
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
-use crate::output::plots::{image_grid, line_plot, Axes, Series, Tile};
+use crate::output::plots::{image_grid, line_plot, Axes, Point, Series, Tile};
 use crate::output::table::{float, write_rows};
 use crate::scene::procedural::random;
 use serde::Serialize;
@@ -171,28 +171,24 @@ pub fn write_frames(
             }),
         )?;
     }
-    write_rows(&out.join("summary.csv"), summarise(spec, outcome))?;
+    let summaries = summarise(spec, outcome);
+    write_rows(&out.join("summary.csv"), &summaries)?;
     let all = labels(rows);
     let largest = outcome.builds.iter().map(|b| b.triangles).max().unwrap_or(0);
+    // Each structure (and way of following motion) keeps one look in every plot.
+    let look = |l: &str| all.iter().position(|x| x == l).unwrap_or(0);
     for &(shading, _) in &spec.shadings {
-        let series = |value: &dyn Fn(&FrameRow) -> f64| -> Vec<(usize, Series)> {
+        let series = |value: &dyn Fn(&FrameRow) -> Point| -> Vec<Series> {
             all.iter()
-                .enumerate()
-                .map(|(i, l)| {
-                    let points = rows
+                .map(|l| Series {
+                    name: l.clone(),
+                    look: look(l),
+                    points: rows
                         .iter()
                         .filter(|r| r.shading == shading && r.triangles == largest && label(r) == *l)
                         .filter(|r| r.viewpoint == spec.viewpoints[0])
-                        .map(|r| (r.frame as f64, value(r), f64::NAN))
-                        .collect();
-                    (
-                        i,
-                        Series {
-                            name: l.clone(),
-                            points,
-                            dashed: false,
-                        },
-                    )
+                        .map(value)
+                        .collect(),
                 })
                 .collect()
         };
@@ -204,93 +200,106 @@ pub fn write_frames(
             thousands(largest),
             spec.viewpoints[0]
         );
-        let frame_times = series(&|r| r.seconds);
+        let frame_times = series(&|r| {
+            let e = median_interval(&r.renders);
+            Point::between(r.frame as f64, r.seconds, e.lo, e.hi)
+        });
+        let renders = rows.iter().map(|r| r.renders.len()).min().unwrap_or(0);
+        let interval = format!("{:.0} % interval of {renders} renders", coverage(renders) * 100.0);
         line_plot(
             &out.join(format!("plots/frame_time_{}.png", shading.name())),
-            &Axes::new(&title, "frame", "render seconds", false, spread(&frame_times) > 30.0),
+            &Axes {
+                interval: &interval,
+                ..Axes::new(
+                    &title,
+                    "frame",
+                    "render seconds (median of the renders)",
+                    false,
+                    spread(&frame_times) > 30.0,
+                )
+            },
             &frame_times,
             &[],
         )?;
         if spec.motion.is_some() {
             line_plot(
                 &out.join(format!("plots/update_time_{}.png", shading.name())),
-                &Axes::new(&title, "frame", "update seconds", false, true),
-                &series(&|r| r.update_seconds.unwrap_or(f64::NAN)),
+                &Axes::new(&title, "frame", "update seconds (one update per frame)", false, true),
+                &series(&|r| Point::bare(r.frame as f64, r.update_seconds.unwrap_or(f64::NAN))),
                 &[],
             )?;
         }
         let sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).collect();
         if sizes.iter().any(|&t| t != largest) {
-            let series: Vec<(usize, Series)> = all
+            // The medians over the path with their intervals, as the report's table gives them.
+            let series: Vec<Series> = all
                 .iter()
-                .enumerate()
-                .map(|(i, l)| {
-                    let mut points: Vec<(f64, f64, f64)> = sizes
+                .map(|l| Series {
+                    name: l.clone(),
+                    look: look(l),
+                    points: summaries
                         .iter()
-                        .filter_map(|&t| Some((t as f64, median_at(rows, shading, l, t)?, f64::NAN)))
-                        .collect();
-                    points.dedup_by(|a, b| a.0 == b.0);
-                    (
-                        i,
-                        Series {
-                            name: l.clone(),
-                            points,
-                            dashed: false,
-                        },
-                    )
+                        .filter(|s| s.shading == shading.name() && s.structure == *l)
+                        .map(|s| Point::between(s.triangles as f64, s.frame_s, s.frame_s_lo, s.frame_s_hi))
+                        .collect(),
                 })
                 .collect();
             line_plot(
                 &out.join(format!("plots/scaling_{}.png", shading.name())),
-                &Axes::new(
-                    &format!(
-                        "{} shading, {}x{}, median over the path",
-                        shading.name(),
-                        spec.width,
-                        spec.height
-                    ),
-                    "triangles",
-                    "frame seconds",
-                    true,
-                    true,
-                ),
+                &Axes {
+                    interval: "95 % interval over the frames",
+                    ..Axes::new(
+                        &format!(
+                            "{} shading, {}x{}, median over the path",
+                            shading.name(),
+                            spec.width,
+                            spec.height
+                        ),
+                        "triangles",
+                        "frame seconds",
+                        true,
+                        true,
+                    )
+                },
                 &series,
                 &[],
             )?;
         }
     }
     if outcome.builds.iter().any(|b| b.triangles != largest) {
-        for (file, what, value) in [
+        // One structure's look: its first label's (the structure, or how it first followed motion).
+        let structure_look = |name: &str| rows.iter().find(|r| r.structure == name).map_or(0, |r| look(&label(r)));
+        for (file, title, what, value) in [
             (
                 "memory",
-                "MB beyond the triangles",
+                "Memory beyond the triangles: one exact count per structure and size",
+                "MB beyond the triangles (exact, no interval)",
                 &(|b: &BuildRow| b.memory_bytes as f64 / 1e6) as &dyn Fn(&BuildRow) -> f64,
             ),
-            ("build_time", "build seconds", &|b: &BuildRow| b.build_seconds),
+            (
+                "build_time",
+                "Build time: one build per structure and size, timed once",
+                "build seconds (one timing, no interval)",
+                &|b: &BuildRow| b.build_seconds,
+            ),
         ] {
-            let series: Vec<(usize, Series)> = spec
+            let series: Vec<Series> = spec
                 .structures
                 .iter()
-                .enumerate()
-                .map(|(i, s)| {
-                    (
-                        i,
-                        Series {
-                            name: s.name.to_string(),
-                            points: outcome
-                                .builds
-                                .iter()
-                                .filter(|b| b.structure == s.name)
-                                .map(|b| (b.triangles as f64, value(b), f64::NAN))
-                                .collect(),
-                            dashed: false,
-                        },
-                    )
+                .map(|s| Series {
+                    name: s.name.to_string(),
+                    look: structure_look(s.name),
+                    points: outcome
+                        .builds
+                        .iter()
+                        .filter(|b| b.structure == s.name)
+                        .map(|b| Point::bare(b.triangles as f64, value(b)))
+                        .collect(),
                 })
                 .collect();
             line_plot(
                 &out.join(format!("plots/{file}.png")),
-                &Axes::new(what, "triangles", what, true, true),
+                &Axes::new(title, "triangles", what, true, true),
                 &series,
                 &[],
             )?;
@@ -332,9 +341,11 @@ pub fn write_frames(
 }
 
 /// One gallery per shading: the strip's frames (`images/strip_SHADING_FRAME.exr`, radiance,
-/// the first structure's), shown at the first frame's exposure.
+/// the first structure's), shown at the first frame's exposure, each against the next
+/// shading's strip (the same frame under the other shading).
 fn strips(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Gallery> {
-    spec.shadings
+    let mut strips: Vec<Gallery> = spec
+        .shadings
         .iter()
         .filter_map(|&(shading, _)| {
             let frames: Vec<_> = outcome.pictures.iter().filter(|p| p.shading == shading).collect();
@@ -344,9 +355,10 @@ fn strips(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Gallery> {
                 width: spec.width,
                 height: spec.height,
                 tone: Tone::Radiance {
-                    p99: exposure(&first.radiance),
+                    p99: exposure(&Tone::radiance_stored(&first.radiance)),
                 },
                 reference: None,
+                against: None,
                 shots: frames
                     .iter()
                     .map(|p| Shot {
@@ -362,16 +374,21 @@ fn strips(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Gallery> {
                     .collect(),
             })
         })
-        .collect()
+        .collect();
+    let n = strips.len();
+    for (i, g) in strips.iter_mut().enumerate() {
+        g.against = (n > 1).then_some((i + 1) % n);
+    }
+    strips
 }
 
 /// The largest positive y of `series` over the smallest: where it is large, one structure's
 /// times would flatten the others' on a linear axis.
-fn spread(series: &[(usize, Series)]) -> f64 {
+fn spread(series: &[Series]) -> f64 {
     let ys = || {
         series
             .iter()
-            .flat_map(|(_, s)| s.points.iter().map(|p| p.1))
+            .flat_map(|s| s.points.iter().map(|p| p.y))
             .filter(|y| *y > 0.0)
     };
     ys().fold(0.0, f64::max) / ys().fold(f64::INFINITY, f64::min)

@@ -6,13 +6,15 @@
 use super::runner::{Outcome, Picture, Row, Series, Timed, REFERENCE};
 use super::spec::RealtimeSpec;
 use crate::experiment::sweep::reference::has_exact_answer;
+use crate::experiment::sweep::report::plots::scheme_look;
 use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, MARGIN, RULE};
 use crate::experiment::RunContext;
 use crate::files::write_atomic;
 use crate::metrics::stats::mean_ci;
 use crate::output::page::{self, Gallery, Page, Shot, Tone};
-use crate::output::plots::{line_plot, Axes, Series as PlotSeries};
+use crate::output::plots::{line_panels, Axes, Panel, Point, Series as PlotSeries};
 use crate::output::table::write_rows;
+use crate::sampling::DiskScheme;
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -534,44 +536,59 @@ fn lag_section(spec: &RealtimeSpec, summary: &[Summary]) -> String {
     out
 }
 
-/// RMSE against frames on the static variant at the fewest rays, one line per (scheme, filter)
-/// at the first accumulation.
+/// RMSE against frames on the static variant at the fewest rays, at the first accumulation:
+/// one panel per filter on shared axes, one line per scheme in each, a scheme in the look it
+/// has in every sweep plot.
 fn plot(spec: &RealtimeSpec, summary: &[Summary], dir: &std::path::Path) -> anyhow::Result<()> {
     let acc = spec.accumulations.first().map(|a| a.name()).unwrap_or("mean");
-    let mut lines: Vec<(usize, PlotSeries)> = Vec::new();
     let rays = spec.rays[0];
-    for s in summary
+    let shown: Vec<&Summary> = summary
         .iter()
         .filter(|s| s.variant == "static" && s.accumulation == acc && s.rays == rays)
-    {
-        let name = format!("{}, {}", s.scheme, s.filter);
-        match lines.iter_mut().find(|(_, l)| l.name == name) {
-            Some((_, l)) => l.points.push((s.frames as f64, s.rmse, s.rmse_ci95)),
+        .collect();
+    let mut panels: Vec<Panel> = Vec::new();
+    for s in &shown {
+        let at = match panels.iter().position(|p| p.title == s.filter) {
+            Some(i) => i,
             None => {
-                let i = lines.len();
-                lines.push((
-                    i,
-                    PlotSeries {
-                        name,
-                        points: vec![(s.frames as f64, s.rmse, s.rmse_ci95)],
-                        dashed: s.filter == "none",
-                    },
-                ))
+                panels.push(Panel {
+                    title: s.filter.clone(),
+                    series: vec![],
+                });
+                panels.len() - 1
             }
+        };
+        let point = Point::ci(s.frames as f64, s.rmse, s.rmse_ci95);
+        let series = &mut panels[at].series;
+        match series.iter_mut().find(|l| l.name == s.scheme) {
+            Some(l) => l.points.push(point),
+            None => series.push(PlotSeries {
+                name: s.scheme.clone(),
+                look: s
+                    .scheme
+                    .parse::<DiskScheme>()
+                    .map_or(series.len(), |d| scheme_look(d, &spec.schemes)),
+                points: vec![point],
+            }),
         }
     }
+    for p in &mut panels {
+        p.title = format!("filter: {}", p.title);
+    }
     std::fs::create_dir_all(dir.join("plots"))?;
-    line_plot(
+    line_panels(
         &dir.join("plots/rmse_frames.svg"),
         &Axes {
-            title: &format!("static, {rays} ray(s) a frame: RMSE against exact over the penumbra ({acc})"),
-            x: "frames accumulated",
-            y: "RMSE",
-            log_x: true,
-            log_y: true,
-            x_range: None,
+            interval: "95 % interval over seeds",
+            ..Axes::new(
+                &format!("static, {rays} ray(s) a frame: RMSE against exact over the penumbra ({acc})"),
+                "frames accumulated",
+                "RMSE",
+                true,
+                true,
+            )
         },
-        &lines,
+        &panels,
         &[],
     )
 }
@@ -631,6 +648,7 @@ fn galleries(spec: &RealtimeSpec, m: &Measured) -> Vec<Gallery> {
             height: spec.height,
             tone: Tone::Linear,
             reference: Some(0),
+            against: None,
             shots,
         });
     }

@@ -32,7 +32,8 @@ pub enum Tone {
     /// Values in [0, 1] (visibility, ambient occlusion) shown as grey, value 1 white.
     Linear,
     /// Radiance tone-mapped like [`crate::output::images::tonemap_with`] with this exposure
-    /// (the 99th percentile that maps to the knee).
+    /// (the 99th percentile that maps to the knee). Radiance galleries are pictures to look at,
+    /// not measurements: their EXRs and the page store them at half precision.
     Radiance {
         /// The exposure.
         p99: f64,
@@ -40,6 +41,21 @@ pub enum Tone {
 }
 
 impl Tone {
+    /// Radiance as a picture gallery stores it: rounded to half precision, a finite value beyond
+    /// the half range saturated to its largest (a highlight stays the brightest white, not
+    /// infinity). A gallery's exposure is taken over these values, so that a page rebuilt from
+    /// the EXRs finds the same exposure.
+    pub fn radiance_stored(values: &[f32]) -> Vec<f32> {
+        let most = half::f16::MAX.to_f32();
+        values
+            .iter()
+            .map(|&v| {
+                let v = if v.is_finite() { v.clamp(-most, most) } else { v };
+                half::f16::from_f32(v).to_f32()
+            })
+            .collect()
+    }
+
     /// The 8-bit picture of `values` (what the PNG shows and FLIP compares).
     pub fn picture(self, values: &[f32], width: u32, height: u32) -> crate::output::images::Rgb {
         match self {
@@ -76,10 +92,36 @@ pub struct Gallery {
     pub height: u32,
     /// How values are shown.
     pub tone: Tone,
-    /// The image the others are measured against (FLIP maps are computed against it).
+    /// The image the others are measured against (FLIP maps are computed against it); the page
+    /// pins it as B when one of the others is A.
     pub reference: Option<usize>,
+    /// A gallery of the same size whose i-th image is the counterpart of this one's i-th (the
+    /// same frame under the other shading): B where this gallery has no reference.
+    pub against: Option<usize>,
     /// The images.
     pub shots: Vec<Shot>,
+}
+
+impl Gallery {
+    /// Whether its values are stored at half precision (see [`Tone::Radiance`]).
+    pub fn half(&self) -> bool {
+        matches!(self.tone, Tone::Radiance { .. })
+    }
+
+    /// A shot's values as stored (EXR and page alike): rounded to half precision in a half
+    /// gallery, so that what the page reads out is what the file holds.
+    pub fn stored(&self, shot: &Shot) -> Vec<f32> {
+        stored_as(shot, self.half())
+    }
+}
+
+/// A shot's values, rounded to half precision where `half` ([`Tone::radiance_stored`]).
+fn stored_as(shot: &Shot, half: bool) -> Vec<f32> {
+    if half {
+        Tone::radiance_stored(&shot.values)
+    } else {
+        shot.values.clone()
+    }
 }
 
 /// A results folder's page: what the report step knows besides the files it wrote.
@@ -98,13 +140,16 @@ const TABLE_BYTES: u64 = 1 << 20;
 
 /// Writes every shot's EXR and PNG into `dir`, each at its path (relative to `dir`).
 pub fn write_shots(dir: &Path, gallery: &Gallery) -> anyhow::Result<()> {
-    use crate::output::images::{write_exr, write_png};
+    use crate::output::images::{write_exr, write_exr_half, write_png};
+    let (w, h) = (gallery.width, gallery.height);
     for s in &gallery.shots {
-        write_exr(&dir.join(&s.exr), &s.values, gallery.width, gallery.height)?;
-        write_png(
-            &dir.join(&s.png),
-            &gallery.tone.picture(&s.values, gallery.width, gallery.height),
-        )?;
+        let values = gallery.stored(s);
+        if gallery.half() {
+            write_exr_half(&dir.join(&s.exr), &values, w, h)?;
+        } else {
+            write_exr(&dir.join(&s.exr), &values, w, h)?;
+        }
+        write_png(&dir.join(&s.png), &gallery.tone.picture(&values, w, h))?;
     }
     Ok(())
 }
@@ -113,9 +158,17 @@ pub fn write_shots(dir: &Path, gallery: &Gallery) -> anyhow::Result<()> {
 /// name; those over 1 MiB linked only), plots (plots/*.svg, else *.png) and pictures (images/*.png
 /// with no EXR beside them) the page shows.
 pub fn write(dir: &Path, page: &Page) -> anyhow::Result<()> {
+    let half: Vec<bool> = page.galleries.iter().map(Gallery::half).collect();
+    write_stored(dir, page, &half)
+}
+
+/// [`write`], each gallery's values stored at half precision where `half` says so (a rebuilt
+/// folder's pictures keep the precision their EXRs have).
+fn write_stored(dir: &Path, page: &Page, half: &[bool]) -> anyhow::Result<()> {
+    check(&page.galleries)?;
     let mut galleries = Vec::new();
-    for g in &page.galleries {
-        galleries.push(data::gallery(g, flip_maps(g)?)?);
+    for (g, &half) in page.galleries.iter().zip(half) {
+        galleries.push(data::gallery(g, half, flip_maps(g, half)?)?);
     }
     let mut tables = Vec::new();
     for t in files_in(dir, "", ".csv")? {
@@ -136,11 +189,11 @@ pub fn write(dir: &Path, page: &Page) -> anyhow::Result<()> {
 
 /// Per shot, its FLIP map against the gallery's reference (none for the reference itself or
 /// where the gallery has none): FLIP compares what a person sees, the pictures the PNGs hold.
-fn flip_maps(g: &Gallery) -> anyhow::Result<Vec<Option<Vec<f32>>>> {
+fn flip_maps(g: &Gallery, half: bool) -> anyhow::Result<Vec<Option<Vec<f32>>>> {
     let Some(r) = g.reference else {
         return Ok(vec![None; g.shots.len()]);
     };
-    let reference = g.tone.picture(&g.shots[r].values, g.width, g.height);
+    let reference = g.tone.picture(&stored_as(&g.shots[r], half), g.width, g.height);
     g.shots
         .iter()
         .enumerate()
@@ -148,10 +201,43 @@ fn flip_maps(g: &Gallery) -> anyhow::Result<Vec<Option<Vec<f32>>>> {
             if i == r {
                 return Ok(None);
             }
-            let test = g.tone.picture(&s.values, g.width, g.height);
+            let test = g.tone.picture(&stored_as(s, half), g.width, g.height);
             flip_map(&reference.data, &test.data, g.width, g.height, PIXELS_PER_DEGREE).map(Some)
         })
         .collect()
+}
+
+/// Refuses galleries the page cannot show: one without images, a reference that is not one of
+/// its images, a counterpart gallery that does not exist or whose images are of another size.
+fn check(galleries: &[Gallery]) -> anyhow::Result<()> {
+    for (i, g) in galleries.iter().enumerate() {
+        anyhow::ensure!(!g.shots.is_empty(), "gallery {:?} has no images", g.title);
+        if let Some(r) = g.reference {
+            anyhow::ensure!(
+                r < g.shots.len(),
+                "gallery {:?}: reference {r} of {} images",
+                g.title,
+                g.shots.len()
+            );
+        }
+        if let Some(o) = g.against {
+            anyhow::ensure!(o != i, "gallery {:?} is set against itself", g.title);
+            let other = galleries
+                .get(o)
+                .with_context(|| format!("gallery {:?} is set against gallery {o}, which is not there", g.title))?;
+            anyhow::ensure!(
+                (other.width, other.height) == (g.width, g.height),
+                "gallery {:?} ({}x{}) is set against {:?} ({}x{})",
+                g.title,
+                g.width,
+                g.height,
+                other.title,
+                other.width,
+                other.height
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`; such a name
@@ -202,6 +288,7 @@ fn pictures_in(dir: &Path) -> anyhow::Result<Vec<String>> {
 
 const STYLE: &str = include_str!("page.css");
 const SCRIPT: &str = include_str!("page.js");
+const SELFTEST: &str = include_str!("selftest.js");
 
 /// Text made safe inside HTML elements and double-quoted attributes.
 pub fn escape(text: &str) -> String {
@@ -235,18 +322,16 @@ fn html(page: &Page, plots: &[String], pictures: &[String]) -> String {
     }
     h += "<section id=\"tables\"><h2>Tables</h2><p class=\"hint\">Click a column to sort; a row with an image opens it in the comparison.</p><div id=\"table-list\"></div></section>\n";
     h += "<section id=\"plots\"><h2>Plots</h2>\n";
-    for p in plots {
+    h += "<p class=\"hint\">Click a figure to see it at full size.</p>\n";
+    for p in plots.iter().chain(pictures) {
         let p = escape(p);
-        h += &format!("<figure><a href=\"{p}\"><img src=\"{p}\" alt=\"{p}\" loading=\"eager\"></a><figcaption>{p}</figcaption></figure>\n");
-    }
-    for p in pictures {
-        let p = escape(p);
-        h += &format!("<figure><a href=\"{p}\"><img src=\"{p}\" alt=\"{p}\" loading=\"eager\"></a><figcaption>{p}</figcaption></figure>\n");
+        h += &format!("<figure><div class=\"scroll\"><img src=\"{p}\" alt=\"{p}\" loading=\"eager\"></div><figcaption><a href=\"{p}\">{p}</a></figcaption></figure>\n");
     }
     h += "</section>\n<section id=\"report\"><h2>Report</h2>\n";
     h += &markdown::to_html(&page.report);
-    h += "</section>\n<pre id=\"selftest\" hidden></pre>\n<script src=\"page_data.js\"></script>\n<script>\n";
+    h += "</section>\n<div id=\"lightbox\" hidden><img id=\"lightbox-img\" alt=\"the figure at full size\"></div>\n<pre id=\"selftest\" hidden></pre>\n<script src=\"page_data.js\"></script>\n<script>\n";
     h += SCRIPT;
+    h += SELFTEST;
     h += "</script>\n</body>\n</html>\n";
     h
 }
@@ -255,18 +340,21 @@ const COMPARE: &str = r#"<section id="compare"><h2>Compare</h2>
 <div class="controls">
 <label>A <select id="pick-a"></select></label>
 <label>B <select id="pick-b"></select></label>
-<label>mode <select id="mode"><option value="split">slider</option><option value="flip">flip</option></select></label>
+<label>mode <select id="mode"><option value="split">slider</option><option value="toggle">toggle</option></select></label>
 <label id="split-label">split <input id="split" type="range" min="0" max="1" step="0.001" value="0.5"></label>
-<button id="flip" type="button" title="show the other image (key F)">flip</button>
+<button id="toggle" type="button" title="show A, then B, in one place (key T)">toggle A/B (T)</button>
 <label>exposure <input id="exposure" type="range" min="-6" max="6" step="0.25" value="0"> <output id="exposure-value">0 EV</output></label>
-<label>error view <select id="error-view"><option value="diff">signed difference A − B</option><option value="relse">relative squared error (A − B)² / (B² + 0.01)</option><option value="flip">FLIP of A against the gallery's reference</option></select></label>
+<label>error view <select id="error-view"><option value="diff">signed difference A − B</option><option value="relse">relative squared error</option><option value="flip">FLIP of A against B</option></select></label>
+<label>scale <select id="scale"><option value="auto">auto (99th percentile)</option><option value="fixed">fixed (the values' range)</option><option value="user">maximum:</option><option value="log">log (4 decades)</option></select> <input id="user-max" type="number" min="0" step="any" value="1" disabled></label>
 <button id="fit" type="button">fit</button>
 </div>
+<table id="numbers" class="numbers" title="A against B over every pixel where both have a receiver (the tables' errors are over the penumbra only); pixels differing: values not bit for bit equal"><tr><th>MSE</th><th>relMSE</th><th>mean FLIP</th><th>max |A − B|</th><th>pixels differing</th><th>pixels compared</th></tr>
+<tr><td id="num-mse"></td><td id="num-relmse"></td><td id="num-flip"></td><td id="num-max"></td><td><span id="num-differ"></span> of <span id="num-pixels"></span></td><td id="num-compared"></td></tr></table>
 <div class="views">
-<figure><canvas id="view-compare" width="640" height="480"></canvas><figcaption id="compare-caption"></figcaption></figure>
-<figure><canvas id="view-error" width="640" height="480"></canvas><figcaption><canvas id="colour-bar" width="256" height="14"></canvas><span id="bar-lo"></span><span id="bar-hi"></span> <span id="error-caption"></span></figcaption></figure>
+<figure><canvas id="view-compare" width="640" height="480"></canvas><figcaption><span id="compare-caption" class="line"></span><span id="tone-caption" class="line"></span></figcaption></figure>
+<figure><canvas id="view-error" width="640" height="480"></canvas><figcaption><span id="colour-scale" class="line"><canvas id="colour-bar" width="256" height="14"></canvas><span id="bar-lo"></span><span id="bar-hi"></span></span><span id="error-caption" class="line"></span></figcaption></figure>
 </div>
-<p id="readout" class="readout">Move the cursor over an image: pixel, A, B and the error view's value. Wheel zooms, drag pans.</p>
+<p id="readout" class="readout">Move the cursor over an image: pixel, A, B and the error view's value. Drag pans (the yellow divider moves the split); click the image or hold Ctrl and wheel to zoom; keys 1-9 step A through its gallery, T toggles.</p>
 <p class="files" id="files"></p>
 </section>
 "#;

@@ -1,9 +1,11 @@
 'use strict';
 // The comparison page's viewer. It reads window.PENUMBRA (page_data.js, written beside the
-// page): galleries of measured images and the results folder's tables. Opened with
-// #selftest it also checks itself and writes what it found as JSON into the element with id
-// selftest, which the browser test reads.
-(function () {
+// page): galleries of measured images and the results folder's tables. The pair on screen is A
+// against B: B opens as A's reference (its gallery's ground truth, exact image or brute force, or
+// the same frame under the other shading) and follows A from gallery to gallery; both sides are
+// drawn with B's tone mapping and one exposure; the pair's numbers are computed here from the
+// stored values. Opened with #selftest, selftest.js (inlined after this) checks the page.
+const PAGE = (function () {
   const errors = [];
   window.addEventListener('error', (e) => errors.push(String(e.message || e)));
   window.addEventListener('unhandledrejection', (e) => errors.push('unhandled rejection: ' + String(e.reason)));
@@ -15,8 +17,10 @@
 
   const DATA = window.PENUMBRA;
   if (!DATA) errors.push('page_data.js did not load');
+  const SELFTEST = location.hash === '#selftest';
   const NO_RECEIVER = -1;
   const NO_RECEIVER_RGB = [20, 24, 60];
+  const ZOOM_MAX = 64;
   const $ = (id) => document.getElementById(id);
   // A link to a file of the results folder by its relative path: each part percent-encoded and
   // the whole led by ./, so that no file name (`javascript:x.csv`, `a#b.csv`) reads as a scheme
@@ -32,43 +36,84 @@
     return new Uint8Array(await new Response(stream).arrayBuffer());
   }
 
-  // Every shot as {label, gallery, width, height, tone, values: Float32Array, flip: Float32Array|null}.
+  // IEEE 754 half to number.
+  function halfToFloat(h) {
+    const sign = h & 0x8000 ? -1 : 1;
+    const exponent = (h >> 10) & 0x1f;
+    const fraction = h & 0x3ff;
+    if (exponent === 0) return sign * fraction * Math.pow(2, -24);
+    if (exponent === 31) return fraction ? NaN : sign * Infinity;
+    return sign * (1 + fraction / 1024) * Math.pow(2, exponent - 15);
+  }
+
+  // Every half float's value, by its bits.
+  let halves = null;
+  function halfTable() {
+    if (!halves) {
+      halves = new Float32Array(65536);
+      for (let h = 0; h < 65536; h++) halves[h] = halfToFloat(h);
+    }
+    return halves;
+  }
+
+  // Byte planes of wrapping deltas of bit patterns (data.rs) back to values.
+  function unplane(bytes, n, bits, name) {
+    const width = bits / 8;
+    if (bytes.length !== width * n) throw new Error(`${name}: ${bytes.length} bytes for ${n} pixels of ${bits} bits`);
+    const values = new Float32Array(n);
+    if (bits === 16) {
+      const table = halfTable();
+      let previous = 0;
+      for (let i = 0; i < n; i++) {
+        previous = (previous + (bytes[i] | (bytes[n + i] << 8))) & 0xffff;
+        values[i] = table[previous];
+      }
+      return values;
+    }
+    // Int32 sums wrap as the u32 deltas do; the Uint32Array stores them as those bits.
+    const asBits = new Uint32Array(values.buffer);
+    let previous = 0;
+    for (let i = 0; i < n; i++) {
+      previous = (previous + (bytes[i] | (bytes[n + i] << 8) | (bytes[2 * n + i] << 16) | (bytes[3 * n + i] << 24))) | 0;
+      asBits[i] = previous;
+    }
+    return values;
+  }
+
+  // Galleries as {title, first, count, tone, bits, reference, against} and every shot as
+  // {label, exr, png, key, gallery, index, width, height, values: Float32Array, flip, flipMean}.
   async function decode(data) {
+    const galleries = [];
     const shots = [];
     for (const [g, gallery] of data.galleries.entries()) {
       const first = shots.length;
-      for (const s of gallery.shots) {
-        const n = gallery.width * gallery.height;
-        let values;
-        if (s.same !== null) {
-          values = shots[first + s.same].values;
-        } else {
-          const bytes = await inflate(s.data);
-          if (bytes.length !== 4 * n) throw new Error(`${s.exr}: ${bytes.length} bytes for ${n} pixels`);
-          const view = new DataView(bytes.buffer);
-          values = new Float32Array(n);
-          for (let i = 0; i < n; i++) values[i] = view.getFloat32(4 * i, true);
-        }
+      const n = gallery.width * gallery.height;
+      for (const [k, s] of gallery.shots.entries()) {
+        const values = s.same !== null ? shots[first + s.same].values : unplane(await inflate(s.data), n, gallery.bits, s.exr);
         let flip = null;
         if (s.flip !== null) {
           const bytes = await inflate(s.flip);
           if (bytes.length !== n) throw new Error(`${s.exr}: FLIP map of ${bytes.length} pixels for ${n}`);
-          flip = Float32Array.from(bytes, (b) => b / 255);
+          flip = new Float32Array(n);
+          for (let i = 0; i < n; i++) flip[i] = bytes[i] / 255;
         }
         shots.push({
-          label: s.label, exr: s.exr, png: s.png, key: s.key, gallery: g,
-          galleryTitle: gallery.title, reference: gallery.reference === null ? null : first + gallery.reference,
-          width: gallery.width, height: gallery.height, tone: gallery.tone, values, flip,
+          label: s.label, exr: s.exr, png: s.png, key: s.key, gallery: g, index: k,
+          width: gallery.width, height: gallery.height, values, flip, flipMean: s.flip_mean,
         });
       }
+      galleries.push({
+        title: gallery.title, first, count: gallery.shots.length, tone: gallery.tone, bits: gallery.bits,
+        reference: gallery.reference === null ? null : first + gallery.reference, against: gallery.against,
+      });
     }
-    return shots;
+    return { galleries, shots };
   }
 
   // ---- colour ------------------------------------------------------------------------------
   const toByte = (x) => Math.round(Math.min(Math.max(x, 0), 1) * 255);
 
-  // The same mapping as the PNG beside each EXR (output/images.rs), scaled by 2^ev.
+  // The same mapping as the PNGs (output/images.rs), scaled by 2^ev.
   function toneByte(tone, v, gain) {
     if (tone.kind === 'linear') return toByte(v * gain);
     const x = (2 * v * gain) / tone.p99;
@@ -89,12 +134,14 @@
     return c >= 0 ? [255, toByte(1 - c), toByte(1 - c)] : [toByte(1 + c), toByte(1 + c), 255];
   }
 
-  // ---- error views -------------------------------------------------------------------------
+  // ---- error views and their scales --------------------------------------------------------
   const VIEWS = {
-    diff: { name: 'A − B', value: (a, b) => a - b, colour: (v, s) => diverging(v / s), lo: (s) => -s },
-    relse: { name: '(A − B)² / (B² + 0.01)', value: (a, b) => ((a - b) * (a - b)) / (b * b + 0.01), colour: (v, s) => magma(v / s), lo: () => 0 },
-    flip: { name: 'FLIP', value: null, colour: (v) => magma(v), lo: () => 0 },
+    diff: { name: 'A − B', value: (a, b) => a - b, colour: (t) => diverging(t), signed: true },
+    relse: { name: '(A − B)² / (B² + 0.01)', value: (a, b) => ((a - b) * (a - b)) / (b * b + 0.01), colour: (t) => magma(t), signed: false },
+    flip: { name: 'FLIP', value: null, colour: (t) => magma(t), signed: false },
   };
+  // A log scale spans four decades below its maximum.
+  const LOG_DECADES = 4;
 
   // Per pixel the error view's value (NaN where a pixel has no receiver or there is no map).
   function errorValues(view, a, b) {
@@ -104,7 +151,6 @@
       if (a.flip) out.set(a.flip);
       return out;
     }
-    if (b.values.length !== n) return out;
     const f = VIEWS[view].value;
     for (let i = 0; i < n; i++) {
       const x = a.values[i];
@@ -114,22 +160,78 @@
     return out;
   }
 
-  // The colour scale of an error view: the 99th percentile of |value| (FLIP: 1).
-  function errorScale(view, values) {
-    if (view === 'flip') return 1;
+  // The 99th percentile of |value| (1 where that is 0).
+  function percentile99(values) {
     const m = Array.from(values, Math.abs).filter(Number.isFinite).sort((x, y) => x - y);
     const s = m.length ? m[Math.min(m.length - 1, Math.floor(0.99 * m.length))] : 0;
     return s > 0 ? s : 1;
   }
 
-  // ---- the viewer --------------------------------------------------------------------------
-  const state = { a: 0, b: 0, mode: 'split', split: 0.5, showB: false, ev: 0, view: 'diff', zoom: 1, panX: 0, panY: 0 };
+  // The error view's maximum under the chosen scale: auto (99th percentile), fixed (the values'
+  // own range: 1, or the exposure for radiance; FLIP 1), the user's maximum, or log (four decades
+  // below the largest |value|).
+  function errorMaximum(values) {
+    if (state.view === 'flip') return 1;
+    if (state.scale === 'fixed') return state.view === 'diff' && tone().kind === 'radiance' ? tone().p99 : 1;
+    if (state.scale === 'user') return state.userMax > 0 ? state.userMax : 1;
+    if (state.scale === 'log') {
+      const m = Array.from(values, Math.abs).filter(Number.isFinite).reduce((x, y) => Math.max(x, y), 0);
+      return m > 0 ? m : 1;
+    }
+    return percentile99(values);
+  }
+
+  // Where `v` falls on the colour scale: -1..1 (signed views) or 0..1.
+  function position(v, max) {
+    if (state.scale !== 'log') return v / max;
+    const lo = max * Math.pow(10, -LOG_DECADES);
+    const t = Math.abs(v) <= lo ? 0 : Math.min(Math.log10(Math.abs(v) / lo) / LOG_DECADES, 1);
+    return Math.sign(v) * t;
+  }
+
+  // ---- the viewer's state ------------------------------------------------------------------
+  const state = {
+    a: 0, b: 0, mode: 'split', split: 0.5, showB: false, ev: 0, view: 'diff', scale: 'auto', userMax: 1,
+    zoom: 1, panX: 0, panY: 0,
+  };
+  let galleries = [];
   let shots = [];
   const layers = new Map();
+  // The tone both sides are drawn with: B's (the pinned reference's).
+  const tone = () => galleries[shots[state.b].gallery].tone;
+  const sameSize = (i, j) => shots[i].width === shots[j].width && shots[i].height === shots[j].height;
 
+  // The image B follows A to: A's gallery's reference; else the same image of the gallery A's
+  // is set against (the other shading); else B as it is, where it is of A's size and not A; else
+  // the next image of A's gallery.
+  function partner(i, current) {
+    const s = shots[i];
+    const g = galleries[s.gallery];
+    if (g.reference !== null && g.reference !== i) return g.reference;
+    if (g.against !== null && s.index < galleries[g.against].count && sameSize(galleries[g.against].first + s.index, i)) {
+      return galleries[g.against].first + s.index;
+    }
+    if (current !== undefined && current !== i && sameSize(current, i)) return current;
+    return g.count > 1 ? g.first + ((s.index + 1) % g.count) : i;
+  }
+
+  // The image the page opens on: the first gallery's first image that is not its reference.
+  function opening() {
+    const g = galleries[0];
+    for (let k = 0; k < g.count; k++) if (g.first + k !== g.reference) return g.first + k;
+    return g.first;
+  }
+
+  // Drawn pictures, the most recently used kept (each exposure step draws both sides anew).
+  const LAYERS_KEPT = 48;
   function layer(shot, key, paint) {
     const id = `${shots.indexOf(shot)}:${key}`;
-    if (!layers.has(id)) {
+    if (layers.has(id)) {
+      const c = layers.get(id);
+      layers.delete(id);
+      layers.set(id, c);
+    } else {
+      while (layers.size >= LAYERS_KEPT) layers.delete(layers.keys().next().value);
       const c = document.createElement('canvas');
       c.width = shot.width;
       c.height = shot.height;
@@ -142,32 +244,92 @@
     return layers.get(id);
   }
 
+  // A shot drawn with the pair's tone at the pair's exposure.
   function picture(shot) {
     const gain = Math.pow(2, state.ev);
-    return layer(shot, `ev${state.ev}`, (px) => {
-      shot.values.forEach((v, i) => {
-        const rgb = v === NO_RECEIVER && shot.tone.kind === 'linear' ? NO_RECEIVER_RGB : [toneByte(shot.tone, v, gain)].flatMap((x) => [x, x, x]);
-        px.set([...rgb, 255], 4 * i);
-      });
+    const t = tone();
+    return layer(shot, `${JSON.stringify(t)}:${state.ev}`, (px) => {
+      const linear = t.kind === 'linear';
+      for (let i = 0; i < shot.values.length; i++) {
+        const v = shot.values[i];
+        const at = 4 * i;
+        if (v === NO_RECEIVER && linear) {
+          px.set(NO_RECEIVER_RGB, at);
+        } else {
+          px.fill(toneByte(t, v, gain), at, at + 3);
+        }
+        px[at + 3] = 255;
+      }
     });
   }
 
+  // Whether A's FLIP map is A against B (FLIP is measured against the gallery's reference).
+  const flipShown = () => shots[state.a].flip !== null && galleries[shots[state.a].gallery].reference === state.b;
+
+  // ---- the pair's numbers ------------------------------------------------------------------
+  // Over the pixels where both have a receiver: MSE, relative MSE (÷ (B² + 0.01), as the error
+  // view), max |A − B|; pixels differing counts every pixel whose bits differ; mean FLIP is A's
+  // map's (exact, from the file) where B is the map's reference.
+  const numbersCache = new Map();
+  function pairNumbers(i, j) {
+    const key = `${i}/${j}`;
+    if (!numbersCache.has(key)) {
+      const [a, b] = [shots[i], shots[j]];
+      const [bitsA, bitsB] = [new Uint32Array(a.values.buffer), new Uint32Array(b.values.buffer)];
+      let [compared, differing, se, rel, max] = [0, 0, 0, 0, 0];
+      for (let k = 0; k < a.values.length; k++) {
+        if (bitsA[k] !== bitsB[k]) differing++;
+        const [x, y] = [a.values[k], b.values[k]];
+        if (x === NO_RECEIVER || y === NO_RECEIVER) continue;
+        const d = x - y;
+        compared++;
+        se += d * d;
+        rel += (d * d) / (y * y + 0.01);
+        max = Math.max(max, Math.abs(d));
+      }
+      numbersCache.set(key, {
+        pixels: a.values.length, compared, differing, identical: differing === 0,
+        mse: compared ? se / compared : NaN, relmse: compared ? rel / compared : NaN, max: compared ? max : NaN,
+        flip: galleries[a.gallery].reference === j && a.flipMean !== null ? a.flipMean : NaN,
+      });
+    }
+    return numbersCache.get(key);
+  }
+
+  const fmt = (v) => (Number.isFinite(v) ? (v === 0 ? '0' : v.toPrecision(6)) : '—');
+
+  function showNumbers() {
+    const n = pairNumbers(state.a, state.b);
+    $('num-mse').textContent = fmt(n.mse);
+    $('num-relmse').textContent = fmt(n.relmse);
+    $('num-flip').textContent = fmt(n.flip);
+    $('num-flip').title = Number.isFinite(n.flip) ? 'mean of A\'s FLIP map against its gallery\'s reference (B)' : 'FLIP is measured against A\'s gallery\'s reference only';
+    $('num-max').textContent = fmt(n.max);
+    $('num-differ').textContent = String(n.differing);
+    $('num-pixels').textContent = String(n.pixels);
+    $('num-compared').textContent = String(n.compared);
+  }
+
+  // ---- drawing -----------------------------------------------------------------------------
   let errorCache = null;
   function errorLayer() {
     const a = shots[state.a];
-    const b = shots[state.b];
-    const key = `${state.a}/${state.b}/${state.view}`;
+    const key = `${state.a}/${state.b}/${state.view}/${state.scale}/${state.userMax}/${JSON.stringify(tone())}`;
     if (!errorCache || errorCache.key !== key) {
-      const values = errorValues(state.view, a, b);
-      const scale = errorScale(state.view, values);
+      const values = errorValues(state.view, a, shots[state.b]);
+      const max = errorMaximum(values);
       const c = document.createElement('canvas');
       c.width = a.width;
       c.height = a.height;
       const ctx = c.getContext('2d');
       const img = ctx.createImageData(a.width, a.height);
-      values.forEach((v, i) => img.data.set([...(Number.isFinite(v) ? VIEWS[state.view].colour(v, scale) : [96, 96, 96]), 255], 4 * i));
+      const view = VIEWS[state.view];
+      for (let i = 0; i < values.length; i++) {
+        img.data.set(Number.isFinite(values[i]) ? view.colour(position(values[i], max)) : [96, 96, 96], 4 * i);
+        img.data[4 * i + 3] = 255;
+      }
       ctx.putImageData(img, 0, 0);
-      errorCache = { key, values, scale, canvas: c };
+      errorCache = { key, values, max, canvas: c };
     }
     return errorCache;
   }
@@ -183,47 +345,82 @@
     ctx.setTransform(1, 0, 0, 1, 0, 0);
   }
 
+  // A corner label ("A", "B") drawn on the image.
+  function tag(ctx, text, x, right) {
+    ctx.font = 'bold 15px system-ui, sans-serif';
+    const w = ctx.measureText(text).width + 12;
+    ctx.fillStyle = 'rgba(0, 0, 0, 0.65)';
+    ctx.fillRect(right ? x - w : x, 6, w, 22);
+    ctx.fillStyle = '#ffd400';
+    ctx.fillText(text, (right ? x - w : x) + 6, 22);
+  }
+
   function render() {
     if (!shots.length) return;
     const a = shots[state.a];
     const b = shots[state.b];
     const compare = $('view-compare');
+    const divider = Math.round(state.split * compare.width);
     draw(compare, (ctx) => {
-      if (state.mode === 'flip') {
+      if (state.mode === 'toggle') {
         ctx.drawImage(picture(state.showB ? b : a), 0, 0);
         return;
       }
-      const x = (state.split * compare.width - state.panX) / state.zoom;
-      ctx.save();
-      ctx.beginPath();
-      ctx.rect(-1e6, -1e6, x + 1e6, 2e6);
-      ctx.clip();
-      ctx.drawImage(picture(a), 0, 0);
-      ctx.restore();
-      ctx.save();
-      ctx.beginPath();
-      ctx.rect(x, -1e6, 2e6, 2e6);
-      ctx.clip();
-      ctx.drawImage(picture(b), 0, 0);
-      ctx.restore();
+      const x = (divider - state.panX) / state.zoom;
+      for (const [shot, left] of [[a, true], [b, false]]) {
+        ctx.save();
+        ctx.beginPath();
+        if (left) ctx.rect(-1e6, -1e6, x + 1e6, 2e6);
+        else ctx.rect(x, -1e6, 2e6, 2e6);
+        ctx.clip();
+        ctx.drawImage(picture(shot), 0, 0);
+        ctx.restore();
+      }
     });
+    const ctx = compare.getContext('2d');
     if (state.mode === 'split') {
-      const ctx = compare.getContext('2d');
       ctx.fillStyle = '#ffd400';
-      ctx.fillRect(Math.round(state.split * compare.width) - 1, 0, 2, compare.height);
+      ctx.fillRect(divider - 1, 0, 2, compare.height);
+      tag(ctx, 'A', 6, false);
+      tag(ctx, 'B', compare.width - 6, true);
+    } else {
+      tag(ctx, state.showB ? 'B' : 'A', 6, false);
     }
-    $('compare-caption').textContent = state.mode === 'flip'
+    $('compare-caption').textContent = state.mode === 'toggle'
       ? `showing ${state.showB ? 'B' : 'A'}: ${(state.showB ? b : a).label}`
-      : `left of the line A: ${a.label}; right B: ${b.label}`;
-    const e = errorLayer();
-    draw($('view-error'), (ctx) => ctx.drawImage(e.canvas, 0, 0));
-    colourBar(e.scale);
-    const v = VIEWS[state.view];
-    $('error-caption').textContent = state.view === 'flip'
-      ? (a.flip ? `FLIP of A against ${shots[a.reference].label}` : 'no FLIP map for A (it is its gallery\'s reference, or the gallery has none)')
-      : `${v.name}, scale: 99th percentile of |value|`;
+      : `A (left): ${a.label} · B (right): ${b.label}`;
+    $('compare-caption').title = `A: ${galleries[a.gallery].title} / ${a.label}\nB: ${galleries[b.gallery].title} / ${b.label}`;
+    $('tone-caption').textContent = tone().kind === 'linear'
+      ? 'both sides: values 0…1 as grey'
+      : `both sides: B's exposure (p99 ${tone().p99.toPrecision(4)})`;
+    showNumbers();
+    const identical = pairNumbers(state.a, state.b).identical;
+    const view = VIEWS[state.view];
+    if (identical) {
+      const c = $('view-error');
+      const e = c.getContext('2d');
+      e.setTransform(1, 0, 0, 1, 0, 0);
+      e.fillStyle = '#2b2b2b';
+      e.fillRect(0, 0, c.width, c.height);
+      e.fillStyle = '#f0f0f0';
+      e.font = '20px system-ui, sans-serif';
+      e.textAlign = 'center';
+      e.fillText('A and B are bit-identical:', c.width / 2, c.height / 2 - 14);
+      e.fillText(`every one of ${a.values.length} values equal`, c.width / 2, c.height / 2 + 16);
+      e.textAlign = 'start';
+      $('error-caption').textContent = 'A and B are bit-identical: no error to show';
+    } else {
+      const e = errorLayer();
+      draw($('view-error'), (ctx) => ctx.drawImage(e.canvas, 0, 0));
+      $('error-caption').textContent = state.view === 'flip'
+        ? `FLIP of A against B (its gallery's reference)`
+        : `${view.name}, ${SCALES[state.scale]}`;
+      colourBar(e.max);
+    }
+    $('colour-scale').style.visibility = identical ? 'hidden' : 'visible';
     $('files').innerHTML = '';
-    for (const s of [a, b]) {
+    for (const [name, s] of [['A', a], ['B', b]]) {
+      $('files').append(`${name}: `);
       for (const f of [s.exr, s.png]) {
         const link = document.createElement('a');
         link.href = fileUrl(f);
@@ -231,29 +428,106 @@
         $('files').append(link, ' ');
       }
     }
+    remember();
   }
+  const SCALES = { auto: 'scale: 99th percentile of |value|', fixed: 'scale: the values\' range', user: 'scale: your maximum', log: `log scale, ${LOG_DECADES} decades` };
 
-  function colourBar(scale) {
+  function colourBar(max) {
     const bar = $('colour-bar');
     const ctx = bar.getContext('2d');
-    const v = VIEWS[state.view];
-    const lo = v.lo(scale);
+    const view = VIEWS[state.view];
+    const lo = view.signed ? -1 : 0;
     for (let x = 0; x < bar.width; x++) {
-      const t = lo + ((scale - lo) * (x + 0.5)) / bar.width;
-      ctx.fillStyle = `rgb(${v.colour(t, scale).join(',')})`;
+      ctx.fillStyle = `rgb(${view.colour(lo + ((1 - lo) * (x + 0.5)) / bar.width).join(',')})`;
       ctx.fillRect(x, 0, 1, bar.height);
     }
-    $('bar-lo').textContent = lo.toPrecision(3);
-    $('bar-hi').textContent = scale.toPrecision(3);
+    const floor = max * Math.pow(10, -LOG_DECADES);
+    $('bar-lo').textContent = state.scale === 'log' ? (view.signed ? `−${max.toPrecision(3)}` : floor.toPrecision(3)) : (view.signed ? -max : 0).toPrecision(3);
+    $('bar-hi').textContent = max.toPrecision(3);
   }
 
+  // The zoom at which A fills the canvas.
+  function fitZoom() {
+    const a = shots[state.a];
+    const c = $('view-compare');
+    return Math.min(c.width / a.width, c.height / a.height);
+  }
+
+  // Fits the image in the canvas at any (fractional) zoom, centred.
   function fit() {
     const a = shots[state.a];
     const c = $('view-compare');
-    state.zoom = Math.min(c.width / a.width, c.height / a.height);
-    if (state.zoom >= 1) state.zoom = Math.floor(state.zoom);
+    state.zoom = fitZoom();
     state.panX = (c.width - a.width * state.zoom) / 2;
     state.panY = (c.height - a.height * state.zoom) / 2;
+  }
+
+  // The zoom's bounds: half the fit, and 64x (twice the fit, for an image that small).
+  const zoomBounds = () => [fitZoom() / 2, Math.max(ZOOM_MAX, 2 * fitZoom())];
+
+  // Zoom by `factor` about canvas point (cx, cy), within the bounds.
+  function zoomAt(cx, cy, factor) {
+    const [least, most] = zoomBounds();
+    const zoom = Math.min(Math.max(state.zoom * factor, least), most);
+    const f = zoom / state.zoom;
+    state.panX = cx - (cx - state.panX) * f;
+    state.panY = cy - (cy - state.panY) * f;
+    state.zoom = zoom;
+  }
+
+  // ---- the view in the URL -----------------------------------------------------------------
+  function serialise() {
+    const p = new URLSearchParams();
+    p.set('a', shots[state.a].exr);
+    p.set('b', shots[state.b].exr);
+    for (const k of ['mode', 'split', 'ev', 'view', 'scale', 'userMax', 'zoom', 'panX', 'panY']) p.set(k, String(state[k]));
+    return p.toString();
+  }
+
+  // Applies a serialised view; false where it names no image of this page.
+  function restore(text) {
+    const p = new URLSearchParams(text);
+    const find = (exr) => shots.findIndex((s) => s.exr === exr);
+    const [a, b] = [find(p.get('a')), find(p.get('b'))];
+    if (a < 0) return false;
+    choose(a, b >= 0 ? b : undefined);
+    // What the link leaves out is as the page opens: fitted, slider at the middle, 0 EV.
+    fit();
+    Object.assign(state, { split: 0.5, ev: 0, userMax: 1 });
+    const number = (k, lo, hi) => {
+      const v = p.has(k) ? Number(p.get(k)) : NaN;
+      return Number.isFinite(v) ? Math.min(Math.max(v, lo), hi) : state[k];
+    };
+    const own = (o, k) => k !== null && Object.prototype.hasOwnProperty.call(o, k);
+    state.mode = p.get('mode') === 'toggle' ? 'toggle' : 'split';
+    state.view = own(VIEWS, p.get('view')) ? p.get('view') : 'diff';
+    state.scale = own(SCALES, p.get('scale')) ? p.get('scale') : 'auto';
+    const [least, most] = zoomBounds();
+    state.split = number('split', 0, 1);
+    state.ev = number('ev', -6, 6);
+    if (Number(p.get('userMax')) > 0) state.userMax = Math.min(Number(p.get('userMax')), Number.MAX_VALUE);
+    state.zoom = number('zoom', least, most);
+    state.panX = number('panX', -1e7, 1e7);
+    state.panY = number('panY', -1e7, 1e7);
+    syncControls();
+    render();
+    return true;
+  }
+
+  // The view into the URL, a moment after the last change: browsers refuse (Safari and Firefox
+  // throw) more than about a hundred history updates in a few seconds, which a slider's drag
+  // makes.
+  let rememberLater = null;
+  function remember() {
+    if (SELFTEST) return;
+    clearTimeout(rememberLater);
+    rememberLater = setTimeout(() => {
+      try {
+        history.replaceState(null, '', '#' + serialise());
+      } catch (e) {
+        // Throttled: the next change writes it.
+      }
+    }, 250);
   }
 
   // ---- pixel readout -----------------------------------------------------------------------
@@ -262,10 +536,13 @@
   const show = (v) => (v === NO_RECEIVER ? 'no receiver' : Number.isFinite(v) ? v.toPrecision(7) : '—');
   const showError = (v) => (!Number.isFinite(v) ? '—' : state.view === 'flip' ? v.toFixed(3) : v.toPrecision(7));
 
-  function pixelAt(canvas, clientX, clientY) {
+  function canvasPoint(canvas, clientX, clientY) {
     const r = canvas.getBoundingClientRect();
-    const cx = ((clientX - r.left) * canvas.width) / r.width;
-    const cy = ((clientY - r.top) * canvas.height) / r.height;
+    return [((clientX - r.left) * canvas.width) / r.width, ((clientY - r.top) * canvas.height) / r.height];
+  }
+
+  function pixelAt(canvas, clientX, clientY) {
+    const [cx, cy] = canvasPoint(canvas, clientX, clientY);
     return [Math.floor((cx - state.panX) / state.zoom), Math.floor((cy - state.panY) / state.zoom)];
   }
 
@@ -295,74 +572,121 @@
 
   // ---- controls ----------------------------------------------------------------------------
   function fillPicks() {
-    const pickA = $('pick-a');
-    const pickB = $('pick-b');
     const options = (select, keep) => {
       select.innerHTML = '';
       let group = null;
       shots.forEach((s, i) => {
-        if (!keep(s)) return;
-        if (!group || group.label !== s.galleryTitle) {
+        if (!keep(s, i)) return;
+        if (!group || group.label !== galleries[s.gallery].title) {
           group = document.createElement('optgroup');
-          group.label = s.galleryTitle;
+          group.label = galleries[s.gallery].title;
           select.append(group);
         }
-        group.append(new Option(s.label, String(i)));
+        const o = new Option(`${s.index + 1}. ${s.label}`, String(i));
+        if (i === galleries[s.gallery].reference) o.text += ' (reference)';
+        group.append(o);
       });
     };
-    options(pickA, () => true);
-    const a = shots[state.a];
-    options(pickB, (s) => s.width === a.width && s.height === a.height);
-    pickA.value = String(state.a);
-    pickB.value = String(state.b);
+    options($('pick-a'), () => true);
+    options($('pick-b'), (s, i) => sameSize(i, state.a));
+    $('pick-a').value = String(state.a);
+    $('pick-b').value = String(state.b);
   }
 
+  // The controls showing the state (after a view is restored or a default changes).
+  function syncControls() {
+    const flip = $('error-view').querySelector('option[value="flip"]');
+    flip.disabled = !flipShown();
+    if (state.view === 'flip' && flip.disabled) state.view = 'diff';
+    $('mode').value = state.mode;
+    $('split').value = String(state.split);
+    $('split-label').style.visibility = state.mode === 'split' ? 'visible' : 'hidden';
+    $('exposure').value = String(state.ev);
+    $('exposure-value').textContent = `${state.ev} EV`;
+    $('error-view').value = state.view;
+    $('scale').value = state.scale;
+    $('user-max').value = String(state.userMax);
+    $('user-max').disabled = state.scale !== 'user';
+  }
+
+  // A against b (default: A's partner, B kept where it still is one).
   function choose(a, b) {
-    const s = shots[a];
-    const same = (k) => shots[k] && shots[k].width === s.width && shots[k].height === s.height;
-    const newSize = !same(state.a);
+    const newSize = !sameSize(a, state.a);
     state.a = a;
-    if (b !== undefined && same(b)) state.b = b;
-    else if (!same(state.b)) state.b = s.reference !== null ? s.reference : a;
+    state.b = b !== undefined && sameSize(b, a) ? b : partner(a, newSize ? undefined : state.b);
     if (newSize) fit();
     fillPicks();
+    syncControls();
     render();
   }
 
+  function toggle() {
+    if (state.mode !== 'toggle') {
+      state.mode = 'toggle';
+      state.showB = true;
+    } else {
+      state.showB = !state.showB;
+    }
+    syncControls();
+    render();
+  }
+
+  // Keys act unless the user is typing (a text or number field); a select or slider that kept
+  // the focus does not swallow them.
+  function onKey(e) {
+    const t = e.target;
+    if (t.tagName === 'INPUT' && (t.type === 'text' || t.type === 'number')) return;
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (e.key === 't' || e.key === 'T') {
+      toggle();
+      e.preventDefault();
+    } else if (/^[0-9]$/.test(e.key) && shots.length) {
+      // Number keys: A jumps through its gallery (1 the first, 0 the tenth) against the pinned B.
+      const g = galleries[shots[state.a].gallery];
+      const k = (Number(e.key) + 9) % 10;
+      if (k < g.count) choose(g.first + k, state.b);
+      e.preventDefault();
+    }
+  }
+
   function wire() {
-    $('pick-a').addEventListener('change', (e) => choose(Number(e.target.value)));
-    $('pick-b').addEventListener('change', (e) => choose(state.a, Number(e.target.value)));
-    $('mode').addEventListener('change', (e) => {
-      state.mode = e.target.value;
-      $('split-label').hidden = state.mode !== 'split';
+    const changed = (id, apply) => $(id).addEventListener('change', (e) => {
+      apply(e.target.value);
+      // A select keeps no focus, so that keys reach the page.
+      if (e.target.tagName === 'SELECT') e.target.blur();
+      syncControls();
       render();
+    });
+    $('pick-a').addEventListener('change', (e) => {
+      choose(Number(e.target.value));
+      e.target.blur();
+    });
+    $('pick-b').addEventListener('change', (e) => {
+      choose(state.a, Number(e.target.value));
+      e.target.blur();
+    });
+    changed('mode', (v) => {
+      state.mode = v;
+    });
+    changed('error-view', (v) => {
+      state.view = v;
+    });
+    changed('scale', (v) => {
+      if (v === 'user' && state.scale !== 'user' && !pairNumbers(state.a, state.b).identical) state.userMax = Number(errorLayer().max.toPrecision(3));
+      state.scale = v;
+    });
+    changed('user-max', (v) => {
+      if (Number(v) > 0) state.userMax = Number(v);
     });
     $('split').addEventListener('input', (e) => {
       state.split = Number(e.target.value);
       render();
     });
-    const flip = () => {
-      if (state.mode !== 'flip') {
-        state.mode = 'flip';
-        $('mode').value = 'flip';
-        $('split-label').hidden = true;
-        state.showB = true;
-      } else {
-        state.showB = !state.showB;
-      }
-      render();
-    };
-    $('flip').addEventListener('click', flip);
-    document.addEventListener('keydown', (e) => {
-      if ((e.key === 'f' || e.key === 'F') && e.target.tagName !== 'INPUT' && e.target.tagName !== 'SELECT') flip();
-    });
+    $('toggle').addEventListener('click', toggle);
+    document.addEventListener('keydown', onKey);
     $('exposure').addEventListener('input', (e) => {
       state.ev = Number(e.target.value);
       $('exposure-value').textContent = `${state.ev} EV`;
-      render();
-    });
-    $('error-view').addEventListener('change', (e) => {
-      state.view = e.target.value;
       render();
     });
     $('fit').addEventListener('click', () => {
@@ -371,7 +695,12 @@
     });
     for (const canvas of [$('view-compare'), $('view-error')]) {
       canvas.addEventListener('mousemove', (e) => {
-        if (e.buttons === 1 && drag) {
+        const [cx] = canvasPoint(canvas, e.clientX, e.clientY);
+        if (e.buttons === 1 && drag && drag.divider) {
+          state.split = Math.min(Math.max(cx / canvas.width, 0), 1);
+          $('split').value = String(state.split);
+          render();
+        } else if (e.buttons === 1 && drag) {
           const r = canvas.getBoundingClientRect();
           state.panX += ((e.clientX - drag.x) * canvas.width) / r.width;
           state.panY += ((e.clientY - drag.y) * canvas.height) / r.height;
@@ -381,59 +710,74 @@
         readout(...pixelAt(canvas, e.clientX, e.clientY));
       });
       canvas.addEventListener('mousedown', (e) => {
-        drag = { x: e.clientX, y: e.clientY };
+        // Near the divider (compare view, slider mode) a drag moves it; elsewhere it pans.
+        const [cx] = canvasPoint(canvas, e.clientX, e.clientY);
+        // Within 8 screen pixels, however small the canvas is shown.
+        const reach = (8 * canvas.width) / canvas.getBoundingClientRect().width;
+        const onDivider = canvas.id === 'view-compare' && state.mode === 'split' && Math.abs(cx - state.split * canvas.width) <= reach;
+        drag = { x: e.clientX, y: e.clientY, divider: onDivider };
+        armed = true;
         e.preventDefault();
       });
+      canvas.addEventListener('mouseleave', () => {
+        armed = false;
+      });
+      // The wheel zooms only after a click on the image or with a modifier held; else the page
+      // scrolls as usual.
       canvas.addEventListener('wheel', (e) => {
+        if (!(armed || e.ctrlKey || e.shiftKey || e.altKey || e.metaKey)) return;
         e.preventDefault();
-        const r = canvas.getBoundingClientRect();
-        const cx = ((e.clientX - r.left) * canvas.width) / r.width;
-        const cy = ((e.clientY - r.top) * canvas.height) / r.height;
-        const factor = e.deltaY < 0 ? 1.25 : 0.8;
-        state.panX = cx - (cx - state.panX) * factor;
-        state.panY = cy - (cy - state.panY) * factor;
-        state.zoom *= factor;
+        const [cx, cy] = canvasPoint(canvas, e.clientX, e.clientY);
+        zoomAt(cx, cy, e.deltaY < 0 ? 1.25 : 0.8);
         render();
       }, { passive: false });
     }
     window.addEventListener('mouseup', () => {
       drag = null;
     });
+    // A view's link followed (or the address edited) on the open page.
+    window.addEventListener('hashchange', () => {
+      const hash = location.hash.slice(1);
+      if (!SELFTEST && hash.includes('a=')) restore(hash);
+    });
   }
   let drag = null;
+  let armed = false;
   // The shots some table row opens.
   const linked = new Set();
 
   // ---- tables ------------------------------------------------------------------------------
-  function tables() {
+  async function tables() {
     const list = $('table-list');
-    DATA.tables.forEach((t) => {
-      const details = document.createElement('details');
-      details.open = t.file === (DATA.tables.some((u) => u.file === 'summary.csv') ? 'summary.csv' : DATA.tables[0].file);
-      const summary = document.createElement('summary');
+    const first = DATA.tables.some((u) => u.file === 'summary.csv') ? 'summary.csv' : DATA.tables.length ? DATA.tables[0].file : null;
+    for (const t of DATA.tables) {
       const link = document.createElement('a');
       link.href = fileUrl(t.file);
       link.textContent = t.file;
-      if (!t.shown) {
+      if (t.packed === null) {
         const p = document.createElement('p');
         p.append(link, ' (too large to show here; open the file)');
         list.append(p);
-        return;
+        continue;
       }
-      summary.append(link, ` (${t.rows.length} rows)`);
+      const { header, rows } = JSON.parse(new TextDecoder().decode(await inflate(t.packed)));
+      const details = document.createElement('details');
+      details.open = t.file === first;
+      const summary = document.createElement('summary');
+      summary.append(link, ` (${rows.length} rows)`);
       const table = document.createElement('table');
       table.className = 'data';
       const head = table.createTHead().insertRow();
       const body = table.createTBody();
-      const numeric = t.header.map((_, c) => t.rows.every((r) => r[c] === '' || Number.isFinite(Number(r[c]))));
-      t.header.forEach((h, c) => {
+      const numeric = header.map((_, c) => rows.every((r) => r[c] === '' || Number.isFinite(Number(r[c]))));
+      header.forEach((h, c) => {
         const th = document.createElement('th');
         th.textContent = h;
         th.title = 'sort';
-        th.addEventListener('click', () => sortBy(t, body, c, numeric[c], th));
+        th.addEventListener('click', () => sortBy(body, c, numeric[c], th));
         head.append(th);
       });
-      t.rows.forEach((r) => {
+      rows.forEach((r) => {
         const tr = body.insertRow();
         r.forEach((v, c) => {
           const td = tr.insertCell();
@@ -447,7 +791,7 @@
         shots.forEach((s, i) => {
           const entries = Object.entries(s.key);
           const holds = entries.length && entries.every(([k, v]) => {
-            const c = t.header.indexOf(k);
+            const c = header.indexOf(k);
             return c >= 0 && r[c] === v;
           });
           if (holds && (shot < 0 || entries.length > Object.keys(shots[shot].key).length)) shot = i;
@@ -464,10 +808,10 @@
       });
       details.append(summary, table);
       list.append(details);
-    });
+    }
   }
 
-  function sortBy(t, body, c, numeric, th) {
+  function sortBy(body, c, numeric, th) {
     const down = th.dataset.sort !== 'up';
     th.parentNode.querySelectorAll('th').forEach((h) => delete h.dataset.sort);
     th.dataset.sort = down ? 'up' : 'down';
@@ -481,151 +825,58 @@
     body.append(...rows);
   }
 
-  // ---- self-test (#selftest) ---------------------------------------------------------------
-  function shownHash() {
-    const c = $('view-compare');
-    const copy = document.createElement('canvas');
-    copy.width = c.width;
-    copy.height = c.height;
-    const ctx = copy.getContext('2d', { willReadFrequently: true });
-    ctx.drawImage(c, 0, 0);
-    const px = ctx.getImageData(0, 0, c.width, c.height).data;
-    let h = 2166136261;
-    for (let i = 0; i < px.length; i++) h = Math.imul(h ^ px[i], 16777619) >>> 0;
-    return h;
-  }
-
-  function hover(x, y) {
-    // Magnify around the pixel, then move the cursor over its centre.
-    state.zoom = 4;
-    const c = $('view-compare');
-    state.panX = c.width / 2 - (x + 0.5) * state.zoom;
-    state.panY = c.height / 2 - (y + 0.5) * state.zoom;
-    render();
-    const r = c.getBoundingClientRect();
-    const [clientX, clientY] = [r.left + r.width / 2, r.top + r.height / 2];
-    c.dispatchEvent(new MouseEvent('mousemove', { clientX, clientY, bubbles: true }));
-    const text = (id) => ($(id) ? $(id).textContent : null);
-    const out = { x: text('read-x'), y: text('read-y'), a: text('read-a'), b: text('read-b'), e: text('read-e') };
-    // What is drawn under the cursor: the error view there, and A and B each shown whole (flip),
-    // at 0 EV (the PNG's picture) and at +1 EV.
-    const [cx, cy] = [((clientX - r.left) * c.width) / r.width, ((clientY - r.top) * c.height) / r.height];
-    out.rgb_e = shownAt($('view-error'), cx, cy);
-    const saved = { mode: state.mode, showB: state.showB, ev: state.ev };
-    const colour = (showB, ev) => {
-      Object.assign(state, { mode: 'flip', showB, ev });
-      render();
-      return shownAt(c, cx, cy);
+  // ---- plots at full size ------------------------------------------------------------------
+  function lightbox() {
+    const box = $('lightbox');
+    const close = () => {
+      box.hidden = true;
+      $('lightbox-img').removeAttribute('src');
     };
-    Object.assign(out, { rgb_a: colour(false, 0), rgb_b: colour(true, 0), rgb_a_ev1: colour(false, 1) });
-    Object.assign(state, saved);
-    render();
-    return out;
-  }
-
-  // The colour a canvas shows at canvas position (x, y), read from a copy (reading the shown
-  // canvas itself makes the browser warn about repeated readbacks).
-  function shownAt(canvas, x, y) {
-    const copy = document.createElement('canvas');
-    copy.width = 1;
-    copy.height = 1;
-    const ctx = copy.getContext('2d', { willReadFrequently: true });
-    ctx.drawImage(canvas, Math.floor(x), Math.floor(y), 1, 1, 0, 0, 1, 1);
-    return Array.from(ctx.getImageData(0, 0, 1, 1).data.slice(0, 3));
-  }
-
-  function differs(i, j) {
-    const [p, q] = [shots[i].values, shots[j].values];
-    return p.length === q.length && p.some((v, k) => v !== q[k]);
-  }
-
-  async function selftest() {
-    const report = { errors, images: [], readouts: [], slider: null, flip: null, exposure: null, shots: shots.length };
-    // A shot that names its table rows (its key) and that no row opens.
-    report.unlinked = shots.filter((s, i) => Object.keys(s.key).length && !linked.has(i)).map((s) => s.exr);
-    if (document.readyState !== 'complete') await new Promise((done) => window.addEventListener('load', done));
-    // A broken image has no natural size, and drawing it throws.
-    const scratch = document.createElement('canvas').getContext('2d');
-    for (const img of document.images) {
-      let ok = img.complete && img.naturalWidth > 0;
-      try {
-        scratch.drawImage(img, 0, 0, 1, 1);
-      } catch (e) {
-        ok = false;
-      }
-      report.images.push({ src: img.getAttribute('src'), ok });
-    }
-    if (shots.length) {
-      $('error-view').value = 'diff';
-      state.view = 'diff';
-      shots.forEach((s, i) => {
-        const b = s.reference !== null && s.reference !== i ? s.reference : shots.findIndex((t, j) => j !== i && t.width === s.width && t.height === s.height);
-        choose(i, b >= 0 ? b : i);
-        let worst = 0;
-        const other = shots[state.b].values;
-        s.values.forEach((v, k) => {
-          if (Math.abs(v - other[k]) > Math.abs(s.values[worst] - other[worst])) worst = k;
-        });
-        const pixels = [[0, 0], [s.width - 1, s.height - 1], [worst % s.width, Math.floor(worst / s.width)]];
-        for (const [x, y] of pixels) {
-          report.readouts.push({ a: s.exr, b: shots[state.b].exr, png_a: s.png, png_b: shots[state.b].png, tone: s.tone, x, y, shown: hover(x, y) });
-        }
+    for (const img of document.querySelectorAll('#plots img')) {
+      img.addEventListener('click', () => {
+        $('lightbox-img').src = img.getAttribute('src');
+        box.hidden = false;
       });
-      let pair = null;
-      for (let i = 0; i < shots.length && !pair; i++) {
-        for (let j = 0; j < shots.length && !pair; j++) if (i !== j && differs(i, j)) pair = [i, j];
-      }
-      if (pair) {
-        choose(pair[0], pair[1]);
-        fit();
-        $('mode').value = 'split';
-        $('mode').dispatchEvent(new Event('change'));
-        const slide = (v) => {
-          $('split').value = String(v);
-          $('split').dispatchEvent(new Event('input'));
-          return shownHash();
-        };
-        report.slider = { a: shots[pair[0]].exr, b: shots[pair[1]].exr, changed: slide(1) !== slide(0) };
-        const before = shownHash();
-        $('flip').click();
-        const once = shownHash();
-        $('flip').click();
-        report.flip = { changed: before !== once && once !== shownHash() };
-        const expose = (ev) => {
-          $('exposure').value = String(ev);
-          $('exposure').dispatchEvent(new Event('input'));
-          return shownHash();
-        };
-        report.exposure = { changed: expose(-1) !== expose(0) };
-      }
     }
-    const out = $('selftest');
-    out.textContent = JSON.stringify(report);
-    out.hidden = false;
+    box.addEventListener('click', close);
+    document.addEventListener('keydown', (e) => {
+      if (e.key === 'Escape') close();
+    });
   }
+
+  // The page's first pair, and the state the self-test starts from.
+  const opened = { a: null, b: null };
 
   async function main() {
     if (DATA) {
-      shots = await decode(DATA);
+      ({ galleries, shots } = await decode(DATA));
       if (shots.length) {
         wire();
-        // B opens as A's reference, or where its gallery has none (a strip's frames) as the
-        // gallery's next image, so that the page opens on a comparison.
-        const first = shots[0];
-        const next = shots.findIndex((s, j) => j > 0 && s.gallery === first.gallery);
-        choose(0, first.reference !== null ? first.reference : next >= 0 ? next : undefined);
-        fit();
-        render();
+        const hash = location.hash.slice(1);
+        const linkedView = !SELFTEST && hash.includes('a=') && restore(hash);
+        if (!linkedView) {
+          const a = opening();
+          state.a = a;
+          choose(a);
+          fit();
+          render();
+        }
+        opened.a = shots[state.a].exr;
+        opened.b = shots[state.b].exr;
       }
-      tables();
+      await tables();
     }
-    if (location.hash === '#selftest') await selftest();
+    lightbox();
   }
-  main().catch((e) => {
-    errors.push(String(e && e.stack ? e.stack : e));
-    if (location.hash === '#selftest') {
-      $('selftest').textContent = JSON.stringify({ errors });
-      $('selftest').hidden = false;
-    }
-  });
+
+  return {
+    main, errors, state, opened, linked, SELFTEST, $,
+    get shots() {
+      return shots;
+    },
+    get galleries() {
+      return galleries;
+    },
+    choose, fit, render, partner, pairNumbers, errorLayer, serialise, restore, flipShown, tone, zoomAt,
+  };
 })();

@@ -4,10 +4,10 @@
 //! by its file name, grouped with the others of its size; `ground_truth` (or
 //! `picture_ground_truth`) is its group's reference; `picture_*` and `strip_*` hold radiance, the
 //! rest values in [0, 1]; each strip's frames (`strip_SHADING_FRAME`) are a group of their own,
-//! shown at the exposure of its first frame, as the frames kind drew their PNGs. A missing PNG
-//! beside an EXR is drawn from it.
+//! shown at the exposure of its first frame, as the frames kind drew their PNGs, and set against
+//! the next strip of its size and length. A missing PNG beside an EXR is drawn from it.
 
-use super::{files_in, write, Gallery, Page, Shot, Tone};
+use super::{files_in, write_stored, Gallery, Page, Shot, Tone};
 use crate::files::{read_regular, read_regular_text, Refused};
 use crate::output::images::{exposure, write_png};
 use anyhow::Context;
@@ -39,18 +39,22 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
     }
     let report = read_regular_text(&dir.join("report.md"))?;
     let mut galleries: Vec<Gallery> = Vec::new();
+    // Numbers in file names in their order (frame 8 before frame 16).
+    let mut exrs = files_in(dir, "images", ".exr")?;
+    exrs.sort_by_cached_key(|e| natural(e));
+    let stems: Vec<String> = exrs
+        .iter()
+        .map(|e| e.trim_start_matches("images/").trim_end_matches(".exr").to_string())
+        .collect();
     // Each gallery's family: a strip's frames (`strip_SHADING_FRAME`) are one gallery per strip,
-    // since each strip's PNGs were drawn at its own exposure; every other image is grouped by
-    // size and kind alone.
+    // since each strip's PNGs were drawn at its own exposure; the images that share a prefix
+    // with a `PREFIX_brute` or `PREFIX_exact` beside them (one mesh's structures, one variant's
+    // filters) are one gallery with it; every other image is grouped by size and kind alone.
     let mut families: Vec<String> = Vec::new();
-    for exr in files_in(dir, "images", ".exr")? {
+    for (exr, stem) in exrs.into_iter().zip(&stems) {
         let (values, width, height) = read_exr(&dir.join(&exr))?;
-        let stem = exr.trim_start_matches("images/").trim_end_matches(".exr").to_string();
         let radiance = stem.starts_with("picture_") || stem.starts_with("strip_");
-        let family = match stem.strip_prefix("strip_").and_then(|s| s.rsplit_once('_')) {
-            Some((strip, _)) => format!("strip {strip}"),
-            None => String::new(),
-        };
+        let family = family(stem, &stems);
         let shot = Shot {
             label: stem.replace('_', " "),
             png: exr.replace(".exr", ".png"),
@@ -68,8 +72,10 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
             None => galleries.push(Gallery {
                 title: if family.is_empty() {
                     format!("{width}x{height} images")
-                } else {
+                } else if family.starts_with("strip ") {
                     format!("{family} frames")
+                } else {
+                    format!("{family}: {width}x{height} images")
                 },
                 width,
                 height,
@@ -79,6 +85,7 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
                     Tone::Linear
                 },
                 reference: None,
+                against: None,
                 shots: vec![shot],
             }),
         }
@@ -86,11 +93,28 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
             families.push(family);
         }
     }
-    for g in &mut galleries {
+    // Each strip's frames against the next strip's (the same frames under the other shading).
+    let strips: Vec<usize> = (0..galleries.len())
+        .filter(|&i| families[i].starts_with("strip "))
+        .collect();
+    for (k, &i) in strips.iter().enumerate() {
+        let next = strips[(k + 1) % strips.len()];
+        let (a, b) = (&galleries[i], &galleries[next]);
+        if next != i && b.shots.len() == a.shots.len() && (b.width, b.height) == (a.width, a.height) {
+            galleries[i].against = Some(next);
+        }
+    }
+    for (g, family) in galleries.iter_mut().zip(&families) {
+        let own = |what: &str| format!("{} {what}", family.replace('_', " "));
         g.reference = g
             .shots
             .iter()
-            .position(|s| s.label == "ground truth" || s.label == "picture ground truth");
+            .position(|s| s.label == "ground truth" || s.label == "picture ground truth")
+            .or_else(|| {
+                g.shots
+                    .iter()
+                    .position(|s| !family.is_empty() && (s.label == own("brute") || s.label == own("exact")))
+            });
         if let Tone::Radiance { p99 } = &mut g.tone {
             *p99 = exposure(&g.shots[g.reference.unwrap_or(0)].values);
         }
@@ -100,17 +124,68 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
             }
         }
     }
+    // Pictures are stored at half precision where their EXRs are (every value a half float);
+    // a folder written before they were keeps its full-precision values, so that the page
+    // reads out what the files hold.
+    let half: Vec<bool> = galleries
+        .iter()
+        .map(|g| {
+            g.half()
+                && g.shots.iter().all(|s| {
+                    s.values
+                        .iter()
+                        .all(|&v| v.is_nan() || half::f16::from_f32(v).to_f32().to_bits() == v.to_bits())
+                })
+        })
+        .collect();
     let name = dir
         .file_name()
         .map_or("results".into(), |n| n.to_string_lossy().into_owned());
-    write(
+    write_stored(
         dir,
         &Page {
             title: format!("{name} (page rebuilt from the folder's files)"),
             report,
             galleries,
         },
+        &half,
     )
+}
+
+/// An image's family (see [`rebuild`]): `strip SHADING` for a strip's frame, else the longest
+/// prefix (cut at an underscore) that has a `PREFIX_brute` or `PREFIX_exact` among `stems`,
+/// else none.
+fn family(stem: &str, stems: &[String]) -> String {
+    if let Some((strip, _)) = stem.strip_prefix("strip_").and_then(|s| s.rsplit_once('_')) {
+        return format!("strip {strip}");
+    }
+    let has = |name: String| stems.contains(&name);
+    stem.match_indices('_')
+        .map(|(i, _)| &stem[..i])
+        .rfind(|p| has(format!("{p}_brute")) || has(format!("{p}_exact")))
+        .unwrap_or("")
+        .to_string()
+}
+
+/// A file name as a sort key in which each run of digits compares as a number.
+fn natural(name: &str) -> Vec<(u128, String)> {
+    let mut key = Vec::new();
+    let mut rest = name;
+    while !rest.is_empty() {
+        let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
+        let (part, tail) = if digits > 0 {
+            rest.split_at(digits)
+        } else {
+            rest.split_at(rest.find(|c: char| c.is_ascii_digit()).unwrap_or(rest.len()))
+        };
+        key.push(if digits > 0 {
+            (part.parse().unwrap_or(u128::MAX), String::new())
+        } else {
+            (0, part.to_string())
+        });
+        rest = tail;
+    }
+    key
 }
 
 /// A one-channel EXR's values, width and height.

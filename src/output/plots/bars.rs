@@ -1,11 +1,13 @@
 //! Grouped bars for a categorical axis: one group per category (a mesh, say), named under the
 //! axis with a note (its size), one bar per series in each group with its 95 % interval as a
-//! whisker. Nothing joins the groups: unrelated categories are not a curve.
+//! whisker. Nothing joins the groups: unrelated categories are not a curve. Each series has its
+//! own look (colour and the marker drawn at each bar's top and in the legend), so that a bar
+//! is known by its shape where its colour is not told apart.
 
 use super::legend::{self, Entry, Look};
 use super::line::minor;
-use super::style::colour;
-use super::ticks::{ticks, Keyed, Scale};
+use super::style::{distinct, look};
+use super::ticks::{axis_labels, ticks, Keyed, Scale};
 use super::{error, text_width, write_figure, Figure, FONT};
 use plotters::coord::combinators::LogCoord;
 use plotters::coord::ranged1d::Ranged;
@@ -15,11 +17,11 @@ use plotters::prelude::*;
 use plotters::style::text_anchor;
 use std::path::Path;
 
-/// One bar: its series (palette index, as in the series list) and value with its 95 % interval
+/// One bar: its series (look index, as in the series list) and value with its 95 % interval
 /// (NaN ends: no whisker).
 #[derive(Clone, Debug)]
 pub struct Bar {
-    /// Palette index of its series.
+    /// Look index of its series.
     pub series: usize,
     /// Its height.
     pub value: f64,
@@ -41,18 +43,25 @@ pub struct Group {
 }
 
 const HEIGHT: u32 = 640;
-const TITLE: u32 = 44;
+const TITLE: u32 = 48;
 const MARGIN: u32 = 14;
-const X_LABELS: u32 = 56;
-const Y_LABELS: u32 = 84;
-const TICK_FONT: u32 = 15;
-const TITLE_FONT: u32 = 22;
+const X_LABELS: u32 = 70;
+/// Room beside the widest y tick label for the axis name and the gaps around it.
+const Y_NAME: u32 = TICK_FONT + 18;
+/// Tick labels and group names; the notes under them; the title (plotters' sizes: a line's
+/// height, 1.24 em, so 19 reads as 15.3 px at the figure's own size).
+const TICK_FONT: u32 = 19;
+const NOTE_FONT: u32 = 17;
+const TITLE_FONT: u32 = 24;
+/// The least share of the figure's width that its data area takes, however long the legend.
+const DATA_SHARE: f64 = 0.6;
 /// Values spread wider than this (largest over smallest) go on a log axis.
 const LOG_SPREAD: f64 = 30.0;
 
-/// Draws `groups` of bars into a PNG at `path` and an SVG beside it: `series` names each palette
+/// Draws `groups` of bars into a PNG at `path` and an SVG beside it: `series` names each look
 /// index in the legend; `y` labels the axis. The y axis starts at 0, or is logarithmic (and
-/// says so) where the values spread over more than a factor of 30.
+/// says so) where the values spread over more than a factor of 30. Two series of one look are
+/// refused.
 pub fn grouped_bars(
     path: &Path,
     title: &str,
@@ -60,6 +69,7 @@ pub fn grouped_bars(
     series: &[(usize, String)],
     groups: &[Group],
 ) -> anyhow::Result<()> {
+    distinct(series.iter().map(|(i, name)| (*i, name.as_str(), 0)))?;
     write_figure(path, &Bars::new(title, y, series, groups))
 }
 
@@ -72,6 +82,8 @@ struct Bars<'a> {
     y: (f64, f64),
     group_px: u32,
     legend: Vec<Entry>,
+    /// Height of the figure: [`HEIGHT`], or more where the legend needs it.
+    height: u32,
 }
 
 impl<'a> Bars<'a> {
@@ -91,10 +103,10 @@ impl<'a> Bars<'a> {
             (false, true) => (0.0, largest * 1.08),
             (false, false) => (0.0, 1.0),
         };
-        let per_bar = 22;
+        let per_bar = 26;
         let names = groups
             .iter()
-            .map(|g| text_width(&g.name, TICK_FONT).max(text_width(&g.note, 13)))
+            .map(|g| text_width(&g.name, TICK_FONT).max(text_width(&g.note, NOTE_FONT)))
             .max()
             .unwrap_or(0);
         let group_px = (names + 24).max(series.len() as u32 * per_bar + 28);
@@ -102,7 +114,7 @@ impl<'a> Bars<'a> {
             .iter()
             .map(|(i, name)| Entry {
                 label: name.clone(),
-                look: Look::Swatch(colour(*i)),
+                look: Look::Bar(look(*i)),
             })
             .collect();
         let mut chart = Bars {
@@ -113,6 +125,7 @@ impl<'a> Bars<'a> {
             y: range,
             group_px,
             legend: vec![],
+            height: HEIGHT,
         };
         if bars().any(|b| b.lo.is_finite() && b.hi.is_finite()) {
             legend.push(Entry {
@@ -126,14 +139,42 @@ impl<'a> Bars<'a> {
                 look: Look::Clipped,
             });
         }
+        chart.height = HEIGHT.max(TITLE + legend::height(&legend));
         chart.legend = legend;
         chart
     }
 
-    /// Width of the chart left of the legend.
+    /// Width of the chart left of the legend: room for the bars and the title, and for the data
+    /// to take [`DATA_SHARE`] of the figure beside however wide a legend.
     fn chart_width(&self) -> u32 {
-        let bars = 2 * MARGIN + Y_LABELS + (self.group_px * self.groups.len() as u32).max(480);
-        bars.max(text_width(self.title, TITLE_FONT) + 2 * MARGIN)
+        let labels = 2 * MARGIN + self.y_labels();
+        let bars = labels + (self.group_px * self.groups.len() as u32).max(560);
+        let legend = legend::width(&self.legend, self.height - TITLE) as f64;
+        let share = ((labels as f64 + DATA_SHARE * legend) / (1.0 - DATA_SHARE)).ceil() as u32;
+        bars.max(share).max(text_width(self.title, TITLE_FONT) + 2 * MARGIN)
+    }
+
+    /// The labelled values of the y axis.
+    fn y_ticks(&self) -> Vec<f64> {
+        let height = (self.height - TITLE - 2 * MARGIN - X_LABELS) as f64;
+        let up = |_: &str| TICK_FONT as f64 + 4.0;
+        let scale = Scale {
+            log: self.log,
+            whole: false,
+        };
+        ticks(self.y.0, self.y.1, scale, height, &up)
+    }
+
+    /// Width of the y axis's labels: the widest tick label and the axis name.
+    fn y_labels(&self) -> u32 {
+        let ticks = self.y_ticks();
+        let label = axis_labels(&ticks);
+        ticks
+            .iter()
+            .map(|v| text_width(&label(v), TICK_FONT))
+            .max()
+            .unwrap_or(0)
+            + Y_NAME
     }
 
     /// Whether an interval lo..hi runs past the bottom and the top of the y range.
@@ -156,7 +197,7 @@ impl<'a> Bars<'a> {
         let mut chart = ChartBuilder::on(&area)
             .margin(MARGIN)
             .x_label_area_size(X_LABELS)
-            .y_label_area_size(Y_LABELS)
+            .y_label_area_size(self.y_labels())
             .build_cartesian_2d(Keyed::<RangedCoordf64>::new(0.0..n, vec![], vec![]), y)
             .map_err(error)?;
         chart
@@ -179,7 +220,7 @@ impl<'a> Bars<'a> {
             };
             root.draw(&Text::new(g.name.clone(), (mid, bottom + 8), top(TICK_FONT)))
                 .map_err(error)?;
-            root.draw(&Text::new(g.note.clone(), (mid, bottom + 28), top(13)))
+            root.draw(&Text::new(g.note.clone(), (mid, bottom + 34), top(NOTE_FONT)))
                 .map_err(error)?;
             let k = g.bars.len().max(1) as f64;
             let width = 0.76 / k;
@@ -189,12 +230,10 @@ impl<'a> Bars<'a> {
                 let column = (left + right) / 2;
                 if b.value.is_finite() && (!self.log || b.value > 0.0) {
                     let top = px(x0, b.value.min(self.y.1)).1;
-                    root.draw(&Rectangle::new(
-                        [(left, top), (right, bottom)],
-                        colour(b.series).filled(),
-                    ))
-                    .map_err(error)?;
+                    legend::bar(root, (left, top, right, bottom), look(b.series))?;
+                    legend::bar_marker(root, (column, top), look(b.series))?;
                 }
+                // The whisker over the marker, so that a short interval is not hidden under it.
                 if b.lo.is_finite() && b.hi.is_finite() {
                     let (clip_lo, clip_hi) = self.clipped(b.lo, b.hi);
                     let low = if clip_lo { bottom } else { px(x0, b.lo).1 };
@@ -207,28 +246,25 @@ impl<'a> Bars<'a> {
             root,
             &self.legend,
             (self.chart_width() as i32, ys.start - 10),
-            HEIGHT - TITLE,
+            self.height - TITLE,
         )
     }
 }
 
 impl Figure for Bars<'_> {
     fn size(&self) -> (u32, u32) {
-        (self.chart_width() + legend::width(&self.legend, HEIGHT - TITLE), HEIGHT)
+        (
+            self.chart_width() + legend::width(&self.legend, self.height - TITLE),
+            self.height,
+        )
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let height = (HEIGHT - TITLE - 2 * MARGIN - X_LABELS) as f64;
-        let up = |_: &str| TICK_FONT as f64 + 4.0;
         let (y0, y1) = self.y;
-        let scale = Scale {
-            log: self.log,
-            whole: false,
-        };
-        let yt = ticks(y0, y1, scale, height, &up);
+        let yt = self.y_ticks();
         let yl = minor(y0, y1, self.log);
         if self.log {
             let y: Keyed<LogCoord<f64>> = Keyed::new((y0..y1).log_scale(), yt, yl);

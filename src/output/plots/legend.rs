@@ -2,7 +2,7 @@
 //! entry drawn with its series' own colour, dashes and marker (a dashed series looks dashed in
 //! its legend too), and notes for the interval whiskers and the carets of clipped intervals.
 
-use super::style::{dashes, draw_marker, Marker};
+use super::style::{dashes, draw_marker, edge_marker, Look as SeriesLook, Marker, DASH, MARKER_RADIUS};
 use super::{error, text_width, FONT};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -20,8 +20,9 @@ pub enum Look {
         /// Marker and whether it is filled.
         marker: Option<(Marker, bool)>,
     },
-    /// A bar's fill.
-    Swatch(RGBColor),
+    /// A bar of a series' look: filled (outlined with dashes where the look is dashed), its
+    /// marker at its top as on the bars.
+    Bar(SeriesLook),
     /// A 95 % interval's whisker.
     Interval,
     /// The caret that marks an interval clipped at the axis.
@@ -37,10 +38,11 @@ pub struct Entry {
     pub look: Look,
 }
 
-/// Text size of legend entries.
-const FONT_SIZE: u32 = 14;
+/// Text size of legend entries as plotters sizes text (a line's height, 1.24 em: 19 reads as
+/// 15.3 px), legible where a page shows the figure at its own size.
+const FONT_SIZE: u32 = 19;
 /// Height of one entry.
-const ROW: i32 = 22;
+const ROW: i32 = 28;
 /// Width of an entry's sample.
 const SAMPLE: i32 = 40;
 /// Space around the legend and between its columns.
@@ -52,6 +54,11 @@ pub const INK: RGBColor = RGBColor(50, 50, 50);
 /// Entries per column when `height` pixels are available.
 fn per_column(height: u32) -> usize {
     ((height as i32 - PAD) / ROW).max(1) as usize
+}
+
+/// Height that `entries` need to stand in one column.
+pub fn height(entries: &[Entry]) -> u32 {
+    (2 * PAD + entries.len() as i32 * ROW) as u32
 }
 
 /// Width of the column(s) `entries` take in `height` pixels (0 for none).
@@ -113,15 +120,13 @@ where
                     .map_err(error)?;
             }
             if let Some((m, filled)) = marker {
-                draw_marker(root, (x + SAMPLE / 2, y), *m, 4, *colour, *filled)?;
+                draw_marker(root, (x + SAMPLE / 2, y), *m, MARKER_RADIUS, *colour, *filled)?;
             }
         }
-        Look::Swatch(colour) => {
-            root.draw(&Rectangle::new(
-                [(x + 8, y - 7), (x + SAMPLE - 8, y + 7)],
-                colour.filled(),
-            ))
-            .map_err(error)?;
+        Look::Bar(look) => {
+            let (left, right, top, bottom) = (x + 10, x + SAMPLE - 10, y - 4, y + 10);
+            bar(root, (left, top, right, bottom), *look)?;
+            bar_marker(root, ((left + right) / 2, top), *look)?;
         }
         Look::Interval => interval(root, x + SAMPLE / 2, (y + 8, false), (y - 8, false))?,
         Look::Clipped => caret(root, (x + SAMPLE / 2, y + 6), false)?,
@@ -164,4 +169,53 @@ where
     let back = if up { y + 8 } else { y - 8 };
     root.draw(&Polygon::new(vec![(x, y), (x + 5, back), (x - 5, back)], INK.filled()))
         .map_err(error)
+}
+
+/// Draws a bar of `look` over the pixel rectangle (left, top, right, bottom): filled in its
+/// colour, or, for a dashed look, white with a dashed edge in its colour.
+pub fn bar<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    (left, top, right, bottom): (i32, i32, i32, i32),
+    look: SeriesLook,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    if !look.dashed {
+        return root
+            .draw(&Rectangle::new([(left, top), (right, bottom)], look.colour.filled()))
+            .map_err(error);
+    }
+    let ring = [
+        (left + 1, bottom),
+        (left + 1, top + 1),
+        (right - 1, top + 1),
+        (right - 1, bottom),
+    ];
+    for piece in dashes(&ring, Some(DASH)) {
+        root.draw(&PathElement::new(piece, look.colour.stroke_width(2)))
+            .map_err(error)?;
+    }
+    Ok(())
+}
+
+/// Draws a bar's marker centred at `at` (the middle of its top): its look's shape in its
+/// colour with a dark edge, so that it reads against the bar's own fill and against white.
+pub fn bar_marker<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    look: SeriesLook,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let r = MARKER_RADIUS + 1;
+    if look.dashed {
+        root.draw(&Circle::new(at, r + 2, WHITE.filled())).map_err(error)?;
+    }
+    draw_marker(root, at, look.marker, r, look.colour, !look.dashed)?;
+    if !look.dashed {
+        edge_marker(root, at, look.marker, r, INK)?;
+    }
+    Ok(())
 }

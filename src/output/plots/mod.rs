@@ -1,9 +1,11 @@
-//! Figures for every kind's report, drawn with plotters: line plots ([`line_plot`]), grouped bars
-//! where the axis is categorical ([`grouped_bars`]), and labelled image grids with colour bars
-//! ([`image_grid`]). Each chart is written twice, a PNG and an SVG beside it (same name), keeps
-//! its legend in a column right of the data, draws in a colour-blind-safe palette with a marker
-//! shape per series, labels its axes so that no two labels touch, and marks a 95 % interval
-//! that runs off a log axis with a caret instead of drawing it to the far edge.
+//! Figures for every kind's report, drawn with plotters: line plots ([`line_plot`]) and small
+//! multiples of them on shared axes ([`line_panels`]), grouped bars where the axis is categorical
+//! ([`grouped_bars`]), and labelled image grids with colour bars ([`image_grid`]). Each chart is
+//! written twice, a PNG and an SVG beside it (same name), keeps its legend in a column right of
+//! the data, gives every series a look of its own (a colour-blind-safe colour, a marker shape and
+//! dashes, all from one index, [`look`]) and refuses two series drawn alike, labels its axes so
+//! that no two labels touch, and marks a 95 % interval that runs off a log axis with a caret
+//! instead of drawing it to the far edge.
 
 mod bars;
 mod grid;
@@ -16,8 +18,8 @@ mod ticks;
 
 pub use bars::{grouped_bars, Bar, Group};
 pub use grid::{image_grid, ColourBar, Tile};
-pub use line::{line_plot, Axes, Reference, Series};
-pub use style::colour;
+pub use line::{line_panels, line_plot, Axes, Panel, Point, Reference, Series};
+pub use style::{colour, look, Look, Marker, LOOKS};
 
 use super::images::{write_png, Rgb};
 use crate::files::write_atomic;

@@ -1,26 +1,26 @@
-//! How series look: a colour-blind-safe palette, a marker shape per series as a second channel
-//! beside colour, and dashes drawn the same way in the data and in the legend.
+//! How series look: one index gives a series its colour, marker shape and dashes together, so
+//! that a series keeps its look in every plot that draws it (a sampling scheme, say) and two
+//! series tell apart by shape where colours do not.
 
 use super::error;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-/// Okabe and Ito's colour-blind-safe palette (2008), less its yellow (too pale on white) and
-/// its black (kept for reference lines): blue, vermillion, bluish green, reddish purple, orange,
-/// sky blue.
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
+/// Paul Tol's colour-blind-safe "muted" qualitative scheme (Tol 2021, "Colour Schemes", SRON
+/// technical note SRON/EPS/TN/09-002, figure 4), less its pale grey for missing data, ordered so
+/// that the first few series get the colours furthest apart and the two palest come last:
+/// indigo, rose, teal, olive, purple, cyan, green, wine, sand.
+const PALETTE: [RGBColor; 9] = [
+    RGBColor(0x33, 0x22, 0x88),
+    RGBColor(0xCC, 0x66, 0x77),
+    RGBColor(0x44, 0xAA, 0x99),
+    RGBColor(0x99, 0x99, 0x33),
+    RGBColor(0xAA, 0x44, 0x99),
+    RGBColor(0x88, 0xCC, 0xEE),
+    RGBColor(0x11, 0x77, 0x33),
+    RGBColor(0x88, 0x22, 0x55),
+    RGBColor(0xDD, 0xCC, 0x77),
 ];
-
-/// Colour of the i-th series (series of one scheme share a colour across plots).
-pub fn colour(i: usize) -> RGBColor {
-    PALETTE[i % PALETTE.len()]
-}
 
 /// A point marker's shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -35,20 +35,79 @@ pub enum Marker {
     Diamond,
     /// A triangle pointing down.
     Wedge,
+    /// An upright cross.
+    Plus,
+    /// A diagonal cross.
+    Cross,
+    /// A five-pointed star.
+    Star,
+    /// A triangle pointing right.
+    Pointer,
 }
 
-const MARKERS: [Marker; 5] = [
+/// One shape per palette colour, so that the first nine series differ in shape as in colour.
+const MARKERS: [Marker; 9] = [
     Marker::Circle,
     Marker::Square,
     Marker::Triangle,
     Marker::Diamond,
     Marker::Wedge,
+    Marker::Plus,
+    Marker::Cross,
+    Marker::Star,
+    Marker::Pointer,
 ];
 
-/// Marker of the i-th series: five shapes against six colours, so the first thirty series
-/// differ in colour or shape or both, and two series of one colour never share a shape.
-pub fn marker(i: usize) -> Marker {
-    MARKERS[i % MARKERS.len()]
+/// How many series can be told apart: every colour with its own shape, solid with filled
+/// markers, then the same dashed with outlined markers. The look of index `i` is that of
+/// `i + LOOKS`.
+pub const LOOKS: usize = 2 * PALETTE.len();
+
+/// A series' look: its colour, its marker's shape, and whether it is dashed (with outlined
+/// markers) or solid (with filled ones).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Look {
+    /// Line, marker and bar colour.
+    pub colour: RGBColor,
+    /// Marker shape.
+    pub marker: Marker,
+    /// Dashed line, outlined marker (and an outlined bar).
+    pub dashed: bool,
+}
+
+/// The look of index `i`: colour and shape run through their nine together, and the second
+/// nine are dashed, so indices under [`LOOKS`] apart never share a look.
+pub fn look(i: usize) -> Look {
+    Look {
+        colour: PALETTE[i % PALETTE.len()],
+        marker: MARKERS[i % MARKERS.len()],
+        dashed: (i / PALETTE.len()) % 2 == 1,
+    }
+}
+
+/// Colour of look `i` (a reference line drawn in its series' colour).
+pub fn colour(i: usize) -> RGBColor {
+    look(i).colour
+}
+
+/// Radius of a marker in pixels.
+pub const MARKER_RADIUS: i32 = 5;
+
+/// Refuses a figure in which two series that are not one share a look: `series` gives each
+/// series' look index, name and group (its panel); within a group no two may share a look,
+/// and across groups one look must name one series, or the legend could not tell them apart.
+pub fn distinct<'a>(series: impl IntoIterator<Item = (usize, &'a str, usize)>) -> anyhow::Result<()> {
+    let all: Vec<(usize, &str, usize)> = series.into_iter().collect();
+    for (k, &(i, a, ga)) in all.iter().enumerate() {
+        for &(j, b, gb) in &all[k + 1..] {
+            if look(i) == look(j) && (ga == gb || a != b) {
+                anyhow::bail!(
+                    "series `{a}` (look {i}) and `{b}` (look {j}) would be drawn alike: same colour, marker and dashes"
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Dashes of a dashed series (pixels on, pixels off).
@@ -107,6 +166,42 @@ pub fn dashes(points: &[(i32, i32)], dash: Option<(u32, u32)>) -> Vec<Vec<(i32, 
     out
 }
 
+/// The corners of `marker` around the origin for radius 1 (every shape but the disc), sized
+/// so that the shapes look about as large as one another.
+fn outline(marker: Marker) -> Vec<(f64, f64)> {
+    let turn = |k: usize, n: usize, r: f64, phase: f64| {
+        let a = phase + std::f64::consts::TAU * k as f64 / n as f64;
+        (r * a.sin(), -r * a.cos())
+    };
+    let plus = |phase: f64| -> Vec<(f64, f64)> {
+        let (arm, half) = (1.25, 0.42);
+        let c = [
+            (-half, -arm),
+            (half, -arm),
+            (half, -half),
+            (arm, -half),
+            (arm, half),
+            (half, half),
+        ];
+        let c: Vec<(f64, f64)> = c.iter().chain(&c.map(|(x, y)| (-x, -y))).copied().collect();
+        let (s, co) = phase.sin_cos();
+        c.into_iter().map(|(x, y)| (x * co - y * s, x * s + y * co)).collect()
+    };
+    match marker {
+        Marker::Circle => (0..24).map(|k| turn(k, 24, 1.0, 0.0)).collect(),
+        Marker::Square => vec![(-0.9, -0.9), (0.9, -0.9), (0.9, 0.9), (-0.9, 0.9)],
+        Marker::Triangle => vec![(0.0, -1.25), (1.2, 0.85), (-1.2, 0.85)],
+        Marker::Diamond => vec![(0.0, -1.3), (1.15, 0.0), (0.0, 1.3), (-1.15, 0.0)],
+        Marker::Wedge => vec![(-1.2, -0.85), (1.2, -0.85), (0.0, 1.25)],
+        Marker::Plus => plus(0.0),
+        Marker::Cross => plus(std::f64::consts::FRAC_PI_4),
+        Marker::Star => (0..10)
+            .map(|k| turn(k, 10, if k % 2 == 0 { 1.45 } else { 0.6 }, 0.0))
+            .collect(),
+        Marker::Pointer => vec![(-0.85, -1.2), (1.25, 0.0), (-0.85, 1.2)],
+    }
+}
+
 /// Draws `marker` of radius `r` centred at pixel `c`, filled or as an outline.
 pub fn draw_marker<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -119,21 +214,18 @@ pub fn draw_marker<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let (x, y) = c;
-    let corners: Vec<(i32, i32)> = match marker {
-        Marker::Circle => {
-            let style = if filled {
-                colour.filled()
-            } else {
-                colour.stroke_width(2)
-            };
-            return area.draw(&Circle::new(c, r, style)).map_err(error);
-        }
-        Marker::Square => vec![(x - r, y - r), (x + r, y - r), (x + r, y + r), (x - r, y + r)],
-        Marker::Triangle => vec![(x, y - r - 1), (x + r + 1, y + r), (x - r - 1, y + r)],
-        Marker::Diamond => vec![(x, y - r - 1), (x + r + 1, y), (x, y + r + 1), (x - r - 1, y)],
-        Marker::Wedge => vec![(x - r - 1, y - r), (x + r + 1, y - r), (x, y + r + 1)],
-    };
+    if marker == Marker::Circle {
+        let style = if filled {
+            colour.filled()
+        } else {
+            colour.stroke_width(2)
+        };
+        return area.draw(&Circle::new(c, r, style)).map_err(error);
+    }
+    let corners: Vec<(i32, i32)> = outline(marker)
+        .iter()
+        .map(|&(x, y)| (c.0 + (x * r as f64).round() as i32, c.1 + (y * r as f64).round() as i32))
+        .collect();
     if filled {
         area.draw(&Polygon::new(corners, colour.filled())).map_err(error)
     } else {
@@ -142,6 +234,28 @@ where
         area.draw(&PathElement::new(ring, colour.stroke_width(2)))
             .map_err(error)
     }
+}
+
+/// Draws a dark edge round `marker` (a marker on a bar of its own colour).
+pub fn edge_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    c: (i32, i32),
+    marker: Marker,
+    r: i32,
+    ink: RGBColor,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    if marker == Marker::Circle {
+        return area.draw(&Circle::new(c, r, ink.stroke_width(1))).map_err(error);
+    }
+    let mut ring: Vec<(i32, i32)> = outline(marker)
+        .iter()
+        .map(|&(x, y)| (c.0 + (x * r as f64).round() as i32, c.1 + (y * r as f64).round() as i32))
+        .collect();
+    ring.push(ring[0]);
+    area.draw(&PathElement::new(ring, ink.stroke_width(1))).map_err(error)
 }
 
 /// Whether pixel `p` lies in `rect` (left, top, right, bottom, inclusive).
@@ -252,9 +366,26 @@ mod tests {
     }
 
     #[test]
-    fn colour_and_marker_pairs_repeat_only_after_thirty_series() {
-        let pairs: std::collections::HashSet<_> = (0..30).map(|i| (colour(i), marker(i))).collect();
-        assert_eq!(pairs.len(), 30);
-        assert_eq!((colour(30), marker(30)), (colour(0), marker(0)));
+    fn looks_repeat_only_after_eighteen_series_and_the_first_nine_differ_in_colour_and_shape() {
+        let looks: std::collections::HashSet<Look> = (0..LOOKS).map(look).collect();
+        assert_eq!(looks.len(), LOOKS);
+        assert_eq!(look(LOOKS), look(0));
+        assert_ne!(look(LOOKS - 1), look(0));
+        let colours: std::collections::HashSet<_> = (0..9).map(colour).collect();
+        let shapes: std::collections::HashSet<_> = (0..9).map(|i| look(i).marker).collect();
+        assert_eq!((colours.len(), shapes.len()), (9, 9));
+        assert!((0..9).all(|i| !look(i).dashed && look(i + 9).dashed));
+    }
+
+    #[test]
+    fn two_series_with_one_look_are_refused() {
+        assert!(distinct([(0, "a", 0), (1, "b", 0), (9, "c", 0)]).is_ok());
+        let e = distinct([(0, "uniform", 0), (3, "paper", 0), (LOOKS + 3, "sobol", 0)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`paper`") && e.contains("`sobol`"), "{e}");
+        // One series in two panels is one legend entry; two series in two panels are not.
+        assert!(distinct([(2, "jittered", 0), (2, "jittered", 1)]).is_ok());
+        assert!(distinct([(2, "jittered", 0), (2, "spiral", 1)]).is_err());
     }
 }

@@ -47,24 +47,20 @@ fn strokes_near<'a>(doc: &'a Document, colour: &str, xs: (f64, f64), y: f64) -> 
 fn a_line_plot_is_written_as_svg_with_its_dashes_in_the_legend_and_clipped_intervals_marked() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("plot.png");
+    let pts = |v: &[(f64, f64, f64)]| -> Vec<Point> { v.iter().map(|&(x, y, h)| Point::ci(x, y, h)).collect() };
+    // Look 10: the second colour, dashed.
     let series = [
-        (
-            0,
-            Series {
-                name: "solid one".into(),
-                points: vec![(1.0, 0.2, 0.01), (4.0, 0.1, 0.01), (16.0, 0.05, 0.01)],
-                dashed: false,
-            },
-        ),
-        (
-            1,
-            Series {
-                name: "dashed one".into(),
-                // The middle interval reaches below zero: on a log axis it is clipped.
-                points: vec![(1.0, 0.3, 0.01), (4.0, 0.12, 0.5), (16.0, 0.06, 0.01)],
-                dashed: true,
-            },
-        ),
+        Series {
+            name: "solid one".into(),
+            look: 0,
+            points: pts(&[(1.0, 0.2, 0.01), (4.0, 0.1, 0.01), (16.0, 0.05, 0.01)]),
+        },
+        Series {
+            name: "dashed one".into(),
+            look: 10,
+            // The middle interval reaches below zero: on a log axis it is clipped.
+            points: pts(&[(1.0, 0.3, 0.01), (4.0, 0.12, 0.5), (16.0, 0.06, 0.01)]),
+        },
     ];
     let axes = Axes::new("title", "rays", "RMSE", true, true);
     line_plot(&path, &axes, &series, &[]).unwrap();
@@ -91,7 +87,7 @@ fn a_line_plot_is_written_as_svg_with_its_dashes_in_the_legend_and_clipped_inter
         .filter(|n| n.has_tag_name("circle") && n.attribute("fill") == Some(hex(colour(0)).as_str()))
         .map(|n| n.attribute("cx").unwrap().parse().unwrap())
         .collect();
-    let sample = solid_x - 30.0;
+    let sample = solid_x - 28.0;
     assert_eq!(xs.len(), 3 + 1, "{xs:?}");
     assert_eq!(xs.iter().filter(|&&x| (x - sample).abs() < 4.0).count(), 1, "{xs:?}");
     assert!(
@@ -101,7 +97,7 @@ fn a_line_plot_is_written_as_svg_with_its_dashes_in_the_legend_and_clipped_inter
         "a data marker under the legend: {xs:?}"
     );
     let solid = strokes_near(&doc, &hex(colour(0)), (solid_x - 60.0, solid_x), solid_y);
-    let dashed = strokes_near(&doc, &hex(colour(1)), (dashed_x - 60.0, dashed_x), dashed_y);
+    let dashed = strokes_near(&doc, &hex(colour(10)), (dashed_x - 60.0, dashed_x), dashed_y);
     assert_eq!(solid.len(), 1, "a solid series' legend line is one stroke");
     assert!(
         dashed.len() >= 3,
@@ -183,6 +179,14 @@ fn grouped_bars_name_each_group_and_join_none() {
             .count();
         // One per group, and the legend's swatch.
         assert_eq!(bars, groups.len() + 1, "bars of series {i}");
+        // Each with its series' marker on top: a disc for the first, polygons for the others.
+        let markers = doc
+            .descendants()
+            .filter(|n| {
+                (n.has_tag_name("circle") || n.has_tag_name("polygon")) && n.attribute("fill") == Some(fill.as_str())
+            })
+            .count();
+        assert_eq!(markers, groups.len() + 1, "markers of series {i}");
         let joined = doc
             .descendants()
             .filter(|n| n.has_tag_name("polyline") && n.attribute("stroke") == Some(fill.as_str()))
@@ -235,14 +239,11 @@ fn an_error_map_gets_a_colour_bar_from_blue_to_red() {
 fn an_axis_over_one_value_is_still_labelled() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("one.png");
-    let series = [(
-        0,
-        Series {
-            name: "one radius".into(),
-            points: vec![(20.0, 14.0, 0.5)],
-            dashed: false,
-        },
-    )];
+    let series = [Series {
+        name: "one radius".into(),
+        look: 0,
+        points: vec![Point::ci(20.0, 14.0, 0.5)],
+    }];
     line_plot(
         &path,
         &Axes::new("t", "light radius (mm)", "width (mm)", false, false),
@@ -253,4 +254,179 @@ fn an_axis_over_one_value_is_still_labelled() {
     let text = std::fs::read_to_string(path.with_extension("svg")).unwrap();
     let doc = Document::parse(&text).unwrap();
     assert!(text_at(&doc, "20").is_some(), "the one x value is labelled");
+}
+
+/// A series of `look` through three points.
+fn three(name: &str, look: usize, scale: f64) -> Series {
+    Series {
+        name: name.into(),
+        look,
+        points: vec![
+            Point::ci(1.0, scale, 0.1 * scale),
+            Point::ci(4.0, 0.5 * scale, 0.1 * scale),
+            Point::ci(16.0, 0.25 * scale, 0.1 * scale),
+        ],
+    }
+}
+
+#[test]
+fn two_series_of_one_look_are_refused_in_line_plots_and_bars() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("alike.png");
+    let axes = Axes::new("t", "rays", "RMSE", true, true);
+    // 3 and 3 + LOOKS: one colour, one marker, both solid.
+    let alike = [three("paper", 3, 1.0), three("sobol", 3 + LOOKS, 2.0)];
+    let e = line_plot(&path, &axes, &alike, &[]).unwrap_err().to_string();
+    assert!(e.contains("`paper`") && e.contains("`sobol`"), "{e}");
+    assert!(!path.exists(), "nothing written for a refused figure");
+    // One colour but dashed: told apart.
+    line_plot(&path, &axes, &[three("paper", 3, 1.0), three("sobol", 12, 2.0)], &[]).unwrap();
+    let names = [(1, "kdtree".to_string()), (1 + LOOKS, "vlf".to_string())];
+    let e = grouped_bars(&dir.path().join("bars.png"), "t", "s", &names, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`kdtree`") && e.contains("`vlf`"), "{e}");
+}
+
+#[test]
+fn small_multiples_share_their_axes_and_name_each_series_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("panels.png");
+    let panels = [
+        Panel {
+            title: "per-pixel pattern".into(),
+            series: vec![three("uniform", 0, 1.0), three("paper", 1, 0.5)],
+        },
+        Panel {
+            title: "shared pattern".into(),
+            // Ten times smaller: on a shared axis it lies lower than the first panel's.
+            series: vec![three("uniform", 0, 0.1), three("paper", 1, 0.05)],
+        },
+    ];
+    let axes = Axes::new("Figure", "rays", "RMSE", true, true);
+    line_panels(&path, &axes, &panels, &[]).unwrap();
+    let text = std::fs::read_to_string(path.with_extension("svg")).unwrap();
+    let doc = Document::parse(&text).unwrap();
+    let texts: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .filter_map(|n| n.text())
+        .map(str::trim)
+        .collect();
+    for t in ["Figure", "per-pixel pattern", "shared pattern"] {
+        assert_eq!(texts.iter().filter(|x| **x == t).count(), 1, "{t}: {texts:?}");
+    }
+    for t in ["uniform", "paper"] {
+        assert_eq!(texts.iter().filter(|x| **x == t).count(), 1, "one legend entry for {t}");
+    }
+    assert_eq!(
+        texts.iter().filter(|x| **x == "RMSE").count(),
+        2,
+        "each panel names its axes"
+    );
+    // The y labels of the two panels read alike: one range for both.
+    let labels = |left: bool| -> Vec<String> {
+        let (x_left, _) = text_at(&doc, "per-pixel pattern").unwrap();
+        let (x_right, _) = text_at(&doc, "shared pattern").unwrap();
+        let mid = (x_left + x_right) / 2.0;
+        let mut v: Vec<(f64, String)> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text") && n.attribute("text-anchor") == Some("end"))
+            .filter_map(|n| {
+                let x: f64 = n.attribute("x")?.parse().ok()?;
+                let y: f64 = n.attribute("y")?.parse().ok()?;
+                let t = n.text()?.trim().to_string();
+                ((x < mid) == left).then_some((y, t))
+            })
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v.into_iter().map(|(_, t)| t).collect()
+    };
+    let (l, r) = (labels(true), labels(false));
+    assert!(l.len() >= 2, "{l:?}");
+    assert_eq!(l, r, "panels on one y range");
+    // The shared panel's first point (RMSE 0.1) lies lower than the per-pixel one's (1.0): the
+    // indigo discs of uniform, three per panel and one in the legend.
+    let indigo = hex(colour(0));
+    let discs: Vec<(f64, f64)> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("circle") && n.attribute("fill") == Some(indigo.as_str()))
+        .map(|n| {
+            (
+                n.attribute("cx").unwrap().parse().unwrap(),
+                n.attribute("cy").unwrap().parse().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(discs.len(), 7, "{discs:?}");
+    assert!(discs[3].1 > discs[0].1 + 100.0, "{discs:?}");
+}
+
+#[test]
+fn a_long_legend_keeps_the_data_on_most_of_the_width_in_legible_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.png");
+    let series: Vec<Series> = (0..9)
+        .map(|i| {
+            three(
+                &format!("a rather long series name, number {i} of nine"),
+                i,
+                1.0 + i as f64,
+            )
+        })
+        .collect();
+    line_plot(&path, &Axes::new("t", "rays", "RMSE", true, true), &series, &[]).unwrap();
+    let text = std::fs::read_to_string(path.with_extension("svg")).unwrap();
+    let doc = Document::parse(&text).unwrap();
+    let width: f64 = doc.root_element().attribute("width").unwrap().parse().unwrap();
+    // The data area: from the y axis's labels to the legend's first sample.
+    let (legend_x, _) = text_at(&doc, "a rather long series name, number 0 of nine").unwrap();
+    let axis_x = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text") && n.attribute("text-anchor") == Some("end"))
+        .filter_map(|n| n.attribute("x")?.parse::<f64>().ok())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        legend_x - 60.0 - axis_x > 0.6 * width,
+        "data {} of {width}",
+        legend_x - 60.0 - axis_x
+    );
+    // Every legend entry and tick label at 15 px or more.
+    for n in doc.descendants().filter(|n| n.has_tag_name("text")) {
+        let size: f64 = n
+            .attribute("font-size")
+            .unwrap()
+            .trim_end_matches("px")
+            .parse()
+            .unwrap();
+        assert!(size >= 15.0, "{:?} at {size}", n.text());
+    }
+}
+
+#[test]
+fn one_wide_interval_is_clipped_rather_than_flattening_the_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("outlier.png");
+    let mut series = three("renders", 0, 2.0);
+    for (i, p) in series.points.iter_mut().enumerate() {
+        p.lo = p.y - 0.05;
+        // The second point's interval reaches fifty times past the data.
+        p.hi = if i == 1 { 50.0 } else { p.y + 0.05 };
+    }
+    line_plot(&path, &Axes::new("t", "frame", "seconds", false, false), &[series], &[]).unwrap();
+    let text = std::fs::read_to_string(path.with_extension("svg")).unwrap();
+    let doc = Document::parse(&text).unwrap();
+    let top = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text") && n.attribute("text-anchor") == Some("end"))
+        .filter_map(|n| n.text()?.trim().parse::<f64>().ok())
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(top > 1.5 && top < 4.0, "the y axis runs to {top}");
+    assert!(text_at(&doc, "interval beyond the axis").is_some());
+    let ink = hex(INK);
+    assert!(
+        doc.descendants()
+            .any(|n| n.has_tag_name("polygon") && n.attribute("fill") == Some(ink.as_str())),
+        "a caret marks the clipped end"
+    );
 }

@@ -101,6 +101,7 @@ fn measuring_view(r: &Results) -> anyhow::Result<Option<Gallery>> {
         height: spec.measure.height,
         tone: Tone::Linear,
         reference: Some(gt),
+        against: None,
         shots,
     }))
 }
@@ -165,7 +166,7 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
                 pic.samples
             );
             Shot {
-                label: format!("{} ({}), {} rays", run.scheme, run.pattern, pic.samples),
+                label: format!("picture: {} ({}), {} rays", run.scheme, run.pattern, pic.samples),
                 exr: format!("{stem}.exr"),
                 png: format!("{stem}.png"),
                 values: pic.frame.radiance.clone(),
@@ -174,7 +175,7 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
         })
         .collect();
     shots.push(Shot {
-        label: format!("jittered (ground truth), {} rays", gt.samples),
+        label: format!("picture: jittered (ground truth), {} rays", gt.samples),
         exr: "images/picture_ground_truth.exr".into(),
         png: "images/picture_ground_truth.png".into(),
         values: gt.frame.radiance.clone(),
@@ -185,9 +186,10 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
         width: gt.frame.width,
         height: gt.frame.height,
         tone: Tone::Radiance {
-            p99: exposure(&gt.frame.radiance),
+            p99: exposure(&Tone::radiance_stored(&gt.frame.radiance)),
         },
         reference: Some(shots.len() - 1),
+        against: None,
         shots,
     })
 }

@@ -112,7 +112,7 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     }
     s += &super::structures::structure_section(spec, outcome, summaries);
     s += "\n## Outputs\n\n- `runs.csv`: one row per run, with the error's radial power spectrum (`error_power_NN`: rings of 1/32 cycles per pixel); `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
-    s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time, the error's spectrum per scheme at the figure ray count (any scene).\n";
+    s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time, the error's spectrum per scheme at the figure ray count (any scene). A plot over both patterns has one panel per pattern on shared axes; one file per value of each other swept axis, named `_AXIS-VALUE` (`rmse_vs_time_lights-1_accelerator-bvh.png`).\n";
     s += "- `images/`: every scheme and pattern of the measuring view at the figure ray count, the ground truth and the exact image, and the Fig. 2 pictures, each as `.exr` (the values) and `.png`; the grids `fig2_measure.png` and `fig2_picture.png`.\n- `index.html`: the comparison page (open it in a browser; no server needed).\n- `manifest.toml`: commit, adapter, experiment, seeds.\n";
     s
 }

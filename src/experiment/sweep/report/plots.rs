@@ -1,6 +1,8 @@
 //! The sweep's plots: RMSE and extent widths against rays and frame time, the error's power
 //! spectrum per scheme at the figure ray count, radial profiles at that count against the exact
-//! profile, and extent width against light radius.
+//! profile, and extent width against light radius. A plot over both patterns is drawn as two
+//! panels side by side on shared axes, one per pattern, so that no panel holds more than one
+//! line per scheme; a scheme has one look (colour, marker, dashes) in every plot.
 
 use super::results::Results;
 use super::summary::{swept_schemes, Summary};
@@ -9,8 +11,8 @@ use crate::experiment::sweep::record::{Aggregated, Status};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::metrics::spectrum::BIN;
 use crate::metrics::stats::{mean_ci, MeanCi};
-use crate::output::plots::{line_plot, Axes, Reference as RefLine, Series};
-use crate::sampling::Pattern;
+use crate::output::plots::{line_panels, line_plot, Axes, Panel, Point, Reference as RefLine, Series};
+use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
 /// The axes the plots name; each plot is drawn once per value of the others.
@@ -22,20 +24,39 @@ struct Filter<'a> {
     radius: Option<f64>,
     samples: Option<u32>,
     slice: &'a Slice,
+    /// The experiment's schemes, which give each its look ([`scheme_look`]).
+    schemes: &'a [DiskScheme],
 }
 
-/// Series of one metric against a per-summary x, per scheme (per-pixel solid, shared dashed).
-fn series(
+/// The look index of `scheme` among an experiment's `schemes`: a built-in scheme's place in
+/// [`DiskScheme::ALL`], so that it looks the same in every plot of every experiment; a user's
+/// points scheme takes the first index no built-in of `schemes` holds, in the order listed.
+pub fn scheme_look(scheme: DiskScheme, schemes: &[DiskScheme]) -> usize {
+    if let Some(i) = DiskScheme::ALL.iter().position(|s| *s == scheme) {
+        return i;
+    }
+    let mut users = schemes.iter().filter(|s| !s.is_built_in());
+    let nth = users.position(|s| *s == scheme).unwrap_or(0);
+    (0..)
+        .filter(|i| !schemes.iter().any(|s| DiskScheme::ALL.get(*i) == Some(s)))
+        .nth(nth)
+        .unwrap_or(0)
+}
+
+/// One panel per pattern swept (its series: one per scheme) of one metric against a per-summary
+/// x.
+fn panels(
     summaries: &[Summary],
     f: Filter,
     x: impl Fn(&Summary) -> f64,
     metric: fn(&Aggregated) -> MeanCi,
     scale: f64,
-) -> Vec<(usize, Series)> {
+) -> Vec<Panel> {
     let mut out = Vec::new();
-    for (ci, scheme) in swept_schemes(summaries).iter().enumerate() {
-        for pattern in Pattern::ALL {
-            let mut pts: Vec<(f64, f64, f64)> = summaries
+    for pattern in Pattern::ALL {
+        let mut series = Vec::new();
+        for scheme in &swept_schemes(summaries) {
+            let mut pts: Vec<Point> = summaries
                 .iter()
                 .filter(|s| s.config.scheme == *scheme && s.config.pattern == pattern)
                 .filter(|s| f.slice.holds(&s.config, &PLOT_NAMES))
@@ -45,31 +66,56 @@ fn series(
                 })
                 .map(|s| {
                     let m = metric(&s.metrics);
-                    (x(s), m.mean * scale, m.ci95 * scale)
+                    Point::ci(x(s), m.mean * scale, m.ci95 * scale)
                 })
-                .filter(|p| p.1.is_finite())
+                .filter(|p| p.y.is_finite())
                 .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            pts.sort_by(|a, b| a.x.total_cmp(&b.x));
             if !pts.is_empty() {
-                out.push((
-                    ci,
-                    Series {
-                        name: format!("{scheme} ({pattern})"),
-                        points: pts,
-                        dashed: pattern == Pattern::Shared,
-                    },
-                ));
+                series.push(Series {
+                    name: scheme.to_string(),
+                    look: scheme_look(*scheme, f.schemes),
+                    points: pts,
+                });
             }
+        }
+        if !series.is_empty() {
+            out.push(Panel {
+                title: format!("{pattern} pattern"),
+                series,
+            });
         }
     }
     out
 }
 
+/// The file name suffix of a slice: `_AXIS-VALUE` per axis that tells the slices apart, in axis
+/// order (`_lights-1_accelerator-bvh`), any character of a value outside letters, digits, `.`
+/// and `-` written `-`.
+fn suffix(slice: &Slice) -> String {
+    slice
+        .varying
+        .iter()
+        .map(|(a, v)| {
+            let v: String = v
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                        c
+                    } else {
+                        '-'
+                    }
+                })
+                .collect();
+            format!("_{}-{v}", a.name())
+        })
+        .collect()
+}
+
 /// Writes every plot into `dir`, one set per slice of the axes the plots do not name.
 pub fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Result<()> {
     for slice in slices(summaries.iter().map(|s| &s.config), &PLOT_NAMES) {
-        let suffix: String = slice.varying.iter().map(|(a, v)| format!("_{v}{}", a.name())).collect();
-        plots_for(r, summaries, dir, &slice, &suffix)?;
+        plots_for(r, summaries, dir, &slice, &suffix(&slice))?;
     }
     Ok(())
 }
@@ -79,15 +125,21 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
     let radius = verdict_radius(spec);
     let n = figure_samples(spec);
     let lights = slice.config.lights;
+    let schemes = &spec.axes.schemes;
     let at_radius = Filter {
         radius: Some(radius),
         samples: None,
         slice,
+        schemes,
     };
     let samples = |s: &Summary| s.config.samples as f64;
     let file = |name: &str| dir.join(format!("{name}{suffix}.png"));
-    let title = |what: &str| format!("{what}, light radius {radius} m, {lights} light(s)");
-    line_plot(
+    let others = match slice.label(&[Axis::Lights]) {
+        l if l.is_empty() => l,
+        l => format!(", {l}"),
+    };
+    let title = |what: &str| format!("{what}, light radius {radius} m, {lights} light(s){others}");
+    line_panels(
         &file("rmse_vs_samples"),
         &Axes::new(
             &title("RMSE vs ground truth over the penumbra"),
@@ -96,10 +148,10 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             true,
         ),
-        &series(summaries, at_radius, samples, |m| m.rmse, 1.0),
+        &panels(summaries, at_radius, samples, |m| m.rmse, 1.0),
         &[],
     )?;
-    line_plot(
+    line_panels(
         &file("rmse_vs_time"),
         &Axes::new(
             &title("What accuracy costs: RMSE vs frame time"),
@@ -108,7 +160,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             true,
         ),
-        &series(summaries, at_radius, |s| s.frame.median * 1e3, |m| m.rmse, 1.0),
+        &panels(summaries, at_radius, |s| s.frame.median * 1e3, |m| m.rmse, 1.0),
         &[],
     )?;
     line_plot(
@@ -148,7 +200,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         }]
     };
     let (a, b) = exact.extent();
-    line_plot(
+    line_panels(
         &file("width_vs_samples"),
         &Axes::new(
             &title("Visible penumbra extent"),
@@ -157,10 +209,10 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             false,
         ),
-        &series(summaries, at_radius, samples, |m| m.extent_width, 1e3),
+        &panels(summaries, at_radius, samples, |m| m.extent_width, 1e3),
         &flat("exact extent", b - a),
     )?;
-    line_plot(
+    line_panels(
         &file("width_10_90_vs_samples"),
         &Axes::new(
             &title("10-90 % width of the mean radial profile"),
@@ -169,7 +221,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
             true,
             false,
         ),
-        &series(summaries, at_radius, samples, |m| m.width_10_90, 1e3),
+        &panels(summaries, at_radius, samples, |m| m.width_10_90, 1e3),
         &flat("exact 10-90 %", exact.width_10_90()),
     )?;
     let mut exact_vs_radius: Vec<(f64, f64)> = r
@@ -184,21 +236,22 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         })
         .collect();
     exact_vs_radius.sort_by(|a, b| a.0.total_cmp(&b.0));
-    line_plot(
+    line_panels(
         &file("width_vs_radius"),
         &Axes::new(
-            &format!("Visible penumbra extent at {n} rays"),
+            &format!("Visible penumbra extent at {n} rays, {lights} light(s){others}"),
             "light radius (mm)",
             "extent width (mm)",
             false,
             false,
         ),
-        &series(
+        &panels(
             summaries,
             Filter {
                 radius: None,
                 samples: Some(n),
                 slice,
+                schemes,
             },
             |s| s.config.light_radius * 1e3,
             |m| m.extent_width,
@@ -211,8 +264,9 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         }],
     )?;
     let mut profiles = Vec::new();
-    for (ci, scheme) in swept_schemes(summaries).iter().enumerate() {
-        for pattern in Pattern::ALL {
+    for pattern in Pattern::ALL {
+        let mut series = Vec::new();
+        for scheme in &swept_schemes(summaries) {
             let config = Config {
                 scheme: *scheme,
                 pattern,
@@ -221,21 +275,23 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
                 ..slice.config.clone()
             };
             if let Some((_, p)) = r.outcome.profiles.iter().find(|(c, _)| *c == config) {
-                let points = p
-                    .radius
-                    .iter()
-                    .zip(&p.mean)
-                    .map(|(x, y)| (x * 1e3, *y, f64::NAN))
-                    .collect();
-                profiles.push((
-                    ci,
-                    Series {
-                        name: format!("{scheme} ({pattern})"),
-                        points,
-                        dashed: pattern == Pattern::Shared,
-                    },
-                ));
+                series.push(Series {
+                    name: scheme.to_string(),
+                    look: scheme_look(*scheme, schemes),
+                    points: p
+                        .radius
+                        .iter()
+                        .zip(&p.mean)
+                        .map(|(x, y)| Point::bare(x * 1e3, *y))
+                        .collect(),
+                });
             }
+        }
+        if !series.is_empty() {
+            profiles.push(Panel {
+                title: format!("{pattern} pattern"),
+                series,
+            });
         }
     }
     let exact_line = RefLine {
@@ -253,7 +309,7 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
         let (ru, rp) = (o.umbra_radius().max(0.0) * 1e3, o.penumbra_radius() * 1e3);
         (ru - 0.4 * (rp - ru), rp + 0.4 * (rp - ru))
     });
-    line_plot(
+    line_panels(
         &file("profiles"),
         &Axes {
             x_range,
@@ -272,9 +328,10 @@ fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suff
 
 /// The mean radial power spectrum of the error over seeds, per scheme with the per-pixel pattern
 /// at `n` rays and light radius `radius`, each ring with its 95 % CI.
-fn spectra(r: &Results, slice: &Slice, n: u32, radius: f64) -> Vec<(usize, Series)> {
+fn spectra(r: &Results, slice: &Slice, n: u32, radius: f64) -> Vec<Series> {
     let mut out = Vec::new();
-    for (ci, scheme) in r.spec.axes.schemes.iter().enumerate() {
+    let schemes = &r.spec.axes.schemes;
+    for scheme in schemes {
         let config = Config {
             scheme: *scheme,
             pattern: Pattern::PerPixel,
@@ -295,18 +352,15 @@ fn spectra(r: &Results, slice: &Slice, n: u32, radius: f64) -> Vec<(usize, Serie
         let points = (0..first.len())
             .map(|k| {
                 let m = mean_ci(&rings.iter().map(|x| x[k]).collect::<Vec<_>>());
-                ((k as f64 + 0.5) * BIN, m.mean, m.ci95)
+                Point::ci((k as f64 + 0.5) * BIN, m.mean, m.ci95)
             })
-            .filter(|p| p.1.is_finite())
+            .filter(|p| p.y.is_finite())
             .collect();
-        out.push((
-            ci,
-            Series {
-                name: scheme.to_string(),
-                points,
-                dashed: false,
-            },
-        ));
+        out.push(Series {
+            name: scheme.to_string(),
+            look: scheme_look(*scheme, schemes),
+            points,
+        });
     }
     out
 }
