@@ -76,6 +76,17 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     }
     assert!(texts.iter().any(|t| t.ends_with("triangles")), "{texts:?}");
     common::browser::check_page(&out);
+    // Each mesh's images are measured against brute force, which this experiment runs.
+    let data = common::browser::page_data(&out).unwrap();
+    for g in data["galleries"].as_array().unwrap() {
+        let reference = &g["shots"][g["reference"].as_u64().expect("a reference") as usize];
+        assert!(
+            reference["exr"].as_str().unwrap().ends_with("_brute.exr"),
+            "{}: reference {}",
+            g["title"],
+            reference["exr"]
+        );
+    }
     let tables = common::assert_tidy_tables(&out);
     assert_eq!(tables.len(), 3, "ao.csv, rounds.csv and tuning.csv: {tables:?}");
     // Every timed frame is committed: each row's median and interval recompute from rounds.csv.

@@ -178,6 +178,17 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
         assert!(out.join(file).exists(), "{file} missing");
     }
     common::browser::check_page(&out);
+    // The two strips are set against each other: opengl frame N against whitted frame N.
+    let data = common::browser::page_data(&out).unwrap();
+    let galleries = data["galleries"].as_array().unwrap();
+    assert_eq!(galleries.len(), 2);
+    for (i, g) in galleries.iter().enumerate() {
+        assert_eq!(g["against"].as_u64(), Some(1 - i as u64), "{}", g["title"]);
+        assert_eq!(
+            g["shots"].as_array().unwrap().len(),
+            galleries[1 - i]["shots"].as_array().unwrap().len()
+        );
+    }
     assert!(
         report.contains("equals the first structure's pixel for pixel"),
         "{report}"

@@ -266,7 +266,7 @@ fn gallery_of<'a>(data: &'a Value, exr: &str) -> Option<&'a Value> {
 }
 
 /// page_data.js as JSON.
-fn page_data(dir: &Path) -> Result<Value, String> {
+pub fn page_data(dir: &Path) -> Result<Value, String> {
     let text = std::fs::read_to_string(dir.join("page_data.js")).map_err(|e| format!("page_data.js: {e}"))?;
     let json = text
         .strip_prefix("window.PENUMBRA = ")
