@@ -12,13 +12,15 @@
 //!
 //! over the storage buffers it declares at `@group(2)` ([`GpuStructure`]), with `AccelHit
 //! { t, triangle }` (`triangle` in input order, `NO_HIT` on a miss; `skip` is a triangle to
-//! ignore) and the flag `cut_short` set where a loop ended early. Every structure's module may
+//! ignore) and the flag `cut_short` set where a loop ended early; it adds each node (or tile) it
+//! visits to `work_nodes` and each primitive test to `work_prims`, as its CPU walk counts them
+//! ([`work`]). Every structure's module may
 //! use the shared triangle struct `AccelTri` and ray-triangle test `triangle_t`
 //! ([`TRIANGLE_WGSL`], prepended to it). The GPU
 //! backend compiles each structure's module into its own pipelines, chosen by name. Adding a
 //! structure is its module, its WGSL and one line in [`REGISTRY`]. A structure may be CPU only
-//! ([`Registered::gpu`] false, as obvhs' CWBVH is): its [`Accelerator::gpu`] then refuses by
-//! name, and the GPU backend reports that error rather than render with another structure.
+//! ([`Registered::gpu`] false): its [`Accelerator::gpu`] then refuses by name, and the GPU
+//! backend reports that error rather than render with another structure.
 
 pub mod brute;
 pub mod bundle;
@@ -391,9 +393,9 @@ pub const REGISTRY: &[Registered] = &[
     },
     Registered {
         name: "cwbvh",
-        wgsl: "",
-        gpu: false,
-        gpu_buffers: 0,
+        wgsl: cwbvh::WGSL,
+        gpu: true,
+        gpu_buffers: 2,
         params: settings::validate::<cwbvh::CwbvhSettings>,
         tuning: <cwbvh::CwbvhSettings as settings::Params>::tuning,
         build: |t, s| {

@@ -23,7 +23,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
     let header = experiment.header().clone();
     let kind = header.kind.name();
     let accepts = experiment.accepts();
-    let choice = cli.backend.or(header.backend).unwrap_or(BackendChoice::Auto);
+    let choice = cli.backend.or(header.backend).unwrap_or(accepts.backend);
     if !accepts.gpu && choice == BackendChoice::Gpu {
         return Err(BadInput(format!(
             "`{kind}` experiments time the f64 CPU backend, where every structure answers exactly; --backend gpu (or backend = \"gpu\") does not apply"

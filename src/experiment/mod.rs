@@ -41,6 +41,8 @@ pub struct Accepts {
     /// Whether it runs on the GPU; a kind that does not times the f64 CPU backend, where every
     /// structure is exact, and refuses `--backend gpu`.
     pub gpu: bool,
+    /// The backend where neither the file nor the command line names one.
+    pub backend: crate::render::BackendChoice,
 }
 
 /// Everything a kind's run may use.
@@ -88,8 +90,8 @@ pub trait Experiment {
     /// Every file it read (experiment, scenes, meshes), hashed into the manifest.
     fn inputs(&self) -> Vec<PathBuf>;
 
-    /// What of it the GPU cannot run (a pass or material it has no kernel for, a structure
-    /// without a GPU form), located at its file and key; the driver asks before it chooses a
+    /// What of it the GPU cannot run (a structure without a GPU form), located at its file and
+    /// key; the driver asks before it chooses a
     /// backend. Kinds that render on the CPU only say nothing.
     fn gpu_gap(&self) -> Option<String> {
         None
@@ -107,12 +109,10 @@ pub trait Experiment {
     fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished>;
 }
 
-/// What of `scene`, read from `path`, the GPU cannot run: a pass or material without a kernel
-/// ([`crate::render::gpu::gpu_gap`]) or its structure without a GPU form, at the scene's key.
+/// What of `scene`, read from `path`, the GPU cannot run: its structure without a GPU form
+/// ([`crate::accel::Accelerator::gpu_refusal`]), at the scene's key. Every pass of the render
+/// plan has a GPU kernel.
 pub(crate) fn scene_gpu_gap(path: &Path, scene: &crate::scene::Scene) -> Option<String> {
-    if let Some(gap) = crate::render::gpu::gpu_gap(scene) {
-        return Some(format!("{}: {gap}", path.display()));
-    }
     let refusal = scene.accel.as_ref()?.gpu_refusal()?;
     Some(format!("{}: key `accelerator`: {refusal}", path.display()))
 }

@@ -100,7 +100,8 @@ pub struct Frame {
     /// Rays traced.
     pub rays: RayCounts,
     /// What the queries cost (nodes visited, primitives tested), where the backend counts it:
-    /// the CPU always; the GPU not (`counted` false, `work` zero).
+    /// the CPU always, the GPU where switched on ([`Backend::count_work`]; never in timed
+    /// frames).
     pub work: crate::accel::work::Work,
     /// Whether `work` was counted.
     pub counted: bool,
@@ -163,6 +164,23 @@ pub struct AdapterInfo {
     pub threads: Option<usize>,
 }
 
+impl AdapterInfo {
+    /// The device in the words a report opens with: the CPU backend and its threads, or the GPU
+    /// adapter, saying so where the adapter is Mesa's software rasteriser (its GPU times are a
+    /// CPU's).
+    pub fn describe(&self) -> String {
+        if self.backend == "cpu" {
+            return format!("the f64 CPU backend ({} threads)", self.threads.unwrap_or(1));
+        }
+        let software = if self.name.contains("llvmpipe") {
+            ": Mesa's software Vulkan driver, so its GPU times are this machine's CPU's"
+        } else {
+            ""
+        };
+        format!("the GPU backend on {} ({}){software}", self.name, self.api)
+    }
+}
+
 /// A renderer of scenes into frames.
 pub trait Backend {
     /// Which device this is.
@@ -171,6 +189,11 @@ pub trait Backend {
     /// Work units issued so far over all frames (GPU: compute dispatches, CPU: pass loops): what
     /// tests count against the plan, since a pass not in the plan must never run.
     fn dispatches(&self) -> u64;
+
+    /// Switches the counting of work (queries, nodes, primitive tests) in the frames read back:
+    /// the CPU always counts; the GPU only when switched on (its atomics), which the ao and
+    /// frames kinds do and the sweep, fps and realtime kinds do not (their GPU rows read n/a).
+    fn count_work(&mut self, _on: bool) {}
 
     /// Renders one frame and reads it back.
     fn render(&mut self, scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame>;
@@ -199,10 +222,11 @@ pub trait Backend {
 }
 
 /// Which renderer runs an experiment: the experiment file's `backend` key, or `--backend`.
-#[derive(Clone, Copy, Debug, serde::Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, serde::Deserialize, PartialEq, Eq, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum BackendChoice {
     /// The GPU when an adapter exists, else the CPU with a warning.
+    #[default]
     Auto,
     /// The GPU or an error.
     Gpu,

@@ -79,8 +79,9 @@ pub struct AmbientOcclusion {
     pub weighting: Weighting,
     /// Occluders farther than this do not count (infinite: no limit).
     pub max_distance: f64,
-    /// How the CPU issues the rays: receiver by receiver, or a grid line's rays of many
-    /// receivers as one bundle ([`crate::accel::Issue`]). The image is the same either way.
+    /// How the rays are issued: receiver by receiver, or a grid line's rays of many receivers
+    /// as one bundle on the CPU and one dispatch per direction on the GPU
+    /// ([`crate::accel::Issue`]). The image is the same either way.
     pub issue: crate::accel::Issue,
 }
 

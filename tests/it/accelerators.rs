@@ -443,3 +443,54 @@ fn work_counts_are_exact_and_do_not_depend_on_threads() {
         );
     }
 }
+
+/// The GPU's work counters against the CPU's, frame for frame, with every structure. Each ray is
+/// one query on either backend (its closest or any hit over shapes and structure), so queries
+/// equal rays traced on both. Brute force tests every triangle for a closest hit and those up to
+/// the first blocker for an any hit on both, so its primitive tests agree but for the rays f32
+/// and f64 decide differently; the other structures' counts are their own GPU walks' (the BVH
+/// pops nodes where obvhs' CPU walk tests child pairs, the CWBVH tests a node's children in slot
+/// order rather than obvhs' octant order) and are printed beside the CPU's; the kd-trees walk as
+/// their CPU twins do. Counting is off until switched on.
+#[test]
+fn gpu_work_counters_count_what_the_cpu_counts_where_the_walks_are_the_same() {
+    let Some(mut gpu) = common::gpu() else { return };
+    let cam = camera();
+    let s = scene("bvh");
+    assert!(
+        gpu.render(&s, view(&cam), sampling()).unwrap().work().is_none(),
+        "off by default"
+    );
+    gpu.count_work(true);
+    for r in REGISTRY.iter().filter(|r| r.gpu) {
+        let s = scene(r.name);
+        let g = gpu.render(&s, view(&cam), sampling()).unwrap();
+        let c = CpuBackend::default().render(&s, view(&cam), sampling()).unwrap();
+        let (gw, cw) = (g.work().expect("GPU frames count when switched on"), c.work().unwrap());
+        eprintln!(
+            "{}: GPU {gw:?}, CPU {cw:?}; nodes x{:.3}, primitives x{:.3}",
+            r.name,
+            gw.nodes as f64 / cw.nodes.max(1) as f64,
+            gw.primitives as f64 / cw.primitives.max(1) as f64
+        );
+        assert_eq!(gw.queries, g.rays.total(), "{}: GPU queries are its rays", r.name);
+        assert_eq!(cw.queries, c.rays.total(), "{}: CPU queries are its rays", r.name);
+        assert!(gw.nodes > 0 || r.name == "brute", "{}: {gw:?}", r.name);
+        if r.name == "brute" {
+            assert_eq!((gw.nodes, cw.nodes), (0, 0));
+            let off = gw.primitives.abs_diff(cw.primitives) as f64 / cw.primitives as f64;
+            assert!(off < 1e-3, "brute: {gw:?} vs {cw:?}");
+        }
+        if r.name.starts_with("kdtree") {
+            // The same walk as the CPU's (near child first, the same thick planes), so the same
+            // counts but where f32 decides a plane differently from f64.
+            let near = |a: u64, b: u64| a.abs_diff(b) as f64 <= 0.01 * b as f64;
+            assert!(
+                near(gw.nodes, cw.nodes) && near(gw.primitives, cw.primitives),
+                "{}: {gw:?} vs {cw:?}",
+                r.name
+            );
+        }
+    }
+    gpu.count_work(false);
+}

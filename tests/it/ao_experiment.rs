@@ -202,3 +202,41 @@ fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
         "{v}"
     );
 }
+
+/// experiments/ao-ci.toml on the GPU (`--backend gpu`, lavapipe in CI): every structure's AO
+/// image equals the first's bit for bit, single and direction-major alike; rows carry the GPU's
+/// work counts and the open question's table its GPU rows; the report names the adapter.
+#[test]
+fn the_ci_experiment_runs_on_the_gpu() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ao-ci-gpu");
+    let exp = common::repo("experiments/ao-ci.toml");
+    let (code, err) = common::sweep(&[
+        exp.as_os_str(),
+        OsStr::new("--backend"),
+        OsStr::new("gpu"),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut reader = csv::Reader::from_path(out.join("ao.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 2 * (6 + 3));
+    for r in &rows {
+        assert_eq!(&r[col("same_image_as_first")], "true", "{r:?}");
+        assert!(
+            r[col("primitive_tests")].parse::<u64>().unwrap() > 0,
+            "GPU work counted: {r:?}"
+        );
+        let receivers: u64 = r[col("receivers")].parse().unwrap();
+        assert_eq!(r[col("ao_rays")].parse::<u64>().unwrap(), 33 * receivers, "{r:?}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("s on the GPU backend on "), "{report}");
+    assert!(report.contains("| `vlf` single / bundled |"), "{report}");
+}

@@ -1,10 +1,11 @@
-//! The visibility-field paper's two walkthrough shadings on the CPU backend: OpenGL-like (no
-//! rays beyond the camera's, unoccluded local light) against the closed form of a point light
-//! over a plane, and Whitted's mirror chains against an independent path: what a flat mirror
-//! shows is what a camera mirrored through its plane sees of the scene without the mirror.
+//! The visibility-field paper's two walkthrough shadings on the f64 CPU backend and (where an
+//! adapter exists) the GPU: OpenGL-like (no rays beyond the camera's, unoccluded local light)
+//! against the closed form of a point light over a plane, and Whitted's mirror chains against an
+//! independent path: what a flat mirror shows is what a camera mirrored through its plane sees
+//! of the scene without the mirror; and the GPU's frames against the CPU's with every structure.
 
 use glam::DVec3;
-use penumbra::accel::AccelSettings;
+use penumbra::accel::{AccelSettings, REGISTRY};
 use penumbra::mesh::Triangles;
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::plan::Pass;
@@ -65,15 +66,7 @@ fn mirror_mesh(mirror: f64, triangles: usize) -> Mesh {
 
 /// `scene` with one mirror mesh of weight `mirror` made of `quads`, under `shading`.
 fn with_mirrors(scene: Scene, quads: &[[[DVec3; 3]; 2]], mirror: f64, shading: Shading) -> Scene {
-    let positions: Vec<[DVec3; 3]> = quads.iter().flatten().copied().collect();
-    let n = positions.len();
-    let triangles = Triangles {
-        positions,
-        object_of: vec![0; n],
-    };
-    scene
-        .with_meshes(vec![mirror_mesh(mirror, n)], triangles, AccelSettings::default())
-        .with_shading(shading)
+    with_mirrors_in(scene, quads, mirror, shading, &AccelSettings::default())
 }
 
 fn perspective(position: DVec3, look_at: DVec3) -> Camera {
@@ -85,19 +78,51 @@ fn perspective(position: DVec3, look_at: DVec3) -> Camera {
     }
 }
 
-fn render(scene: &Scene, camera: &Camera, w: u32, h: u32) -> (Frame, u64) {
-    let mut b = CpuBackend::default();
+/// Relative tolerance of a radiance against its exact answer: f64 rounding on the CPU; on the
+/// GPU, f32 rounding of the hit point, the light's offset and its square (a few ulps each,
+/// 1.2e-7 apiece) in coordinates re-based on the camera's look-at point.
+fn tolerance(backend: &str) -> f64 {
+    if backend == "cpu" {
+        1e-6
+    } else {
+        2e-5
+    }
+}
+
+/// Runs `f` with the CPU backend, then with the GPU backend if there is one.
+fn on_backends(f: impl Fn(&str, &mut dyn Backend)) {
+    f("cpu", &mut CpuBackend::default());
+    if let Some(mut g) = common::gpu() {
+        g.count_work(true);
+        f("gpu", &mut *g);
+        g.count_work(false);
+    }
+}
+
+/// The frame and the work units the backend issued for it (CPU: one loop per pass; GPU: one
+/// dispatch per pass, more where the adapter caps loops and a pass is split).
+fn render(b: &mut dyn Backend, scene: &Scene, camera: &Camera, w: u32, h: u32) -> (Frame, u64) {
     let view = View {
         camera,
         width: w,
         height: h,
     };
+    let before = b.dispatches();
     let frame = b.render(scene, view, SAMPLING).unwrap();
-    (frame, b.dispatches())
+    (frame, b.dispatches() - before)
+}
+
+/// Whether `b` may split a pass into several dispatches (an adapter that caps loops).
+fn splits(b: &dyn Backend) -> bool {
+    b.adapter().loop_cap.is_some()
 }
 
 #[test]
 fn opengl_shading_is_the_unoccluded_closed_form_and_traces_no_shadow_rays() {
+    on_backends(|name, b| opengl_closed_form(name, b));
+}
+
+fn opengl_closed_form(name: &str, b: &mut dyn Backend) {
     let camera = perspective(DVec3::new(4.0, -3.0, 2.5), DVec3::new(1.0, 0.5, 0.0));
     let (w, h) = (64, 48);
     let opengl = room().with_shading(Shading::OPENGL);
@@ -111,29 +136,44 @@ fn opengl_shading_is_the_unoccluded_closed_form_and_traces_no_shadow_rays() {
         plan.passes[..],
         [Pass::Primary { .. }, Pass::Direct { lights: 1 }]
     ));
-    let (frame, dispatches) = render(&opengl, &camera, w, h);
-    assert_eq!(dispatches, 2, "one loop per pass");
-    assert_eq!(frame.rays.shadow_total(), 0);
-    assert_eq!(frame.rays.total(), (w * h) as u64);
-    let (shadowed, _) = render(&room(), &camera, w, h);
-    let (mut floor, mut in_shadow) = (0, 0);
-    for i in 0..(w * h) as usize {
-        if frame.hit[i] != 1 {
-            continue;
-        }
-        let ray = camera.ray(i as u32 % w, i as u32 / w, w, h);
-        let p = ray.origin + ray.direction * (-ray.origin.z / ray.direction.z);
-        let d = LIGHT - p;
-        let expected = 0.6 / PI * POWER / (4.0 * PI) * d.normalize().z / d.length_squared();
+    let (frame, dispatches) = render(b, &opengl, &camera, w, h);
+    assert!(
+        dispatches == 2 || splits(b),
+        "{name}: one work unit per pass, {dispatches}"
+    );
+    assert_eq!(frame.rays.shadow_total(), 0, "{name}");
+    assert_eq!(frame.rays.total(), (w * h) as u64, "{name}");
+    let work = frame.work().expect("a frame read back counts its work");
+    assert_eq!(work.queries, (w * h) as u64, "{name}: the camera rays' queries only");
+    let (shadowed, _) = render(b, &room(), &camera, w, h);
+    let floor: Vec<(usize, f64)> = (0..(w * h) as usize)
+        .filter(|&i| frame.hit[i] == 1)
+        .map(|i| {
+            let ray = camera.ray(i as u32 % w, i as u32 / w, w, h);
+            let p = ray.origin + ray.direction * (-ray.origin.z / ray.direction.z);
+            let d = LIGHT - p;
+            (i, 0.6 / PI * POWER / (4.0 * PI) * d.normalize().z / d.length_squared())
+        })
+        .collect();
+    // The f32 hit point's rounding moves a grazing cosine by more than its own ulps: on the GPU
+    // the error is bounded at the image's scale as well (the brightest floor pixel's).
+    let brightest = floor.iter().map(|f| f.1).fold(0.0, f64::max);
+    let absolute = if name == "cpu" {
+        0.0
+    } else {
+        tolerance(name) * brightest
+    };
+    let mut in_shadow = 0;
+    for &(i, expected) in &floor {
         let got = frame.radiance[i] as f64;
         assert!(
-            (got - expected).abs() <= 1e-6 * expected,
-            "pixel {i}: {got} vs {expected}"
+            (got - expected).abs() <= tolerance(name) * expected + absolute,
+            "{name}: pixel {i}: {got} vs {expected}"
         );
-        floor += 1;
         in_shadow += (shadowed.radiance[i] == 0.0) as usize;
     }
-    assert!(floor > 1000, "{floor} floor pixels");
+    let floor = floor.len();
+    assert!(floor > 1000, "{name}: {floor} floor pixels");
     assert!(
         in_shadow > 10,
         "the sphere shadows {in_shadow} floor pixels when shadows are on"
@@ -142,6 +182,10 @@ fn opengl_shading_is_the_unoccluded_closed_form_and_traces_no_shadow_rays() {
 
 #[test]
 fn a_flat_mirror_shows_what_the_mirrored_camera_sees() {
+    on_backends(|name, b| flat_mirror(name, b));
+}
+
+fn flat_mirror(name: &str, backend: &mut dyn Backend) {
     let (w, h) = (64, 48);
     let glass = quad(0.0, [-1.5, 1.5], [0.0, 2.0]);
     let camera = perspective(DVec3::new(3.0, -0.5, 1.2), DVec3::new(0.0, 0.0, 0.8));
@@ -168,38 +212,44 @@ fn a_flat_mirror_shows_what_the_mirrored_camera_sees() {
         .passes
         .iter()
         .any(|p| matches!(p, Pass::Mirror { .. })));
-    let (a1, dispatches) = render(&whitted, &camera, w, h);
-    assert_eq!(dispatches, 3, "primary, shadow, mirror");
-    let (a0, _) = render(&diffuse_only, &camera, w, h);
-    let (b, _) = render(&room(), &mirrored, w, h);
+    let (a1, dispatches) = render(backend, &whitted, &camera, w, h);
+    assert!(
+        dispatches == 3 || splits(backend),
+        "{name}: primary, shadow, mirror; {dispatches}"
+    );
+    let (a0, _) = render(backend, &diffuse_only, &camera, w, h);
+    let (b, _) = render(backend, &room(), &mirrored, w, h);
     let mirror_id = 2;
     let (mut seen, mut mismatched, mut lit) = (0u64, 0, 0);
     for i in 0..(w * h) as usize {
         let (x, y) = (i as u32 % w, i as u32 / w);
         let reflected = (a1.radiance[i] - a0.radiance[i]) as f64;
         if a1.hit[i] != mirror_id {
-            assert_eq!(a1.radiance[i], a0.radiance[i], "pixel {i} sees no mirror");
+            assert_eq!(a1.radiance[i], a0.radiance[i], "{name}: pixel {i} sees no mirror");
             continue;
         }
         seen += 1;
         let j = (y * w + (w - 1 - x)) as usize;
         let expected = m * b.radiance[j] as f64;
         lit += (expected > 0.0) as usize;
-        if (reflected - expected).abs() > 1e-5 * expected.max(0.05) {
+        if (reflected - expected).abs() > 10.0 * tolerance(name) * expected.max(0.05) {
             mismatched += 1;
         }
     }
     assert!(
         seen > 1000 && lit > 400,
-        "{seen} mirror pixels, {lit} showing a lit surface"
+        "{name}: {seen} mirror pixels, {lit} showing a lit surface"
     );
-    assert_eq!(
-        mismatched, 0,
-        "{mismatched} of {seen} mirror pixels differ from the mirrored view"
+    // In f32 a reflected ray grazing the sphere's silhouette or the shadow's edge may be decided
+    // the other way than the mirrored camera's ray: a handful of pixels, never more.
+    let allowed = if name == "cpu" { 0 } else { seen as usize / 200 };
+    assert!(
+        mismatched <= allowed,
+        "{name}: {mismatched} of {seen} mirror pixels differ from the mirrored view"
     );
     assert_eq!(
         a1.rays.reflection, seen,
-        "one reflected ray per mirror pixel at depth 1"
+        "{name}: one reflected ray per mirror pixel at depth 1"
     );
     assert_eq!(a0.rays.reflection, 0);
     assert!(
@@ -212,6 +262,10 @@ fn a_flat_mirror_shows_what_the_mirrored_camera_sees() {
 
 #[test]
 fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_vertices() {
+    on_backends(|name, b| facing_mirrors(name, b));
+}
+
+fn facing_mirrors(name: &str, b: &mut dyn Backend) {
     let camera = Camera {
         position: DVec3::new(1.0, 0.0, 1.0),
         look_at: DVec3::new(0.0, 0.0, 1.0),
@@ -231,7 +285,7 @@ fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_
             1.0,
             Shading::whitted(depth),
         );
-        let (f, _) = render(&perfect, &camera, w, h);
+        let (f, _) = render(b, &perfect, &camera, w, h);
         let pixels = (w * h) as u64;
         let view = View {
             camera: &camera,
@@ -243,8 +297,12 @@ fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_
             matches!(plan.passes.last(), Some(Pass::Mirror { max_rays, .. }) if *max_rays == pixels * depth as u64 * 2)
         );
         assert!(f.rays.total() <= plan.max_rays());
-        assert_eq!(f.rays.reflection, depth as u64 * pixels);
-        assert_eq!(f.rays.shadow_total(), pixels, "only the camera's hits are shaded");
+        assert_eq!(f.rays.reflection, depth as u64 * pixels, "{name}");
+        assert_eq!(
+            f.rays.shadow_total(),
+            pixels,
+            "{name}: only the camera's hits are shaded"
+        );
         assert!(
             f.radiance.iter().all(|&r| r == 0.0),
             "perfect mirrors with nothing diffuse in sight are black"
@@ -256,8 +314,8 @@ fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_
             0.5,
             Shading::whitted(depth),
         );
-        let (g, _) = render(&half, &camera, w, h);
-        assert_eq!(g.rays.shadow_total(), (depth as u64 + 1) * pixels);
+        let (g, _) = render(b, &half, &camera, w, h);
+        assert_eq!(g.rays.shadow_total(), (depth as u64 + 1) * pixels, "{name}");
         // The centre pixel's chain bounces straight between x = 0 and x = 2 at one height, and
         // vertex k adds 0.5^k x (1 - 0.5) x albedo / pi x E(vertex k).
         let p0 = camera.ray(w / 2, h / 2, w, h);
@@ -273,9 +331,15 @@ fn facing_mirrors_trace_exactly_the_depth_asked_and_shadow_rays_only_at_diffuse_
             at.x = 2.0 - at.x;
         }
         let got = g.radiance[(h / 2 * w + w / 2) as usize] as f64;
+        // Each bounce adds the f32 rounding of one more vertex on the GPU.
+        let tol = if name == "cpu" {
+            1e-5
+        } else {
+            tolerance(name) * (depth + 1) as f64
+        };
         assert!(
-            (got - expected).abs() <= 1e-5 * expected,
-            "depth {depth}: {got} vs {expected}"
+            (got - expected).abs() <= tol * expected,
+            "{name}: depth {depth}: {got} vs {expected}"
         );
     }
 }
@@ -329,25 +393,116 @@ fn scene_files_declare_shading_and_mirror_weights_with_located_errors() {
     assert!(e.contains("reflections"), "{e}");
 }
 
+/// The GPU's frames against the f64 CPU's for both shadings, a mirror material without
+/// reflections and shadowed Whitted chains, with every structure: the same objects seen, radiance
+/// within f32 rounding, the same rays, and work counted, except on the few pixels where a ray
+/// grazes an edge or a silhouette and f32 decides it the other way.
 #[test]
-fn the_gpu_backend_refuses_passes_it_has_no_kernel_for() {
+fn the_gpu_renders_both_shadings_as_the_cpu_does_with_every_structure() {
     let Some(mut gpu) = common::gpu() else { return };
-    let camera = perspective(DVec3::new(3.0, -0.5, 1.2), DVec3::new(0.0, 0.0, 0.8));
+    gpu.count_work(true);
+    let camera = perspective(DVec3::new(3.0, -2.5, 1.6), DVec3::new(0.0, 0.0, 0.7));
+    let (w, h) = (48, 36);
     let view = View {
         camera: &camera,
-        width: 8,
-        height: 8,
+        width: w,
+        height: h,
     };
-    let e = gpu
-        .render(&room().with_shading(Shading::OPENGL), view, SAMPLING)
-        .unwrap_err();
-    assert!(format!("{e:#}").contains("direct pass"), "{e:#}");
-    let whitted = with_mirrors(room(), &[quad(0.0, [-1.5, 1.5], [0.0, 2.0])], 0.5, Shading::whitted(2));
-    let e = gpu.render(&whitted, view, SAMPLING).unwrap_err();
-    assert!(format!("{e:#}").contains("mirror pass"), "{e:#}");
-    let unreflected = with_mirrors(room(), &[quad(0.0, [-1.5, 1.5], [0.0, 2.0])], 0.5, Shading::default());
-    let e = gpu.render(&unreflected, view, SAMPLING).unwrap_err();
-    assert!(format!("{e:#}").contains("mirror materials"), "{e:#}");
+    let glass = [quad(0.0, [-1.5, 1.5], [0.0, 2.0]), quad(2.8, [-1.5, 0.5], [0.2, 1.8])];
+    for r in REGISTRY.iter().filter(|r| r.gpu) {
+        let settings = AccelSettings::named(r.name).unwrap();
+        for (what, scene) in [
+            (
+                "opengl",
+                with_mirrors_in(room(), &glass, 0.0, Shading::OPENGL, &settings),
+            ),
+            (
+                "opengl mirrors",
+                with_mirrors_in(
+                    room(),
+                    &glass,
+                    0.6,
+                    Shading {
+                        shadows: false,
+                        mirror_depth: 3,
+                    },
+                    &settings,
+                ),
+            ),
+            (
+                "mirror material",
+                with_mirrors_in(room(), &glass, 0.5, Shading::default(), &settings),
+            ),
+            (
+                "whitted",
+                with_mirrors_in(room(), &glass, 0.6, Shading::whitted(3), &settings),
+            ),
+        ] {
+            let c = CpuBackend::default().render(&scene, view, SAMPLING).unwrap();
+            let g = gpu.render(&scene, view, SAMPLING).unwrap();
+            let label = format!("{} {what}", r.name);
+            let hits = c.hit.iter().zip(&g.hit).filter(|(a, b)| a != b).count();
+            let off = c
+                .radiance
+                .iter()
+                .zip(&g.radiance)
+                .filter(|(a, b)| ((**a - **b) as f64).abs() > 1e-4 * (**a as f64).max(1e-3))
+                .count();
+            let pixels = (w * h) as usize;
+            eprintln!("{label}: {hits} hits and {off} radiances of {pixels} differ");
+            assert!(
+                hits <= pixels / 500 && off <= pixels / 100,
+                "{label}: {hits} hits, {off} radiances differ"
+            );
+            assert_eq!(g.rays.primary, c.rays.primary, "{label}");
+            let near = |a: u64, b: u64| a.abs_diff(b) <= (a / 100).max(2);
+            assert!(
+                near(g.rays.reflection, c.rays.reflection),
+                "{label}: {:?} vs {:?}",
+                g.rays,
+                c.rays
+            );
+            assert!(
+                near(g.rays.shadow_total(), c.rays.shadow_total()),
+                "{label}: {:?} vs {:?}",
+                g.rays,
+                c.rays
+            );
+            let (gw, cw) = (g.work().expect("GPU work counted"), c.work().unwrap());
+            assert!(near(gw.queries, cw.queries), "{label}: {gw:?} vs {cw:?}");
+            assert!(
+                gw.primitives > 0 && (r.name == "brute" || gw.nodes > 0),
+                "{label}: {gw:?}"
+            );
+            if what == "opengl" {
+                assert_eq!(
+                    g.rays.total(),
+                    g.rays.primary,
+                    "{label}: OpenGL-like shading traces camera rays only"
+                );
+            }
+        }
+    }
+    gpu.count_work(false);
+}
+
+/// [`with_mirrors`] with the mirror mesh in structure `settings`.
+fn with_mirrors_in(
+    scene: Scene,
+    quads: &[[[DVec3; 3]; 2]],
+    mirror: f64,
+    shading: Shading,
+    settings: &AccelSettings,
+) -> Scene {
+    let positions: Vec<[DVec3; 3]> = quads.iter().flatten().copied().collect();
+    let n = positions.len();
+    let triangles = Triangles {
+        positions,
+        object_of: vec![0; n],
+    };
+    scene
+        .with_meshes(vec![mirror_mesh(mirror, n)], triangles, settings.clone())
+        .with_shading(shading)
 }
 
 use crate::common;

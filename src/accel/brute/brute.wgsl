@@ -8,6 +8,7 @@ fn accel_closest(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> AccelHit {
     let n = arrayLength(&brute_tris);
     var i = 0u;
     for (; i < n; i++) {
+        work_prims += 1u;
         let tri = brute_tris[i];
         let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
         if (i != skip && t > 0.0 && t < best.t) {
@@ -23,6 +24,7 @@ fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     var found = false;
     var i = 0u;
     for (; i < n && !found; i++) {
+        work_prims += 1u;
         let tri = brute_tris[i];
         let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
         found = i != skip && t > 0.0 && t < tmax;

@@ -57,13 +57,17 @@ fn bvh_closest(o: vec3<f32>, d: vec3<f32>, tmax_in: f32, skip: u32) -> MeshHit {
     stack[0] = 0u;
     while (sp > 0u) {
         sp -= 1u;
+        work_nodes += 1u;
         let n = nodes[stack[sp]];
         let entered = slab(o, inv_d, best.t, n) != BIG;
         if (entered && n.prim_count > 0u) {
             var i = n.first_index;
             for (; i < n.first_index + n.prim_count; i++) {
+                work_prims += 1u;
                 let t = triangle_t(o, d, tris[i].v0, tris[i].e1, tris[i].e2);
-                if (t > 0.0 && t < best.t && tris[i].index != skip) {
+                // Equal distances go to the lower input index, as every other structure's.
+                let tie = t == best.t && best.slot != NO_HIT && tris[i].index < tris[best.slot].index;
+                if (t > 0.0 && (t < best.t || tie) && tris[i].index != skip) {
                     best = MeshHit(t, i);
                 }
             }
@@ -94,11 +98,13 @@ fn accel_any(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32) -> bool {
     var found = false;
     while (sp > 0u && !found) {
         sp -= 1u;
+        work_nodes += 1u;
         let n = nodes[stack[sp]];
         let entered = slab(o, inv_d, tmax, n) != BIG;
         if (entered && n.prim_count > 0u) {
             var i = n.first_index;
             for (; i < n.first_index + n.prim_count; i++) {
+                work_prims += 1u;
                 let t = triangle_t(o, d, tris[i].v0, tris[i].e1, tris[i].e2);
                 found = found || (t > 0.0 && t < tmax && tris[i].index != skip);
             }

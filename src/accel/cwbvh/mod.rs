@@ -10,10 +10,15 @@
 //! by a few f32 ulps of the scene's size before quantisation, as the BVH2's are, so the f32 walk
 //! never culls a hit the f64 test finds.
 //!
-//! CPU only: there is no WGSL traversal of this layout here, and [`Accelerator::gpu`] refuses
-//! with an error naming the structure (the GPU backend asks for it before compiling anything).
+//! On the GPU the same nodes are walked by `cwbvh.wgsl` ([`gpu`]): a stack walk that tests a
+//! node's eight children at once and visits inner children near to far, with f32 triangle
+//! tests.
 
+mod gpu;
 pub mod ray;
+
+/// The CWBVH's WGSL: `accel_closest` and `accel_any` over its node and triangle buffers.
+pub const WGSL: &str = include_str!("cwbvh.wgsl");
 
 use super::bvh::{centre, relative, widened, Preset};
 use super::{intersect, work, Accelerator, BuildStats, GpuStructure, TriHit};
@@ -210,10 +215,6 @@ impl Cwbvh {
     }
 }
 
-/// Why the compressed wide BVH has no GPU form.
-const NO_GPU: &str = "the acceleration structure `cwbvh` has no GPU traversal (obvhs' compressed wide BVH is \
-                      walked on the CPU only): render it with the CPU backend (--backend cpu)";
-
 impl Accelerator for Cwbvh {
     fn name(&self) -> &'static str {
         "cwbvh"
@@ -232,13 +233,13 @@ impl Accelerator for Cwbvh {
         BuildStats {
             parameters: self.preset.name().to_string(),
             build_time: self.build_time,
-            gpu_bytes: 0,
+            gpu_bytes: gpu::bytes(self),
             memory_bytes: self.bytes() as u64,
             triangles: n,
             description: format!(
-                "CWBVH (obvhs, preset `{}`, obvhs' traversal, f64 triangle tests): {} nodes of 8 \
-                 children, {:.2} primitive slots per triangle, {:.1} bytes per triangle, built in \
-                 {:.1} ms; CPU only",
+                "CWBVH (obvhs, preset `{}`, obvhs' traversal, f64 triangle tests; a stack walk of \
+                 the same nodes on the GPU): {} nodes of 8 children, {:.2} primitive slots per \
+                 triangle, {:.1} bytes per triangle, built in {:.1} ms",
                 self.preset.name(),
                 self.tree.nodes.len(),
                 self.tree.primitive_indices.len() as f64 / n.max(1) as f64,
@@ -248,12 +249,12 @@ impl Accelerator for Cwbvh {
         }
     }
 
-    fn gpu(&self, _frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
-        anyhow::bail!("{}", NO_GPU)
+    fn gpu(&self, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
+        gpu::structure(self, frame)
     }
 
     fn gpu_refusal(&self) -> Option<String> {
-        Some(NO_GPU.into())
+        gpu::too_deep(gpu::depth(&self.tree))
     }
 
     fn update(

@@ -81,6 +81,7 @@ fn kd_walk(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32, any: bool) -> Accel
         var n = kd_nodes[e.node];
         var overflow = false;
         while ((n.y & 3u) != 3u && !overflow) {
+            work_nodes += 1u;
             let axis = n.y & 3u;
             let left = n.y >> 2u;
             let split = bitcast<f32>(n.x);
@@ -117,11 +118,13 @@ fn kd_walk(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32, any: bool) -> Accel
         }
         cut_short = cut_short || overflow;
         if (!overflow) {
+            work_nodes += 1u;
             let first = n.x;
             let count = n.y >> 2u;
             var i = 0u;
             for (; i < count && !found; i++) {
                 let id = kd_items[first + i];
+                work_prims += u32(id != skip);
                 let tri = kd_tris[id];
                 let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
                 if (id != skip && t > 0.0 && t < tmax && (t < best.t || (t == best.t && id < best.triangle))) {

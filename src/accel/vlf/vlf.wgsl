@@ -150,6 +150,7 @@ struct VlfLeaf {
 
 fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, best_in: AccelHit, any: bool) -> AccelHit {
     var best = best_in;
+    work_nodes += 1u;
     let mask = select(0xffffu, 0xffffffffu, leaf.wide);
     var i = leaf.a;
     for (; i < leaf.b && !(any && best.triangle != NO_HIT); i++) {
@@ -157,6 +158,7 @@ fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, be
         if (id == mask || id == skip) {
             continue;
         }
+        work_prims += 1u;
         let tri = vlf_tris[id];
         let t = triangle_t(o, d, tri.v0, tri.e1, tri.e2);
         if (t > 0.0 && (t < best.t || (t == best.t && id < best.triangle && best.triangle != NO_HIT))) {
@@ -203,6 +205,7 @@ fn vlf_leaf_exit(at: VlfIds, l: u32, up: bool, v: u32, e: f32) -> f32 {
 
 // One tile of one layer over the ray's [ta, tb].
 fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, d: vec3<f32>, skip: u32, best_in: AccelHit, any: bool) -> AccelHit {
+    work_nodes += 1u;
     let n = vlf_head[VLF_H_TILES];
     let dirs = vlf_head[VLF_H_DIRS];
     let chunk = select(vlf_head[VLF_H_ROWS + 9u * dirs + ray.k], 0u, layer == 1u);

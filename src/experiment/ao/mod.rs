@@ -105,7 +105,18 @@ impl Declaration for AoSpec {
         Ok(out)
     }
 
+    /// On the GPU when asked (`backend = "gpu"` or `--backend gpu`); the f64 CPU backend, where
+    /// every structure answers exactly, by default.
+    fn gpu(&self) -> bool {
+        true
+    }
+
+    fn backend(&self) -> crate::render::BackendChoice {
+        crate::render::BackendChoice::Cpu
+    }
+
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<MeshOutcome> {
+        backend.count_work(true);
         run_mesh(self, &self.meshes[unit.at[0]], backend, progress)
     }
 
@@ -115,9 +126,9 @@ impl Declaration for AoSpec {
             rows.extend(o.rows);
             tuning.extend(o.tuning);
         }
-        let threads = rayon::current_num_threads();
+        let device = run.backend.adapter().describe();
         let seconds = run.started.elapsed().as_secs_f64();
-        report::write_ao(self, (&rows, &tuning), threads, seconds, run.out)?;
+        report::write_ao(self, (&rows, &tuning), &device, seconds, run.out)?;
         tracing::info!("{} rows", rows.len());
         let mut details = toml::Table::new();
         details.insert("rows".into(), (rows.len() as i64).into());

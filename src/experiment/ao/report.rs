@@ -212,7 +212,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
 pub fn write_ao(
     spec: &AoSpec,
     (rows, tuning): (&[AoRow], &[TuningRow]),
-    threads: usize,
+    device: &str,
     seconds: f64,
     outputs: &Outputs,
 ) -> anyhow::Result<()> {
@@ -331,7 +331,7 @@ pub fn write_ao(
         &names,
         &groups,
     )?;
-    let report = report(spec, rows, threads, seconds);
+    let report = report(spec, rows, device, seconds);
     write_atomic(&out("report.md")?, report.as_bytes())?;
     page::write(
         outputs.dir(),
@@ -381,7 +381,7 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
         .collect()
 }
 
-fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String {
+fn report(spec: &AoSpec, rows: &[AoRow], device: &str, seconds: f64) -> String {
     let schedule = spec.header.schedule;
     let tuned: Vec<String> = spec
         .structures
@@ -400,7 +400,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], threads: usize, seconds: f64) -> String
         spec.name
     );
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each structure is first tuned per mesh, as the paper tuned both methods ({}; each candidate timed in {} interleaved rounds at {}x{}, the fastest median kept, `tuning.csv`); then the kept settings render one untimed frame, which gives the image and the work counts, and every structure of a mesh is timed in {} interleaved rounds (order seed {}). Rays/s count camera and AO rays. {RULE}\n\n",
+        "Experiment `{}`, {:.0} s on {device}. Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each structure is first tuned per mesh, as the paper tuned both methods ({}; each candidate timed in {} interleaved rounds at {}x{}, the fastest median kept, `tuning.csv`); then the kept settings render one untimed frame, which gives the image and the work counts, and every structure of a mesh is timed in {} interleaved rounds (order seed {}). Rays/s count camera and AO rays. {RULE}\n\n",
         spec.path.display(),
         seconds,
         spec.width,

@@ -1,5 +1,6 @@
 //! Runs an ambient-occlusion experiment on the f64 CPU backend, where every structure answers
-//! exactly (the GPU's f32 walks may decide a grazing ray differently): per mesh, each structure
+//! exactly, or on the GPU where asked (`backend = "gpu"`: every structure's f32 walk runs the same
+//! triangle test, its direction-major issue one dispatch per direction): per mesh, each structure
 //! is tuned over its candidates (timed at a small size in interleaved rounds), built at the
 //! settings kept, and renders the AO image once (untimed; its rays and work counted; every
 //! structure's image must equal the first's bit for bit); then the mesh's structures are timed

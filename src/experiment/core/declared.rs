@@ -21,7 +21,7 @@ use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
 use crate::experiment::{Accepts, Experiment, Finished, RunContext};
 use crate::fingerprint::{build_id, fnv1a};
-use crate::render::{AdapterInfo, Backend};
+use crate::render::{AdapterInfo, Backend, BackendChoice};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -54,6 +54,11 @@ pub trait Declaration: Clone {
     /// Whether it runs on the GPU (otherwise it times the f64 CPU backend and refuses `gpu`).
     fn gpu(&self) -> bool {
         false
+    }
+
+    /// The backend where neither the file nor the command line names one.
+    fn backend(&self) -> BackendChoice {
+        BackendChoice::Auto
     }
 
     /// What of it the GPU cannot run, at its file and key ([`Experiment::gpu_gap`]).
@@ -493,7 +498,10 @@ impl<D: Declaration> Experiment for Declared<D> {
     }
 
     fn accepts(&self) -> Accepts {
-        Accepts { gpu: self.0.gpu() }
+        Accepts {
+            gpu: self.0.gpu(),
+            backend: self.0.backend(),
+        }
     }
 
     fn inputs(&self) -> Vec<PathBuf> {

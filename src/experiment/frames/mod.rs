@@ -138,7 +138,18 @@ impl Declaration for FramesSpec {
         Ok(out)
     }
 
+    /// On the GPU when asked (`backend = "gpu"` or `--backend gpu`); the f64 CPU backend, where
+    /// every structure answers exactly, by default.
+    fn gpu(&self) -> bool {
+        true
+    }
+
+    fn backend(&self) -> crate::render::BackendChoice {
+        crate::render::BackendChoice::Cpu
+    }
+
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<FramesOutcome> {
+        backend.count_work(true);
         run_block(self, &Block::of(&unit.at), backend, progress)
     }
 
@@ -151,11 +162,11 @@ impl Declaration for FramesSpec {
             outcome.scenes.extend(o.scenes);
             outcome.tuning.extend(o.tuning);
         }
-        let threads = rayon::current_num_threads();
+        let device = run.backend.adapter().describe();
         report::write_frames(
             self,
             &outcome,
-            threads,
+            &device,
             run.started.elapsed().as_secs_f64(),
             run.out.dir(),
         )?;

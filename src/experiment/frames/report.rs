@@ -100,7 +100,7 @@ struct TuningCost {
 pub fn write_frames(
     spec: &FramesSpec,
     outcome: &FramesOutcome,
-    threads: usize,
+    device: &str,
     seconds: f64,
     out: &Path,
 ) -> anyhow::Result<()> {
@@ -328,7 +328,7 @@ pub fn write_frames(
     for g in &galleries {
         write_shots(out, g)?;
     }
-    let report = report(spec, outcome, threads, seconds);
+    let report = report(spec, outcome, device, seconds);
     write_atomic(&out.join("report.md"), report.as_bytes())?;
     page::write(
         out,
@@ -522,11 +522,11 @@ fn tuning_paragraph(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
     )
 }
 
-fn report(spec: &FramesSpec, outcome: &FramesOutcome, threads: usize, seconds: f64) -> String {
+fn report(spec: &FramesSpec, outcome: &FramesOutcome, device: &str, seconds: f64) -> String {
     let rows = &outcome.frames;
     let mut md = format!("# {}: frame times per acceleration structure\n\n", spec.name);
     md += &format!(
-        "Experiment `{}`, {:.0} s on the f64 CPU backend ({threads} threads). Scenes: {}. {} frames per viewpoint ({}; {}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (counterbalanced seeded orders of the structures; order seed {}), the median kept (`frames.csv`: every frame with the interval of its renders: their range for three, a 75 % interval), and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
+        "Experiment `{}`, {:.0} s on {device}. Scenes: {}. {} frames per viewpoint ({}; {}) at {}x{}, shadings {}. Every frame is rendered by every structure in {} interleaved rounds (counterbalanced seeded orders of the structures; order seed {}), the median kept (`frames.csv`: every frame with the interval of its renders: their range for three, a 75 % interval), and compared pixel for pixel with the first structure's; before each path every structure renders its first frame {} time(s) untimed. {RULE}{}\n\n",
         spec.path.display(),
         seconds,
         outcome.scenes.join("; "),

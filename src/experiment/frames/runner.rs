@@ -1,7 +1,8 @@
 //! Runs a frame-time experiment on the f64 CPU backend, where every structure answers exactly
-//! and frames can be compared pixel for pixel: per scene, each structure is built once (its
-//! build time and memory recorded); then, for each shading and viewpoint, every frame of the
-//! path is rendered by every structure in the schedule's interleaved rounds (counterbalanced
+//! and frames can be compared pixel for pixel, or on the GPU where asked (every structure's f32
+//! walk runs the same triangle test, so frames compare there too): per scene, each structure is
+//! built once (its build time and memory recorded); then, for each shading and viewpoint, every
+//! frame of the path is rendered by every structure in the schedule's interleaved rounds (counterbalanced
 //! seeded orders of the structures, so a change of machine load falls on all alike; the median
 //! of the rounds is kept, with the frame's rays and work), and each structure's frame is compared
 //! with the first structure's. With a `[motion]`, one part moves by a step before each frame and

@@ -1,5 +1,6 @@
 //! The frame-time experiment file (`kind = "frames"`): a generated scene walked along its camera
-//! path and rendered by each acceleration structure, frame by frame, on the f64 CPU backend.
+//! path and rendered by each acceleration structure, frame by frame, on the f64 CPU backend (or
+//! the GPU, `backend = "gpu"`).
 //! One kind serves the visibility-field paper's three frame-time figures: scaling with scene
 //! size (Fig. 5: random triangles at several counts, two viewpoints), the classroom walkthrough
 //! (Fig. 6: OpenGL-like and Whitted shading) and dynamic scenes (a `[motion]` table: one part

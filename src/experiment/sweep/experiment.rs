@@ -30,7 +30,10 @@ impl Experiment for Spec {
     }
 
     fn accepts(&self) -> Accepts {
-        Accepts { gpu: true }
+        Accepts {
+            gpu: true,
+            backend: crate::render::BackendChoice::Auto,
+        }
     }
 
     fn inputs(&self) -> Vec<PathBuf> {

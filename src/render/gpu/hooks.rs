@@ -21,6 +21,11 @@ pub struct ProbeHit {
     pub any: bool,
 }
 
+/// The hooks run outside any render plan.
+fn no_passes() -> crate::render::RenderPlan {
+    crate::render::RenderPlan { passes: vec![] }
+}
+
 fn dummy_camera() -> crate::scene::camera::Camera {
     use glam::DVec3;
     crate::scene::camera::Camera {
@@ -131,7 +136,7 @@ impl GpuBackend {
         if let Some(scheme) = scheme {
             packed.tables = crate::sampling::tables::pack(&[(scheme, n)]);
         }
-        let r = self.resources(&packed, View { height: 2, ..view }, 0)?;
+        let r = self.resources(&packed, View { height: 2, ..view }, &no_passes(), 0)?;
         self.run_hook(false, &r, &[], n.div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, n as u64 * 8)?);
         Ok(raw.chunks(2).map(|c| [c[0], c[1]]).collect())
@@ -167,7 +172,7 @@ impl GpuBackend {
                 ]
             })
             .collect();
-        let r = self.resources(&packed, view, 3 * rays.len() as u64)?;
+        let r = self.resources(&packed, view, &no_passes(), 3 * rays.len() as u64)?;
         self.run_hook(true, &r, &probes, (rays.len() as u32).div_ceil(64))?;
         let raw: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.visibility, rays.len() as u64 * 12)?);
         Ok(raw

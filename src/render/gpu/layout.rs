@@ -42,7 +42,13 @@ pub struct Params {
     pub ao_max_distance: f32,
     /// Index of the frame in a temporal sequence ([`Sampling::frame`]).
     pub frame: u32,
-    pub _pad: [u32; 3],
+    /// 1 where lights are tested for occlusion; 0 for OpenGL-like shading (the plan's `direct`
+    /// pass runs the shadow kernel with every target visible).
+    pub shadows: u32,
+    /// Most mirror bounces after the camera ray ([`crate::scene::Shading::mirror_depth`]).
+    pub mirror_depth: u32,
+    /// 1 where the kernels add their work to the counters (untimed frames only).
+    pub stats: u32,
 }
 
 /// How the AO kernel makes and weights its directions (`AO_*` in render.wgsl).
@@ -176,6 +182,12 @@ pub struct Packed {
     pub accel: Option<(&'static str, GpuStructure)>,
     /// The tables the per-pixel schemes read ([`crate::sampling::tables::pack`]).
     pub tables: Vec<u32>,
+    /// Per object id, its mirror weight (0 for analytic shapes).
+    pub mirrors: Vec<f32>,
+    /// Whether the AO rays are issued direction-major ([`crate::accel::Issue::Bundled`]): one
+    /// dispatch per direction, every receiver's ray along it, so a dispatch walks one
+    /// direction's part of a structure.
+    pub ao_direction_major: bool,
 }
 
 /// Packs a scene, view and sampling choice into GPU structs; fails where the scene's
@@ -211,7 +223,9 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         ao_scheme: 0,
         ao_max_distance: f32::INFINITY,
         frame: sampling.frame,
-        _pad: [0; 3],
+        shadows: scene.shading.shadows as u32,
+        mirror_depth: scene.shading.mirror_depth,
+        stats: 0,
     };
     let mut ao_dirs = Vec::new();
     if let Some(ao) = &scene.ambient {
@@ -347,5 +361,10 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         ao_dirs,
         accel,
         tables: crate::sampling::tables::pack(&uses),
+        mirrors: scene.shapes.iter().map(|s| s.mirror() as f32).collect(),
+        ao_direction_major: scene
+            .ambient
+            .as_ref()
+            .is_some_and(|a| a.issue == crate::accel::Issue::Bundled),
     })
 }

@@ -2,10 +2,13 @@
 //!
 //! Setup (adapter, device with the adapter's real limits, pipelines, the loop-cap probe) happens
 //! once in [`GpuBackend::new`]; the scene's geometry is uploaded once and stays resident
-//! ([`resources`]); each frame runs the plan's passes (primary, then one shadow pass per light
-//! and the ambient-occlusion pass where the scene asks, each in one dispatch or, on adapters
-//! that cap loop iterations, several) with a timestamp pair
-//! around each pass when the adapter supports timestamp queries, and reads the outputs back.
+//! ([`resources`]); each frame runs the plan's passes (primary; one shadow pass per light, or
+//! the direct pass over every light where the scene has no shadows; Whitted's mirror chains and
+//! the ambient-occlusion pass where the scene asks; each in one dispatch or, on adapters that
+//! cap loop iterations, several) with a timestamp pair around each pass when the adapter
+//! supports timestamp queries, and reads the outputs back. Where switched on
+//! ([`Backend::count_work`]), frames read back count their work (queries, nodes, primitive tests)
+//! in atomics the kernels add to once per invocation; timed frames never count.
 
 mod denoise;
 #[cfg(feature = "test-hooks")]
@@ -34,10 +37,16 @@ pub use pipelines::scheme_prelude;
 pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; the count of
-/// invocations whose loops were cut short; ambient-occlusion rays as (low, high) words.
-pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 3;
+/// invocations whose loops were cut short; then as (low, high) words ambient-occlusion rays,
+/// reflection rays, and the work of frames that count it (queries, nodes, primitive tests).
+pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 11;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
+
+/// The 64-bit counter at words (`slot`, `slot + 1`) of a counters read-back.
+fn wide(counters: &[u32], slot: usize) -> u64 {
+    counters[slot] as u64 | ((counters[slot + 1] as u64) << 32)
+}
 
 /// What to install when no adapter is found, for the error message.
 pub const NO_ADAPTER_HELP: &str = "no GPU adapter found; on Debian install the software Vulkan driver with \
@@ -63,6 +72,8 @@ pub struct GpuBackend {
     dispatches: std::cell::Cell<u64>,
     /// The reconstruction filters' pipelines, compiled on first use.
     denoise: Option<denoise::Pipelines>,
+    /// Whether frames read back count their work ([`Backend::count_work`]).
+    count_work: bool,
 }
 
 impl GpuBackend {
@@ -125,6 +136,7 @@ impl GpuBackend {
             static_uploads: 0,
             dispatches: Default::default(),
             denoise: None,
+            count_work: false,
         })
     }
 
@@ -162,6 +174,10 @@ impl GpuBackend {
                 (view.pixels() * packed.lights.len().max(1)) as u64 * 4,
             ),
             (
+                "light sums buffer",
+                (view.pixels() * packed.lights.len().max(1)) as u64 * 4,
+            ),
+            (
                 "mesh triangle buffer",
                 std::mem::size_of_val(packed.mesh_tris.as_slice()) as u64,
             ),
@@ -190,6 +206,7 @@ impl GpuBackend {
         let p = self.pipelines.get(&self.device, &self.layouts, r.accel, CUT_SHORT_SLOT);
         encoder.clear_buffer(&r.counters, 0, None);
         encoder.clear_buffer(&r.visibility, 0, None);
+        encoder.clear_buffer(&r.light_sums, 0, None);
         encoder.clear_buffer(&r.ambient, 0, None);
         let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
         for (index, pass) in plan.passes.iter().enumerate() {
@@ -202,20 +219,23 @@ impl GpuBackend {
                 label: None,
                 timestamp_writes,
             });
-            // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk.
-            let (pipeline, chunks) = match pass {
-                Pass::Primary { .. } => (&p.primary, &r.passes[0][..1]),
-                Pass::Shadow { light, .. } => (&p.shadow, &r.passes[*light][..]),
-                Pass::Ambient { .. } => (&p.ambient, &r.ambient_passes[..]),
-                Pass::Direct { .. } | Pass::Mirror { .. } => unreachable!("refused before encoding"),
+            // The primary and mirror passes ignore group 1; a shadow pass runs one dispatch per
+            // sample chunk; the direct pass runs the shadow kernel (without occlusion tests) over
+            // every light's chunks.
+            let (pipeline, chunks): (_, Vec<&wgpu::BindGroup>) = match pass {
+                Pass::Primary { .. } => (&p.primary, vec![&r.passes[0][0]]),
+                Pass::Shadow { light, .. } => (&p.shadow, r.passes[*light].iter().collect()),
+                Pass::Direct { .. } => (&p.shadow, r.passes.iter().flatten().collect()),
+                Pass::Mirror { .. } => (&p.mirror, vec![&r.passes[0][0]]),
+                Pass::Ambient { .. } => (&p.ambient, r.ambient_passes.iter().collect()),
             };
             cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
             if r.accel != NO_ACCEL {
                 cp.set_bind_group(2, &r.accel_group, &[]);
             }
-            for chunk in chunks {
-                cp.set_bind_group(1, chunk, &[]);
+            for chunk in &chunks {
+                cp.set_bind_group(1, *chunk, &[]);
                 cp.dispatch_workgroups(groups.0, groups.1, 1);
             }
             self.dispatches.set(self.dispatches.get() + chunks.len() as u64);
@@ -300,61 +320,6 @@ impl GpuBackend {
     }
 }
 
-/// A part of a scene the GPU kernels cannot render: the pass (or material) and the scene-file
-/// key that asks for it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct GpuGap {
-    /// The pass or material, in the words of the render plan.
-    pub what: &'static str,
-    /// The scene-file key that asks for it.
-    pub key: String,
-}
-
-impl std::fmt::Display for GpuGap {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "key `{}` asks for {}, which the GPU backend has no kernel for",
-            self.key, self.what
-        )
-    }
-}
-
-/// What of `scene` the GPU has no kernel for, if anything. The GPU kernels cover the primary,
-/// shadow and ambient passes over diffuse materials; OpenGL-like direct light (the `direct`
-/// pass, where `[shading] shadows = false`), Whitted's mirror chains (the `mirror` pass) and
-/// mirror materials (whose diffuse part is scaled by 1 - mirror) are the CPU backend's only. The
-/// conditions are [`RenderPlan::new`]'s, read from the scene alone, so a run can choose its
-/// backend before any frame.
-pub fn gpu_gap(scene: &crate::scene::Scene) -> Option<GpuGap> {
-    if !scene.shading.shadows && !scene.lights.is_empty() {
-        return Some(GpuGap {
-            what: "the direct pass (OpenGL-like shading without shadow rays)",
-            key: "shading.shadows".into(),
-        });
-    }
-    let mirror = scene.meshes().position(|m| m.mirror > 0.0)?;
-    Some(if scene.shading.mirror_depth > 0 {
-        GpuGap {
-            what: "the mirror pass (Whitted's mirror chains)",
-            key: "shading.mirror_depth".into(),
-        }
-    } else {
-        GpuGap {
-            what: "mirror materials",
-            key: format!("meshes[{mirror}].mirror"),
-        }
-    })
-}
-
-/// Refuses a scene the GPU kernels cannot render ([`gpu_gap`]), never skipping what it asks for.
-fn refuse_unsupported(scene: &crate::scene::Scene) -> anyhow::Result<()> {
-    match gpu_gap(scene) {
-        Some(gap) => bail!("{gap}; render this scene with backend = \"cpu\""),
-        None => Ok(()),
-    }
-}
-
 impl Backend for GpuBackend {
     fn adapter(&self) -> &AdapterInfo {
         &self.info
@@ -372,14 +337,18 @@ impl Backend for GpuBackend {
         self.dispatches.get()
     }
 
+    fn count_work(&mut self, on: bool) {
+        self.count_work = on;
+    }
+
     fn render(&mut self, scene: &crate::scene::Scene, view: View, sampling: Sampling) -> anyhow::Result<Frame> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(scene)?;
-        let packed = pack(scene, view, sampling)?;
+        let mut packed = pack(scene, view, sampling)?;
+        packed.params.stats = self.count_work as u32;
         self.check_limits(&packed, view)?;
         let lights = scene.lights.len();
         let (r, counters) = loop {
-            let r = self.resources(&packed, view, 0)?;
+            let r = self.resources(&packed, view, &plan, 0)?;
             let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, &r, view, &plan);
@@ -401,15 +370,15 @@ impl Backend for GpuBackend {
             primary: pixels as u64,
             shadow: [0; MAX_LIGHTS],
             ambient: 0,
-            reflection: 0,
+            reflection: wide(&counters, CUT_SHORT_SLOT + 3),
         };
         for (i, s) in rays.shadow.iter_mut().enumerate() {
-            *s = counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
+            *s = wide(&counters, 2 * i);
         }
         let hit: Vec<u32> = hits.chunks((HIT_BYTES / 4) as usize).map(|h| h[3]).collect();
         let ambient = match scene.ambient {
             Some(_) => {
-                rays.ambient = counters[CUT_SHORT_SLOT + 1] as u64 | ((counters[CUT_SHORT_SLOT + 2] as u64) << 32);
+                rays.ambient = wide(&counters, CUT_SHORT_SLOT + 1);
                 let sums: Vec<f32> = bytemuck::pod_collect_to_vec(&self.read(&r.ambient, pixels as u64 * 8)?);
                 Some(
                     sums.chunks(2)
@@ -432,8 +401,12 @@ impl Backend for GpuBackend {
             hit,
             ambient,
             rays,
-            work: crate::accel::work::Work::ZERO,
-            counted: false,
+            work: crate::accel::work::Work {
+                queries: wide(&counters, CUT_SHORT_SLOT + 5),
+                nodes: wide(&counters, CUT_SHORT_SLOT + 7),
+                primitives: wide(&counters, CUT_SHORT_SLOT + 9),
+            },
+            counted: self.count_work,
         })
     }
 
@@ -446,11 +419,10 @@ impl Backend for GpuBackend {
         repeats: u32,
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
-        refuse_unsupported(scene)?;
         let packed = pack(scene, view, sampling)?;
         self.check_limits(&packed, view)?;
         loop {
-            let r = self.resources(&packed, view, 0)?;
+            let r = self.resources(&packed, view, &plan, 0)?;
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;
             if self.whole(&self.counters(&r)?, &packed)? {
                 return Ok(timing);

@@ -49,7 +49,9 @@ pub(super) struct Pipelines {
     /// Its buffers' layout (group 2).
     pub accel: wgpu::BindGroupLayout,
     pub primary: wgpu::ComputePipeline,
+    /// Also the plan's `direct` pass (`Params::shadows` off).
     pub shadow: wgpu::ComputePipeline,
+    pub mirror: wgpu::ComputePipeline,
     pub ambient: wgpu::ComputePipeline,
     #[cfg(feature = "test-hooks")]
     hooks: Option<(wgpu::ComputePipeline, wgpu::ComputePipeline)>,
@@ -84,12 +86,19 @@ fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
 impl Layouts {
     pub fn new(device: &wgpu::Device) -> Layouts {
         // params; spheres, planes, lights, shared points; hits, visibility, radiance, counters;
-        // mesh triangles; AO directions and output; the sampling schemes' tables.
+        // mesh triangles; AO directions and output; the sampling schemes' tables; mirror weights;
+        // the lights' running sums between sample chunks.
         let mut entries = vec![uniform(0)];
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
         entries.push(storage(9, true));
-        entries.extend([storage(10, true), storage(11, false), storage(12, true)]);
+        entries.extend([
+            storage(10, true),
+            storage(11, false),
+            storage(12, true),
+            storage(13, true),
+            storage(14, false),
+        ]);
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
@@ -216,6 +225,7 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
     Pipelines {
         primary: entry(device, &module, "primary", &layout),
         shadow: entry(device, &module, "shadow", &layout),
+        mirror: entry(device, &module, "mirror", &layout),
         ambient: entry(device, &module, "ambient", &layout),
         accel,
         #[cfg(feature = "test-hooks")]

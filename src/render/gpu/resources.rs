@@ -9,7 +9,7 @@ use super::pipelines::NO_ACCEL;
 use super::GpuBackend;
 use super::{COUNTER_WORDS, CUT_SHORT_SLOT};
 use crate::fingerprint::fnv1a;
-use crate::render::View;
+use crate::render::{plan::RenderPlan, View};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -25,6 +25,8 @@ pub(super) struct SceneBuffers {
     spheres: wgpu::Buffer,
     planes: wgpu::Buffer,
     mesh_tris: wgpu::Buffer,
+    /// Per object id, its mirror weight.
+    mirrors: wgpu::Buffer,
     /// The acceleration structure's name and its buffers' bind group (group 2).
     accel: &'static str,
     accel_group: wgpu::BindGroup,
@@ -38,6 +40,8 @@ pub(super) struct FrameResources {
     pub hits: wgpu::Buffer,
     pub visibility: wgpu::Buffer,
     pub radiance: wgpu::Buffer,
+    /// Per light and pixel, the running sum of its sample terms between chunks.
+    pub light_sums: wgpu::Buffer,
     /// Per pixel, the AO pass's (unoccluded, total) weights.
     pub ambient: wgpu::Buffer,
     /// One bind group per dispatch of the AO pass's rays (none without the pass).
@@ -56,6 +60,7 @@ fn static_key(p: &Packed) -> u64 {
         (p.spheres.len(), bytemuck::cast_slice::<_, u8>(&p.spheres)),
         (p.planes.len(), bytemuck::cast_slice(&p.planes)),
         (p.mesh_tris.len(), bytemuck::cast_slice(&p.mesh_tris)),
+        (p.mirrors.len(), bytemuck::cast_slice(&p.mirrors)),
     ];
     if let Some((name, s)) = &p.accel {
         parts.push((0, name.as_bytes()));
@@ -135,6 +140,7 @@ impl GpuBackend {
                 spheres: self.storage("spheres", &packed.spheres, Zeroable::zeroed()),
                 planes: self.storage("planes", &packed.planes, Zeroable::zeroed()),
                 mesh_tris: self.storage("mesh triangles", &packed.mesh_tris, Zeroable::zeroed()),
+                mirrors: self.storage("mirror weights", &packed.mirrors, 0f32),
                 accel,
                 accel_group,
             });
@@ -148,6 +154,7 @@ impl GpuBackend {
         &mut self,
         packed: &Packed,
         view: View,
+        plan: &RenderPlan,
         extra_floats: u64,
     ) -> anyhow::Result<FrameResources> {
         self.scene_buffers(packed)?;
@@ -166,6 +173,7 @@ impl GpuBackend {
             (pixels * packed.lights.len().max(1) as u64).max(extra_floats) * 4,
         );
         let radiance = self.output("radiance", pixels * 4);
+        let light_sums = self.output("light sums", pixels * packed.lights.len().max(1) as u64 * 4);
         let counters = self.output("ray counters", COUNTER_WORDS as u64 * 4);
         let ao_dirs = self.storage("ambient-occlusion directions", &packed.ao_dirs, [0f32; 4]);
         let ao_on = packed.params.ao_rays > 0;
@@ -185,6 +193,8 @@ impl GpuBackend {
             &ao_dirs,
             &ambient,
             &tables,
+            &s.mirrors,
+            &light_sums,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -215,16 +225,18 @@ impl GpuBackend {
                     .collect()
             })
             .collect();
-        // AO rays take the shadow samples' chunk: each costs one point and one occlusion query.
+        // AO rays take the shadow samples' chunk (each costs one point and one occlusion query),
+        // or one ray per dispatch where they are issued direction-major.
+        let ao_chunk = if packed.ao_direction_major { 1 } else { chunk };
         let ambient_passes = (0..if ao_on {
-            packed.params.ao_rays.div_ceil(chunk)
+            packed.params.ao_rays.div_ceil(ao_chunk)
         } else {
             0
         })
-            .map(|c| self.pass_info(AMBIENT_PASS, c * chunk, chunk))
+            .map(|c| self.pass_info(AMBIENT_PASS, c * ao_chunk, ao_chunk))
             .collect();
         let queries = self.timestamps.then(|| {
-            let count = 2 * (packed.lights.len() as u32 + 1 + ao_on as u32);
+            let count = 2 * plan.passes.len().max(1) as u32;
             let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("timestamps"),
                 ty: wgpu::QueryType::Timestamp,
@@ -244,6 +256,7 @@ impl GpuBackend {
             hits,
             visibility,
             radiance,
+            light_sums,
             ambient,
             ambient_passes,
             counters,

@@ -1,9 +1,12 @@
 // The render plan's passes: `primary` (camera rays, closest hit), `shadow` (per light, one
-// dispatch per chunk of its samples, any-hit with early exit) and `ambient` (where the scene
-// asks for ambient occlusion, one dispatch per chunk of its rays). Mirrors src/render/cpu.rs and
+// dispatch per chunk of its samples, any-hit with early exit; with `params.shadows` off the
+// same kernel is the plan's `direct` pass: every target visible, no rays), `mirror` (Whitted's
+// mirror chains, src/render/mirror.rs) and `ambient` (where the scene asks for ambient
+// occlusion, one dispatch per chunk of its rays). Mirrors src/render/cpu.rs and
 // src/render/shading.rs in f32, in coordinates re-based on the camera's look-at point so that
 // large translations cost nothing. Shapes' structs and tests come from src/scene/shape/*.wgsl,
-// mesh queries from the scene's acceleration structure (accel_closest, accel_any).
+// mesh queries from the scene's acceleration structure (accel_closest, accel_any), which counts
+// its nodes and primitive tests into `work_nodes` and `work_prims`.
 
 struct Params {
     width: u32,
@@ -27,9 +30,9 @@ struct Params {
     ao_scheme: u32,
     ao_max_distance: f32,
     frame: u32,
-    _f0: u32,
-    _f1: u32,
-    _f2: u32,
+    shadows: u32,
+    mirror_depth: u32,
+    stats: u32,
 }
 
 struct Light {
@@ -53,7 +56,7 @@ struct Hit {
     normal: vec3<f32>,
     albedo: f32,
     triangle: u32,
-    _h0: u32,
+    mirror: f32,
     _h1: u32,
     _h2: u32,
 }
@@ -79,6 +82,17 @@ const LIGHT_POINT: u32 = 0u;
 var<private> cut_short: bool = false;
 const NO_RECEIVER: f32 = -1.0;
 
+// The invocation's work (src/accel/work.rs): queries asked of the scene, traversal steps and
+// primitive tests; added to the counters once at the end of a kernel when `params.stats` is on.
+var<private> work_queries: u32 = 0u;
+var<private> work_nodes: u32 = 0u;
+var<private> work_prims: u32 = 0u;
+const AO_RAYS_SLOT: u32 = CUT_SHORT_SLOT + 1u;
+const REFLECTION_RAYS_SLOT: u32 = CUT_SHORT_SLOT + 3u;
+const QUERIES_SLOT: u32 = CUT_SHORT_SLOT + 5u;
+const NODES_SLOT: u32 = CUT_SHORT_SLOT + 7u;
+const PRIMS_SLOT: u32 = CUT_SHORT_SLOT + 9u;
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
 @group(0) @binding(2) var<storage, read> planes: array<Plane>;
@@ -92,6 +106,10 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(10) var<storage, read> ao_dirs: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> ambient_out: array<f32>;
 @group(0) @binding(12) var<storage, read> scheme_tables: array<u32>;
+// Per object id, its mirror weight (0 for every analytic shape).
+@group(0) @binding(13) var<storage, read> mirrors: array<f32>;
+// Per light and pixel, the running sum of a light's sample terms between its chunks.
+@group(0) @binding(14) var<storage, read_write> light_sums: array<f32>;
 @group(1) @binding(0) var<uniform> pass_info: PassInfo;
 
 // Any-hit along origin -> origin + d, skipping the receiver's own sphere or plane (`skip`) or
@@ -103,8 +121,10 @@ fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
 
 // Any-hit along origin + t dir, 0 < t < len (len may be infinite), with the same skips.
 fn blocked(origin: vec3<f32>, dir: vec3<f32>, len: f32, skip: u32, skip_tri: u32) -> bool {
+    work_queries += 1u;
     var i = 0u;
     for (; i < params.sphere_count; i++) {
+        work_prims += u32(spheres[i].object != skip);
         let r = sphere_roots(origin, dir, spheres[i].center, spheres[i].radius);
         if (spheres[i].object != skip && r.z > 0.0 && ((r.x > 0.0 && r.x < len) || (r.y > 0.0 && r.y < len))) {
             return true;
@@ -112,6 +132,7 @@ fn blocked(origin: vec3<f32>, dir: vec3<f32>, len: f32, skip: u32, skip_tri: u32
     }
     var j = 0u;
     for (; j < params.plane_count; j++) {
+        work_prims += u32(planes[j].object != skip);
         let t = plane_t(origin, dir, planes[j]);
         if (planes[j].object != skip && t > 0.0 && t < len) {
             return true;
@@ -121,23 +142,24 @@ fn blocked(origin: vec3<f32>, dir: vec3<f32>, len: f32, skip: u32, skip_tri: u32
     return accel_any(origin, dir, len, skip_tri);
 }
 
-@compute @workgroup_size(8, 8)
-fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.width || gid.y >= params.height) {
-        return;
-    }
-    let pixel = gid.y * params.width + gid.x;
-    let sx = (2.0 * (f32(gid.x) + 0.5) / f32(params.width) - 1.0) * params.half_x;
-    let sy = (1.0 - 2.0 * (f32(gid.y) + 0.5) / f32(params.height)) * params.half_y;
-    var origin = params.cam_origin;
-    var dir = params.cam_forward;
+// Pixel `xy`'s camera ray: (origin, unit direction).
+fn camera_ray(xy: vec2<u32>) -> array<vec3<f32>, 2> {
+    let sx = (2.0 * (f32(xy.x) + 0.5) / f32(params.width) - 1.0) * params.half_x;
+    let sy = (1.0 - 2.0 * (f32(xy.y) + 0.5) / f32(params.height)) * params.half_y;
     if (params.ortho != 0u) {
-        origin = params.cam_origin + sx * params.cam_right + sy * params.cam_up;
-    } else {
-        dir = normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up);
+        return array<vec3<f32>, 2>(params.cam_origin + sx * params.cam_right + sy * params.cam_up, params.cam_forward);
     }
-    // Analytic shapes by kind, equal distances going to the lower object id as on the CPU, then
-    // the accelerator within the distance found; `best` indexes spheres, then planes.
+    return array<vec3<f32>, 2>(params.cam_origin, normalize(params.cam_forward + sx * params.cam_right + sy * params.cam_up));
+}
+
+// The closest surface along origin + t dir, t > 0, skipping triangle `skip_tri` (a secondary
+// ray's own): cpu::closest_hit_skipping in f32. Analytic shapes by kind, equal distances going
+// to the lower object id as on the CPU, then the accelerator within the distance found; the
+// point re-projected onto analytic surfaces, the normal facing the ray.
+fn closest(origin: vec3<f32>, dir: vec3<f32>, skip_tri: u32) -> Hit {
+    work_queries += 1u;
+    work_prims += params.sphere_count + params.plane_count;
+    // `best` indexes spheres, then planes.
     var best_t = 3.4e38;
     var best = NO_HIT;
     var best_object = NO_HIT;
@@ -158,11 +180,11 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
             best_object = planes[i].object;
         }
     }
-    let mesh_hit = accel_closest(origin, dir, best_t, NO_HIT);
-    radiance[pixel] = 0.0;
+    let mesh_hit = accel_closest(origin, dir, best_t, skip_tri);
     var hit: Hit;
     hit.object = NO_HIT;
     hit.triangle = NO_HIT;
+    hit.mirror = 0.0;
     if (mesh_hit.triangle != NO_HIT) {
         let tri = mesh_tris[mesh_hit.triangle];
         hit.object = tri.object;
@@ -170,9 +192,6 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
         hit.normal = normalize(cross(tri.e1, tri.e2));
         hit.albedo = tri.albedo;
         hit.triangle = mesh_hit.triangle;
-        if (dot(hit.normal, dir) > 0.0) {
-            hit.normal = -hit.normal;
-        }
     } else if (best != NO_HIT) {
         let raw = origin + best_t * dir;
         if (best < params.sphere_count) {
@@ -189,24 +208,119 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
             hit.normal = pl.normal;
             hit.albedo = pl.albedo;
         }
+    }
+    if (hit.object != NO_HIT) {
+        hit.mirror = mirrors[hit.object];
         if (dot(hit.normal, dir) > 0.0) {
             hit.normal = -hit.normal;
         }
     }
-    hits[pixel] = hit;
+    return hit;
+}
+
+// Adds `n` to the 64-bit counter at words (slot, slot + 1).
+fn add_wide(slot: u32, n: u32) {
+    if (n == 0u) {
+        return;
+    }
+    let old = atomicAdd(&counters[slot], n);
+    if (old + n < old) {
+        atomicAdd(&counters[slot + 1u], 1u);
+    }
+}
+
+// The end of every kernel: the invocation's work where the frame counts it, and whether a loop
+// was cut short.
+fn finish_invocation() {
+    if (params.stats != 0u) {
+        add_wide(QUERIES_SLOT, work_queries);
+        add_wide(NODES_SLOT, work_nodes);
+        add_wide(PRIMS_SLOT, work_prims);
+    }
     if (cut_short) {
         atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
     }
 }
 
-fn add_rays(light: u32, n: u32) {
-    if (n == 0u) {
+@compute @workgroup_size(8, 8)
+fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
-    let old = atomicAdd(&counters[2u * light], n);
-    if (old + n < old) {
-        atomicAdd(&counters[2u * light + 1u], 1u);
+    let pixel = gid.y * params.width + gid.x;
+    let ray = camera_ray(gid.xy);
+    radiance[pixel] = 0.0;
+    hits[pixel] = closest(ray[0], ray[1], NO_HIT);
+    finish_invocation();
+}
+
+// What a receiver has gathered from one light so far: the visible targets, the running sum of
+// their geometric terms (cos cos' / d^4 for a disk, cos / d^2 for a point) and the rays traced.
+// The sum is one left fold over the samples in order, whichever dispatches they were split into,
+// so a frame's bits do not depend on how an adapter's loop cap chunks a pass. The twin of
+// shading::shade_light; with `params.shadows` off every target counts as visible and no ray is
+// traced (OpenGL-like shading).
+struct LightSample {
+    visible: f32,
+    sum: f32,
+    rays: u32,
+}
+
+// `so_far` continued over the light's samples first .. first + count.
+fn sample_light(li: u32, hit: Hit, first: u32, count: u32, xy: vec2<u32>, pixel: u32, so_far: LightSample) -> LightSample {
+    let light = lights[li];
+    let p = hit.position;
+    let n = hit.normal;
+    let origin = select(p, offset_origin(p, n), hit.triangle != NO_HIT);
+    let shadows = params.shadows != 0u;
+    var out = so_far;
+    if (light.kind == LIGHT_POINT && first == 0u) {
+        let d = light.center - p;
+        if (dot(n, d) > 0.0) {
+            out.rays = u32(shadows);
+            if (!shadows || !occluded(origin, light.center - origin, hit.object, hit.triangle)) {
+                out.visible = 1.0;
+                out.sum = dot(n, normalize(d)) / dot(d, d);
+            }
+        }
+    } else if (light.kind != LIGHT_POINT) {
+        let tilt = sqrt(max(1.0 - dot(n, light.normal) * dot(n, light.normal), 0.0));
+        let reachable = dot(light.normal, p - light.center) > 0.0 && dot(n, light.center - p) + light.radius * tilt > 0.0;
+        if (reachable) {
+            let stream = stream_pixel(params.seed, li, pixel);
+            let last = first + min(count, light.samples - min(first, light.samples));
+            var k = first;
+            for (; k < last; k++) {
+                var s: vec2<f32>;
+                if (params.shared_pattern != 0u) {
+                    s = shared_points[light.shared_offset + k];
+                } else {
+                    s = disk_point(params.scheme, light.samples, k, stream, xy, tile_seed(params.seed, li), params.frame);
+                }
+                let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
+                let d = q - p;
+                if (dot(n, d) > 0.0 && dot(light.normal, d) < 0.0) {
+                    out.rays += u32(shadows);
+                    if (!shadows || !occluded(origin, q - origin, hit.object, hit.triangle)) {
+                        out.visible += 1.0;
+                        let d2 = dot(d, d);
+                        out.sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
+                    }
+                }
+            }
+            cut_short = cut_short || k < last;
+        }
     }
+    return out;
+}
+
+// (visibility, irradiance) of a light's gathered samples.
+fn light_finish(li: u32, s: LightSample) -> vec2<f32> {
+    let light = lights[li];
+    if (light.kind == LIGHT_POINT) {
+        return vec2<f32>(s.visible, light.power / (4.0 * PI) * s.sum);
+    }
+    return vec2<f32>(s.visible / f32(light.samples), light.power / (PI * f32(light.samples)) * s.sum);
 }
 
 @compute @workgroup_size(8, 8)
@@ -222,62 +336,71 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
         visibility[out] = NO_RECEIVER;
         return;
     }
-    let light = lights[li];
-    let p = hit.position;
-    let n = hit.normal;
-    let origin = select(p, offset_origin(p, n), hit.triangle != NO_HIT);
-    var vis = 0.0;
-    var irradiance = 0.0;
-    var rays = 0u;
+    // Chunks of one light's samples carry the visible count (in `visibility`) and the running
+    // sum (in `light_sums`, cleared each frame) to the next; the last turns them into the
+    // light's visibility and radiance, a mirror's diffuse part weighted by 1 - mirror.
     let first = pass_info.first_sample;
-    if (light.kind == LIGHT_POINT && first == 0u) {
-        let d = light.center - p;
-        if (dot(n, d) > 0.0) {
-            rays = 1u;
-            if (!occluded(origin, light.center - origin, hit.object, hit.triangle)) {
-                vis = 1.0;
-                irradiance = light.power / (4.0 * PI) * dot(n, normalize(d)) / dot(d, d);
+    let so_far = LightSample(visibility[out], light_sums[out], 0u);
+    let s = sample_light(li, hit, first, pass_info.sample_count, gid.xy, pixel, so_far);
+    let samples = lights[li].samples;
+    if (pass_info.sample_count >= samples - min(first, samples)) {
+        let f = light_finish(li, s);
+        visibility[out] = f.x;
+        radiance[pixel] += (1.0 - hit.mirror) * hit.albedo / PI * f.y;
+    } else {
+        visibility[out] = s.visible;
+        light_sums[out] = s.sum;
+    }
+    add_wide(2u * li, s.rays);
+    finish_invocation();
+}
+
+// Whitted's mirror chain from the pixel's receiver (src/render/mirror.rs in f32): the reflected
+// ray's closest hit, shaded from every light with all its samples (shadow rays where the scene
+// has shadows), followed again where it reflects, up to `params.mirror_depth` bounces. Radiance
+// leaving a vertex is (1 - m) x diffuse + m x reflected; a chain cut at the depth limit or
+// leaving the scene brings back nothing.
+@compute @workgroup_size(8, 8)
+fn mirror(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    var at = hits[pixel];
+    if (at.object == NO_HIT || at.mirror == 0.0) {
+        return;
+    }
+    var weight = at.mirror;
+    var dir = normalize(reflect(camera_ray(gid.xy)[1], at.normal));
+    var reflected = 0.0;
+    var bounces = 0u;
+    // A flag rather than a break: lavapipe miscompiled early exits from loops under divergence.
+    var left_scene = false;
+    var b = 0u;
+    for (; b < params.mirror_depth && weight != 0.0 && !left_scene; b++) {
+        bounces += 1u;
+        let origin = select(at.position, offset_origin(at.position, at.normal), at.triangle != NO_HIT);
+        let next = closest(origin, dir, at.triangle);
+        left_scene = next.object == NO_HIT;
+        if (!left_scene && next.mirror < 1.0) {
+            var irradiance = 0.0;
+            for (var li = 0u; li < params.light_count; li++) {
+                let s = sample_light(li, next, 0u, lights[li].samples, gid.xy, pixel, LightSample(0.0, 0.0, 0u));
+                irradiance += light_finish(li, s).y;
+                add_wide(2u * li, s.rays);
             }
+            reflected += weight * (1.0 - next.mirror) * next.albedo / PI * irradiance;
         }
-    } else if (light.kind != LIGHT_POINT) {
-        let tilt = sqrt(max(1.0 - dot(n, light.normal) * dot(n, light.normal), 0.0));
-        let reachable = dot(light.normal, p - light.center) > 0.0 && dot(n, light.center - p) + light.radius * tilt > 0.0;
-        if (reachable) {
-            let stream = stream_pixel(params.seed, li, pixel);
-            var visible = 0u;
-            var sum = 0.0;
-            let last = min(first + pass_info.sample_count, light.samples);
-            var k = first;
-            for (; k < last; k++) {
-                var s: vec2<f32>;
-                if (params.shared_pattern != 0u) {
-                    s = shared_points[light.shared_offset + k];
-                } else {
-                    s = disk_point(params.scheme, light.samples, k, stream, gid.xy, tile_seed(params.seed, li), params.frame);
-                }
-                let q = light.center + light.radius * (s.x * light.u + s.y * light.v);
-                let d = q - p;
-                if (dot(n, d) > 0.0 && dot(light.normal, d) < 0.0) {
-                    rays += 1u;
-                    if (!occluded(origin, q - origin, hit.object, hit.triangle)) {
-                        visible += 1u;
-                        let d2 = dot(d, d);
-                        sum += dot(n, d) * -dot(light.normal, d) / (d2 * d2);
-                    }
-                }
-            }
-            cut_short = cut_short || k < last;
-            vis = f32(visible) / f32(light.samples);
-            irradiance = light.power / (PI * f32(light.samples)) * sum;
+        if (!left_scene) {
+            weight *= next.mirror;
+            dir = normalize(reflect(dir, next.normal));
+            at = next;
         }
     }
-    // Sample chunks of one light accumulate (the buffer is cleared each frame).
-    visibility[out] += vis;
-    radiance[pixel] += hit.albedo / PI * irradiance;
-    add_rays(li, rays);
-    if (cut_short) {
-        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
-    }
+    cut_short = cut_short || (b < params.mirror_depth && weight != 0.0 && !left_scene);
+    radiance[pixel] += reflected;
+    add_wide(REFLECTION_RAYS_SLOT, bounces);
+    finish_invocation();
 }
 
 // Ambient occlusion (src/render/ambient.rs in f32): rays `first_sample ..` of the pass's chunk
@@ -287,7 +410,6 @@ const AO_GRID_PLAIN: u32 = 1u;
 const AO_GRID_COSINE: u32 = 2u;
 const AO_DISK_PLAIN: u32 = 3u;
 const AMBIENT_STREAM: u32 = 0x414fu;
-const AO_RAYS_SLOT: u32 = CUT_SHORT_SLOT + 1u;
 
 // An orthonormal (t, b) completing unit n (Duff et al. 2017), as tangent_basis in ambient.rs.
 fn tangent_basis(n: vec3<f32>) -> mat2x3<f32> {
@@ -356,12 +478,6 @@ fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
     cut_short = cut_short || k < last;
     ambient_out[2u * pixel] += seen;
     ambient_out[2u * pixel + 1u] += total;
-    let rays = select(0u, last - first, last > first);
-    let old = atomicAdd(&counters[AO_RAYS_SLOT], rays);
-    if (old + rays < old) {
-        atomicAdd(&counters[AO_RAYS_SLOT + 1u], 1u);
-    }
-    if (cut_short) {
-        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
-    }
+    add_wide(AO_RAYS_SLOT, select(0u, last - first, last > first));
+    finish_invocation();
 }
