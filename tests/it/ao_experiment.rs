@@ -239,4 +239,20 @@ fn the_ci_experiment_runs_on_the_gpu() {
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("s on the GPU backend on "), "{report}");
     assert!(report.contains("| `vlf` single / bundled |"), "{report}");
+    // Against the f64 CPU's images: a ray f32 decides the other way moves a pixel by one ray's
+    // weight (1/33); a few percent of the pixels, none by more than two rays.
+    let cpu = dir.path().join("ao-ci-cpu");
+    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), cpu.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    for mesh in ["cow", "mech-holes-shark"] {
+        for structure in ["kdtree", "kdtree-sah", "vlf", "bvh", "cwbvh", "brute"] {
+            let file = format!("images/{mesh}_{structure}.exr");
+            let (off, pixels, worst) = common::differing_from_cpu(&out, &cpu, &file, 1e-6);
+            eprintln!("{file}: {off} of {pixels} pixels differ from the CPU's, worst {worst}");
+            assert!(
+                off * 20 <= pixels && worst <= 2.5 / 33.0,
+                "{file}: {off} of {pixels}, worst {worst}"
+            );
+        }
+    }
 }

@@ -506,3 +506,60 @@ fn with_mirrors_in(
 }
 
 use crate::common;
+
+/// Mirror chains under a disk light of many samples: the mirror kernel shades every vertex with
+/// all of a light's samples in one invocation (depth 16 x 4096 samples here), which an adapter
+/// that caps loop iterations (lavapipe: 65535 per loop nest) cannot finish. There the frame is
+/// refused naming the mirror pass, without retrying splits that cannot help; elsewhere it
+/// matches the CPU.
+#[test]
+fn mirror_chains_past_the_loop_cap_are_refused_by_name_and_otherwise_match_the_cpu() {
+    let Some(mut gpu) = common::gpu() else { return };
+    let camera = Camera {
+        position: DVec3::new(1.0, 0.0, 1.0),
+        look_at: DVec3::new(0.0, 0.0, 1.0),
+        up: DVec3::Z,
+        projection: Projection::Orthographic { width: 1.0 },
+    };
+    let (w, h) = (4, 4);
+    let pair = [quad(0.0, [-5.0, 5.0], [-4.0, 6.0]), quad(2.0, [-5.0, 5.0], [-4.0, 6.0])];
+    let light = Light::Disk(penumbra::scene::DiskLight {
+        center: DVec3::new(1.0, 0.0, 5.0),
+        normal: -DVec3::Z,
+        radius: 0.5,
+        power: 10.0,
+        samples: 4096,
+    });
+    let scene = with_mirrors(
+        Scene::analytic(vec![], vec![], vec![light]),
+        &pair,
+        0.5,
+        Shading::whitted(16),
+    );
+    let view = View {
+        camera: &camera,
+        width: w,
+        height: h,
+    };
+    let c = CpuBackend::default().render(&scene, view, SAMPLING).unwrap();
+    let before = gpu.dispatches();
+    match gpu.render(&scene, view, SAMPLING) {
+        Err(e) => {
+            let e = format!("{e:#}");
+            assert!(gpu.loop_cap().is_some(), "refused without a loop cap: {e}");
+            assert!(
+                e.contains("mirror chains") && e.contains("16 bounces") && e.contains("CPU backend"),
+                "{e}"
+            );
+            let dispatched = gpu.dispatches() - before;
+            assert!(dispatched < 600, "no futile retries: {dispatched} dispatches");
+        }
+        Ok(g) => {
+            for i in 0..(w * h) as usize {
+                let (a, b) = (c.radiance[i] as f64, g.radiance[i] as f64);
+                assert!((a - b).abs() <= 1e-3 * a, "pixel {i}: cpu {a} gpu {b}");
+            }
+            assert_eq!(g.rays.shadow_total(), c.rays.shadow_total());
+        }
+    }
+}

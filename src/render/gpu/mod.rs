@@ -38,8 +38,9 @@ pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; the count of
 /// invocations whose loops were cut short; then as (low, high) words ambient-occlusion rays,
-/// reflection rays, and the work of frames that count it (queries, nodes, primitive tests).
-pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 11;
+/// reflection rays, and the work of frames that count it (queries, nodes, primitive tests); the
+/// count of mirror-chain invocations whose loops were cut short.
+pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 12;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
 
@@ -166,6 +167,8 @@ impl GpuBackend {
     /// the buffer and the excess.
     fn check_limits(&self, packed: &layout::Packed, view: View) -> anyhow::Result<()> {
         let limits = self.device.limits();
+        let structure = packed.accel.as_ref().map(|(name, s)| (*name, s.buffers.len() as u32));
+        storage_buffers_fit(structure, limits.max_storage_buffers_per_shader_stage)?;
         let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         let mut buffers = vec![
             ("hit buffer", view.pixels() as u64 * HIT_BYTES),
@@ -302,6 +305,15 @@ impl GpuBackend {
     /// can help (a BVH deeper than the traversal stack) and the frame is an error, never a silent
     /// answer.
     fn whole(&mut self, counters: &[u32], packed: &layout::Packed) -> anyhow::Result<bool> {
+        let chains = counters[CUT_SHORT_SLOT + 11];
+        if chains > 0 {
+            let samples: u32 = packed.lights.iter().map(|l| l.samples).sum();
+            bail!(
+                "{chains} GPU invocations of Whitted's mirror chains ended a loop early: {} bounces, each shading every light with all its samples ({samples} in all) in one invocation, run past this adapter's loop cap {:?}, and the mirror pass is not split further; use the CPU backend for this scene",
+                packed.params.mirror_depth,
+                self.loop_cap
+            );
+        }
         let cut = counters[CUT_SHORT_SLOT];
         if cut == 0 {
             return Ok(true);
@@ -318,6 +330,22 @@ impl GpuBackend {
             ),
         }
     }
+}
+
+/// Storage buffers every render kernel binds at group 0 (render.wgsl, bindings 1-14).
+const FRAME_STORAGE_BUFFERS: u32 = 14;
+
+/// Whether the kernels' storage buffers (the frame's and structure `(name, buffers)`'s) fit the
+/// adapter's per-stage limit, else an error naming both counts: a compute-only fallback (wgpu's
+/// GL backend offers 8-16) cannot bind the visibility field's nine.
+fn storage_buffers_fit(structure: Option<(&str, u32)>, limit: u32) -> anyhow::Result<()> {
+    let (name, own) = structure.unwrap_or(("no structure", 0));
+    let needed = FRAME_STORAGE_BUFFERS + own;
+    anyhow::ensure!(
+        needed <= limit,
+        "the render kernels bind {needed} storage buffers ({FRAME_STORAGE_BUFFERS} per frame, {own} of `{name}`); this adapter allows {limit} per shader stage"
+    );
+    Ok(())
 }
 
 impl Backend for GpuBackend {
@@ -428,5 +456,22 @@ impl Backend for GpuBackend {
                 return Ok(timing);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn storage_buffers_beyond_the_adapters_limit_are_refused_with_both_counts() {
+        assert!(storage_buffers_fit(Some(("vlf", 9)), 23).is_ok());
+        let e = storage_buffers_fit(Some(("vlf", 9)), 16).unwrap_err().to_string();
+        assert!(
+            e.contains("23 storage buffers") && e.contains("9 of `vlf`") && e.contains("allows 16"),
+            "{e}"
+        );
+        assert!(storage_buffers_fit(None, 14).is_ok());
+        assert!(storage_buffers_fit(None, 13).is_err());
     }
 }

@@ -107,7 +107,7 @@ pub fn self_test(browser: &Path, page: &Path) -> Result<Value, String> {
 }
 
 /// A one-channel EXR's values and width.
-fn exr(path: &Path) -> Result<(Vec<f32>, usize), String> {
+pub fn exr(path: &Path) -> Result<(Vec<f32>, usize), String> {
     let img = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let width = img.layer_data.size.width();
     let ch = &img.layer_data.channel_data.list[0];

@@ -284,3 +284,15 @@ pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
     }
     rows
 }
+
+/// Pixels of the GPU's image `gpu` that differ from the CPU's `cpu` (same file name in both
+/// results folders) by more than `step`, and the largest difference: f32 against f64 decides a
+/// grazing ray the other way now and then, which moves a pixel by about one ray's weight.
+pub fn differing_from_cpu(gpu: &std::path::Path, cpu: &std::path::Path, file: &str, step: f32) -> (usize, usize, f32) {
+    let (g, _) = browser::exr(&gpu.join(file)).unwrap();
+    let (c, _) = browser::exr(&cpu.join(file)).unwrap();
+    assert_eq!(g.len(), c.len(), "{file}");
+    let diff: Vec<f32> = g.iter().zip(&c).map(|(a, b)| (a - b).abs()).collect();
+    let worst = diff.iter().cloned().fold(0.0, f32::max);
+    (diff.iter().filter(|&&d| d > step).count(), diff.len(), worst)
+}

@@ -92,6 +92,7 @@ const REFLECTION_RAYS_SLOT: u32 = CUT_SHORT_SLOT + 3u;
 const QUERIES_SLOT: u32 = CUT_SHORT_SLOT + 5u;
 const NODES_SLOT: u32 = CUT_SHORT_SLOT + 7u;
 const PRIMS_SLOT: u32 = CUT_SHORT_SLOT + 9u;
+const MIRROR_CUT_SLOT: u32 = CUT_SHORT_SLOT + 11u;
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
@@ -230,15 +231,16 @@ fn add_wide(slot: u32, n: u32) {
 }
 
 // The end of every kernel: the invocation's work where the frame counts it, and whether a loop
-// was cut short.
-fn finish_invocation() {
+// was cut short, counted at `cut_slot` (the mirror kernel has its own: splitting the shadow and
+// AO passes further cannot help it).
+fn finish_invocation(cut_slot: u32) {
     if (params.stats != 0u) {
         add_wide(QUERIES_SLOT, work_queries);
         add_wide(NODES_SLOT, work_nodes);
         add_wide(PRIMS_SLOT, work_prims);
     }
     if (cut_short) {
-        atomicAdd(&counters[CUT_SHORT_SLOT], 1u);
+        atomicAdd(&counters[cut_slot], 1u);
     }
 }
 
@@ -251,7 +253,7 @@ fn primary(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ray = camera_ray(gid.xy);
     radiance[pixel] = 0.0;
     hits[pixel] = closest(ray[0], ray[1], NO_HIT);
-    finish_invocation();
+    finish_invocation(CUT_SHORT_SLOT);
 }
 
 // What a receiver has gathered from one light so far: the visible targets, the running sum of
@@ -352,7 +354,7 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
         light_sums[out] = s.sum;
     }
     add_wide(2u * li, s.rays);
-    finish_invocation();
+    finish_invocation(CUT_SHORT_SLOT);
 }
 
 // Whitted's mirror chain from the pixel's receiver (src/render/mirror.rs in f32): the reflected
@@ -400,7 +402,7 @@ fn mirror(@builtin(global_invocation_id) gid: vec3<u32>) {
     cut_short = cut_short || (b < params.mirror_depth && weight != 0.0 && !left_scene);
     radiance[pixel] += reflected;
     add_wide(REFLECTION_RAYS_SLOT, bounces);
-    finish_invocation();
+    finish_invocation(MIRROR_CUT_SLOT);
 }
 
 // Ambient occlusion (src/render/ambient.rs in f32): rays `first_sample ..` of the pass's chunk
@@ -438,8 +440,10 @@ fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
     let tb = tangent_basis(n);
     let stream = stream_pixel(params.seed, AMBIENT_STREAM, pixel);
     let grid = params.ao_mode == AO_GRID_PLAIN || params.ao_mode == AO_GRID_COSINE;
-    var seen = 0.0;
-    var total = 0.0;
+    // Chunks of the pass continue one running (unoccluded, total) sum, so the image's bits do
+    // not depend on how the rays were split into dispatches.
+    var seen = ambient_out[2u * pixel];
+    var total = ambient_out[2u * pixel + 1u];
     let first = pass_info.first_sample;
     let last = min(first + pass_info.sample_count, params.ao_rays);
     var k = first;
@@ -476,8 +480,8 @@ fn ambient(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     cut_short = cut_short || k < last;
-    ambient_out[2u * pixel] += seen;
-    ambient_out[2u * pixel + 1u] += total;
+    ambient_out[2u * pixel] = seen;
+    ambient_out[2u * pixel + 1u] = total;
     add_wide(AO_RAYS_SLOT, select(0u, last - first, last > first));
-    finish_invocation();
+    finish_invocation(CUT_SHORT_SLOT);
 }
