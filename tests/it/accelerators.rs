@@ -450,8 +450,8 @@ fn work_counts_are_exact_and_do_not_depend_on_threads() {
 /// the first blocker for an any hit on both, so its primitive tests agree but for the rays f32
 /// and f64 decide differently; the other structures' counts are their own GPU walks' (the BVH
 /// pops nodes where obvhs' CPU walk tests child pairs, the CWBVH tests a node's children in slot
-/// order rather than obvhs' octant order) and are printed beside the CPU's; the kd-trees walk as
-/// their CPU twins do. Counting is off until switched on.
+/// order rather than obvhs' octant order) and are printed beside the CPU's; the kd-trees and the
+/// field walk as their CPU twins do. Counting is off until switched on.
 #[test]
 fn gpu_work_counters_count_what_the_cpu_counts_where_the_walks_are_the_same() {
     let Some(mut gpu) = common::gpu() else { return };
@@ -480,6 +480,15 @@ fn gpu_work_counters_count_what_the_cpu_counts_where_the_walks_are_the_same() {
             assert_eq!((gw.nodes, cw.nodes), (0, 0));
             let off = gw.primitives.abs_diff(cw.primitives) as f64 / cw.primitives as f64;
             assert!(off < 1e-3, "brute: {gw:?} vs {cw:?}");
+        }
+        if r.name == "vlf" {
+            // The same tiles and leaves as the CPU's walk (an empty tile is no leaf on either),
+            // but where f32 decides a tile's edge differently: within a few percent.
+            let near = |a: u64, b: u64| a.abs_diff(b) as f64 <= 0.05 * b as f64;
+            assert!(
+                near(gw.nodes, cw.nodes) && near(gw.primitives, cw.primitives),
+                "vlf: {gw:?} vs {cw:?}"
+            );
         }
         if r.name.starts_with("kdtree") {
             // The same walk as the CPU's (near child first, the same thick planes), so the same

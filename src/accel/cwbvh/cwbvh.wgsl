@@ -1,8 +1,9 @@
 // Compressed wide BVH traversal (mod.rs and gpu.rs beside it; Ylitie, Karras & Laine 2017): the
 // nodes are obvhs' 80-byte CWBVH8 nodes, re-based into the frame's local coordinates, each child
-// box decoded from its 8-bit planes as p + 2^e q. A node popped from the stack has its eight
-// children tested at once: leaf children's triangles are tested on the spot, inner children are
-// pushed far to near so the nearest is walked first. Near and far planes come from min and max of
+// box decoded from its 8-bit planes as p + 2^e q. A node popped from the stack (unless it was
+// entered beyond the best hit so far) has its eight children tested at once: leaf children's
+// triangles are tested on the spot, inner children are pushed far to near with their entry
+// distances so the nearest is walked first. Near and far planes come from min and max of
 // the two slab distances, never from the direction's sign, so a -0.0 direction component (on
 // which obvhs' CPU node test picks the planes the wrong way round, see ray.rs) cannot swap them.
 // Written with flags and structured exits (no return inside the loops: lavapipe miscompiled
@@ -24,6 +25,7 @@ const CW_BIG: f32 = 3.4e38;
 
 // Module scope: cleared once per invocation rather than at every call.
 var<private> cw_stack: array<u32, CW_STACK>;
+var<private> cw_stack_t: array<f32, CW_STACK>;
 var<private> cw_order_t: array<f32, 8>;
 var<private> cw_order_node: array<u32, 8>;
 
@@ -68,10 +70,16 @@ fn cw_walk(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32, any: bool) -> Accel
     let inv_d = cw_inverse(d);
     var sp = 1u;
     cw_stack[0] = 0u;
+    cw_stack_t[0] = 0.0;
     var found = false;
     var overflow = false;
     while (sp > 0u && !found && !overflow) {
         sp -= 1u;
+        // Entry distances are lower bounds: a node entered beyond the best hit holds nothing
+        // nearer (strictly beyond: an equal distance may still tie on a lower index).
+        if (cw_stack_t[sp] > best.t) {
+            continue;
+        }
         work_nodes += 1u;
         let n = cw_nodes[cw_stack[sp]];
         let imask = n.e_imask >> 24u;
@@ -111,6 +119,7 @@ fn cw_walk(o: vec3<f32>, d: vec3<f32>, tmax: f32, skip: u32, any: bool) -> Accel
         overflow = sp + inner > CW_STACK;
         for (var j = 0u; j < inner && !overflow; j++) {
             cw_stack[sp] = cw_order_node[j];
+            cw_stack_t[sp] = cw_order_t[j];
             sp += 1u;
         }
     }

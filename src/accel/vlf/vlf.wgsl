@@ -150,7 +150,6 @@ struct VlfLeaf {
 
 fn vlf_leaf(at: VlfIds, leaf: VlfLeaf, o: vec3<f32>, d: vec3<f32>, skip: u32, best_in: AccelHit, any: bool) -> AccelHit {
     var best = best_in;
-    work_nodes += 1u;
     let mask = select(0xffffu, 0xffffffffu, leaf.wide);
     var i = leaf.a;
     for (; i < leaf.b && !(any && best.triangle != NO_HIT); i++) {
@@ -218,6 +217,8 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
     let wide = ((vlf_head[VLF_H_WIDE] >> layer) & 1u) == 1u;
     if ((first & VLF_SPLIT) == 0u) {
         let entries = select(end - start, 2u * ((end - start) / 3u), wide);
+        // An empty tile is no leaf visited, as the CPU's walk counts it.
+        work_nodes += u32(end > start);
         return vlf_leaf(at, VlfLeaf(start, 0u, entries, wide), o, d, skip, best_in, any);
     }
     var best = best_in;
@@ -248,6 +249,7 @@ fn vlf_tile(layer: u32, ray: VlfRay, tile: u32, ta: f32, tb: f32, o: vec3<f32>, 
             a = w0 & 0xffffu;
             b = w1 & 0xffffu;
         }
+        work_nodes += 1u;
         best = vlf_leaf(at, VlfLeaf(h, a, b, wide), o, d, skip, best, any);
         if (best.triangle != NO_HIT && l != select(l0, l1, up)) {
             // Closest hit: later leaves only hold hits beyond this leaf's exit plane.
