@@ -168,7 +168,11 @@ impl GpuBackend {
     fn check_limits(&self, packed: &layout::Packed, view: View) -> anyhow::Result<()> {
         let limits = self.device.limits();
         let structure = packed.accel.as_ref().map(|(name, s)| (*name, s.buffers.len() as u32));
-        storage_buffers_fit(structure, limits.max_storage_buffers_per_shader_stage)?;
+        storage_buffers_fit(
+            self.layouts.frame_storage,
+            structure,
+            limits.max_storage_buffers_per_shader_stage,
+        )?;
         let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         let mut buffers = vec![
             ("hit buffer", view.pixels() as u64 * HIT_BYTES),
@@ -332,18 +336,15 @@ impl GpuBackend {
     }
 }
 
-/// Storage buffers every render kernel binds at group 0 (render.wgsl, bindings 1-14).
-const FRAME_STORAGE_BUFFERS: u32 = 14;
-
-/// Whether the kernels' storage buffers (the frame's and structure `(name, buffers)`'s) fit the
-/// adapter's per-stage limit, else an error naming both counts: a compute-only fallback (wgpu's
-/// GL backend offers 8-16) cannot bind the visibility field's nine.
-fn storage_buffers_fit(structure: Option<(&str, u32)>, limit: u32) -> anyhow::Result<()> {
+/// Whether the kernels' storage buffers (the frame layout's `frame` and structure `(name,
+/// buffers)`'s) fit the adapter's per-stage limit, else an error naming both counts: a
+/// compute-only fallback (wgpu's GL backend offers 8-16) cannot bind the visibility field's nine.
+fn storage_buffers_fit(frame: u32, structure: Option<(&str, u32)>, limit: u32) -> anyhow::Result<()> {
     let (name, own) = structure.unwrap_or(("no structure", 0));
-    let needed = FRAME_STORAGE_BUFFERS + own;
+    let needed = frame + own;
     anyhow::ensure!(
         needed <= limit,
-        "the render kernels bind {needed} storage buffers ({FRAME_STORAGE_BUFFERS} per frame, {own} of `{name}`); this adapter allows {limit} per shader stage"
+        "the render kernels bind {needed} storage buffers ({frame} per frame, {own} of `{name}`); this adapter allows {limit} per shader stage"
     );
     Ok(())
 }
@@ -465,13 +466,13 @@ mod tests {
 
     #[test]
     fn storage_buffers_beyond_the_adapters_limit_are_refused_with_both_counts() {
-        assert!(storage_buffers_fit(Some(("vlf", 9)), 23).is_ok());
-        let e = storage_buffers_fit(Some(("vlf", 9)), 16).unwrap_err().to_string();
+        assert!(storage_buffers_fit(14, Some(("vlf", 9)), 23).is_ok());
+        let e = storage_buffers_fit(14, Some(("vlf", 9)), 16).unwrap_err().to_string();
         assert!(
             e.contains("23 storage buffers") && e.contains("9 of `vlf`") && e.contains("allows 16"),
             "{e}"
         );
-        assert!(storage_buffers_fit(None, 14).is_ok());
-        assert!(storage_buffers_fit(None, 13).is_err());
+        assert!(storage_buffers_fit(14, None, 14).is_ok());
+        assert!(storage_buffers_fit(14, None, 13).is_err());
     }
 }

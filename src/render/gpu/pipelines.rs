@@ -39,6 +39,8 @@ pub fn scheme_prelude() -> String {
 /// includes.
 pub(super) struct Layouts {
     pub frame: wgpu::BindGroupLayout,
+    /// Storage buffers in the frame's layout (every binding but the parameters' uniform).
+    pub frame_storage: u32,
     pub pass: wgpu::BindGroupLayout,
     #[cfg(feature = "test-hooks")]
     pub hooks: wgpu::BindGroupLayout,
@@ -106,6 +108,7 @@ impl Layouts {
             })
         };
         Layouts {
+            frame_storage: entries.len() as u32 - 1,
             frame: layout("frame", &entries),
             pass: layout("pass", &[uniform(0)]),
             #[cfg(feature = "test-hooks")]
