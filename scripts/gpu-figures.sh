@@ -4,7 +4,8 @@
 #
 #   scripts/gpu-figures.sh [--out DIR] [NAME...]
 #
-# NAMEs default to `ao walkthrough scaling` (any experiment under experiments/ may be named).
+# NAMEs default to `ao ao-bundles-gpu walkthrough scaling` (any experiment under experiments/ may
+# be named).
 # Each runs `sweep experiments/NAME.toml --backend gpu --fresh --out DIR/NAME`, DIR being
 # `gpu-results` unless --out names another (one per device, e.g. gpu-results/h100). Every report
 # opens with the adapter it ran on (and says so where it is Mesa's software driver, whose GPU
@@ -37,7 +38,7 @@ while [[ $# -gt 0 ]]; do
             ;;
     esac
 done
-[[ ${#names[@]} -gt 0 ]] || names=(ao walkthrough scaling)
+[[ ${#names[@]} -gt 0 ]] || names=(ao ao-bundles-gpu walkthrough scaling)
 for name in "${names[@]}"; do
     [[ -f experiments/$name.toml ]] || {
         echo "$0: no experiments/$name.toml" >&2

@@ -30,9 +30,10 @@ order=(
     body-structures # body's scene again, swept over the acceleration structures
     fps             # the soft-shadow paper's Table 1
     realtime        # the same question asked as real-time renderers ask it: few rays, frames, filters
-    realtime-body   # ... on the body's narrow penumbrae; the last on the GPU backend
-    ao              # the visibility-field paper's Table 1, CPU backend from here on
+    realtime-body   # ... on the body's narrow penumbrae
+    ao              # the visibility-field paper's Table 1, on the CPU backend as the rest but one
     ao-bundles      # the same workload with SAH and ray bundles: the paper's open question
+    ao-bundles-gpu  # the open question again on the GPU backend (lavapipe here: a CPU's times)
     walkthrough     # Fig. 6, the classroom walk
     dynamic         # the classroom again, with the chrome ball moving
     scaling         # last: its 256K-triangle field peaks near 5.4 GiB, so a short machine fails after the rest

@@ -16,14 +16,32 @@ fn run(dir: &Path, text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>, St
     let out = dir.join("out");
     let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
     assert_eq!(code, 0, "{err}");
-    let mut reader = csv::Reader::from_path(out.join("frames.csv")).unwrap();
-    let header = reader.headers().unwrap().clone();
-    let rows = reader.records().map(Result::unwrap).collect();
+    let (header, rows) = common::table(&out.join("frames.csv"));
     (header, rows, std::fs::read_to_string(out.join("report.md")).unwrap())
 }
 
 fn ci() -> String {
     std::fs::read_to_string(common::repo("experiments/frames-ci.toml")).unwrap()
+}
+
+/// The CI walkthrough as a scaling experiment: random triangles at two sizes, seen from outside
+/// and inside, OpenGL-like shading.
+fn scaling() -> String {
+    ci().replace(
+        "generator = \"classroom\"",
+        "generator = \"random-triangles\"\ntriangles = [300, 2400]\nseed = 5",
+    )
+    .replace("frames = 3", "frames = 2\nviewpoints = [\"outside\", \"inside\"]")
+    .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]")
+}
+
+/// The CI walkthrough with a moving part: every camera of the walk looks at the teacher's desk
+/// while the chrome ball rolls on it.
+fn moving() -> String {
+    ci().replace(
+        "[path]\nframes = 3",
+        "[path]\nframes = 3\nlook_at = [-3.5, 0.0, 0.9]\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, -0.05, 0.0]",
+    )
 }
 
 /// Random cameras and per-scene tuning: each tuned structure keeps exactly one candidate, the
@@ -210,14 +228,7 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
 #[test]
 fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
     let dir = tempfile::tempdir().unwrap();
-    let text = ci()
-        .replace(
-            "generator = \"classroom\"",
-            "generator = \"random-triangles\"\ntriangles = [300, 2400]\nseed = 5",
-        )
-        .replace("frames = 3", "frames = 2\nviewpoints = [\"outside\", \"inside\"]")
-        .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]");
-    let (header, rows, report) = run(dir.path(), &text);
+    let (header, rows, report) = run(dir.path(), &scaling());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
     assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
@@ -239,12 +250,7 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
 #[test]
 fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
     let dir = tempfile::tempdir().unwrap();
-    // Every camera of the walk looks at the teacher's desk while the chrome ball rolls on it.
-    let text = ci().replace(
-        "[path]\nframes = 3",
-        "[path]\nframes = 3\nlook_at = [-3.5, 0.0, 0.9]\n\n[motion]\npart = \"chrome-ball\"\nstep = [0.0, -0.05, 0.0]",
-    );
-    let (header, rows, report) = run(dir.path(), &text);
+    let (header, rows, report) = run(dir.path(), &moving());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let methods: Vec<String> = rows
         .iter()
@@ -466,90 +472,80 @@ fn the_random_camera_designs_load_and_tune_both_kd_trees() {
     }
 }
 
-/// experiments/frames-ci.toml on the GPU (`--backend gpu`, lavapipe in CI): every structure
-/// renders every frame of both shadings as the first structure does, traces the CPU's rays, and
-/// its rows carry the GPU's work counts; the report names the adapter. On an adapter that caps
-/// loop iterations (lavapipe: 65535 per loop nest) brute force over the classroom's 51K
-/// triangles cannot finish a mirror chain in one invocation and is refused (checked below), so
-/// the run there drops it.
-#[test]
-fn the_ci_walkthrough_runs_on_the_gpu() {
-    let Some(capped) = common::gpu().map(|g| g.loop_cap().is_some()) else {
-        return;
-    };
+/// Experiment `text` (a frames kind) on the GPU (`--backend gpu`, lavapipe in CI) and on the f64
+/// CPU: on the GPU every structure renders every frame as the first structure does, every row
+/// counts the GPU's work, the report and manifest name the adapter; and every strip frame is
+/// within 1e-3 W m^-2 sr^-1 (about 1e-4 of the brightest pixel's radiance) of the CPU's but on
+/// at most 1 % of its pixels, where f32 decides a ray grazing an edge the other way. Returns the
+/// GPU's frames.csv.
+fn on_the_gpu_as_on_the_cpu(text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>) {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("gpu");
-    let mut text = std::fs::read_to_string(common::repo("experiments/frames-ci.toml")).unwrap();
-    let structures = if capped { 4 } else { 5 };
-    if capped {
-        let all = "structures = [\"kdtree\", \"vlf\", \"bvh\", \"cwbvh\", \"brute\"]";
-        assert!(text.contains(all), "{text}");
-        let brute = dir.path().join("brute.toml");
-        std::fs::write(
-            &brute,
-            text.replace(all, "structures = [\"kdtree\", \"vlf\", \"brute\"]"),
-        )
-        .unwrap();
-        let (code, err) = common::sweep(&[
-            brute.as_os_str(),
-            OsStr::new("--backend"),
-            OsStr::new("gpu"),
-            OsStr::new("--out"),
-            dir.path().join("brute").as_os_str(),
-        ]);
-        assert_ne!(code, 0, "{err}");
-        assert!(
-            err.contains("ended a loop early") && err.contains("CPU backend"),
-            "{err}"
-        );
-        text = text.replace(all, "structures = [\"kdtree\", \"vlf\", \"bvh\", \"cwbvh\"]");
-    }
-    let exp = dir.path().join("frames-ci.toml");
+    let exp = dir.path().join("exp.toml");
     std::fs::write(&exp, text).unwrap();
-    let (code, err) = common::sweep(&[
-        exp.as_os_str(),
-        OsStr::new("--backend"),
-        OsStr::new("gpu"),
-        OsStr::new("--out"),
-        out.as_os_str(),
-    ]);
-    assert_eq!(code, 0, "{err}");
-    let mut reader = csv::Reader::from_path(out.join("frames.csv")).unwrap();
-    let header = reader.headers().unwrap().clone();
+    let (gpu, cpu) = common::on_gpu_and_cpu(dir.path(), &exp);
+    let (header, rows) = common::table(&gpu.join("frames.csv"));
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
-    assert_eq!(rows.len(), 2 * 3 * structures, "2 shadings x 3 frames x each structure");
     for r in &rows {
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
         assert!(
             r[col("primitive_tests")].parse::<u64>().unwrap() > 0,
             "GPU work counted: {r:?}"
         );
+    }
+    let report = std::fs::read_to_string(gpu.join("report.md")).unwrap();
+    assert!(report.contains("s on the GPU backend on "), "{report}");
+    let manifest = std::fs::read_to_string(gpu.join("manifest.toml")).unwrap();
+    assert!(manifest.contains("backend = \"gpu\""), "{manifest}");
+    for (file, off, pixels, worst) in common::images_against_cpu(&gpu, &cpu, 1e-3) {
+        assert!(off * 100 <= pixels, "{file}: {off} of {pixels}, worst {worst}");
+    }
+    (header, rows)
+}
+
+/// experiments/frames-ci.toml on the GPU: the classroom's walk under both shadings, every
+/// structure (brute force over its 51K triangles included: the mirror pass runs one reflected
+/// ray's walk per dispatch, so no invocation outgrows an adapter's loop cap), Whitted's frames
+/// tracing shadow rays to the four lights and the mirrors' reflections.
+#[test]
+fn the_ci_walkthrough_runs_on_the_gpu() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let (header, rows) = on_the_gpu_as_on_the_cpu(&ci());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 3 * 5, "2 shadings x 3 frames x 5 structures");
+    let mut reflections = 0;
+    for r in &rows {
         let rays: u64 = r[col("rays")].parse().unwrap();
         match &r[col("shading")] {
             "opengl" => assert_eq!(rays, 32 * 32, "OpenGL-like shading traces camera rays only"),
-            _ => assert!(
-                rays > 4 * 32 * 32,
-                "Whitted: shadow rays to 4 lights and reflections; {rays}"
-            ),
+            _ => assert!(rays > 4 * 32 * 32, "Whitted: shadow rays to 4 lights; {rays}"),
         }
+        reflections += r[col("reflection_rays")].parse::<u64>().unwrap();
     }
-    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("s on the GPU backend on "), "{report}");
-    let manifest = std::fs::read_to_string(out.join("manifest.toml")).unwrap();
-    assert!(manifest.contains("backend = \"gpu\""), "{manifest}");
-    // Against the f64 CPU's frames (the strip's EXRs): radiance within 1e-3 W m^-2 sr^-1 (about
-    // 1e-4 of the brightest pixel's) but on at most 1 % of the pixels, where f32 decides a ray
-    // grazing an edge the other way.
-    let cpu = dir.path().join("cpu");
-    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), cpu.as_os_str()]);
-    assert_eq!(code, 0, "{err}");
-    for shading in ["opengl", "whitted"] {
-        for frame in 0..3 {
-            let file = format!("images/strip_{shading}_{frame}.exr");
-            let (off, pixels, worst) = common::differing_from_cpu(&out, &cpu, &file, 1e-3);
-            eprintln!("{file}: {off} of {pixels} pixels differ from the CPU's, worst {worst}");
-            assert!(off * 100 <= pixels, "{file}: {off} of {pixels}, worst {worst}");
-        }
+    assert!(reflections > 0, "the walk sees the mirrors");
+}
+
+/// The scaling variant (random triangles at two sizes, two viewpoints) on the GPU.
+#[test]
+fn random_scenes_at_two_sizes_run_on_the_gpu() {
+    if common::gpu().is_none() {
+        return;
     }
+    let (_, rows) = on_the_gpu_as_on_the_cpu(&scaling());
+    assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
+}
+
+/// The dynamic variant (the chrome ball rolling on the desk in view) on the GPU: every update
+/// method renders what a rebuild renders, the field's and the BVH's updates uploaded again each
+/// frame.
+#[test]
+fn a_moving_part_runs_on_the_gpu() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let (header, rows) = on_the_gpu_as_on_the_cpu(&moving());
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 2 * 3 * 7, "2 shadings x 3 frames x 7 update methods");
+    assert!(rows.iter().any(|r| &r[col("update")] == "refit"));
 }

@@ -14,9 +14,10 @@
 //! a random camera's first draw do not depend on how many frames follow). Where a folder times
 //! the visibility field the draw is among the field's units; random-triangle scenes are drawn up
 //! to 16K triangles (narrow entries: the wide layout is checked by tests/it/visibility_field_*).
-//! The sweep and fps kinds render on the GPU, and f32 rounds differently on another device: their
-//! folders are compared where the adapter and driver are the committed ones (CI's lavapipe),
-//! and skipped with a note elsewhere or without an adapter.
+//! The sweep, fps and realtime folders and ao-bundles-gpu render on the GPU, and f32 rounds
+//! differently on another device: they are compared where the adapter and driver are the
+//! committed ones (CI's lavapipe, as the manifests record them), and skipped with a note
+//! elsewhere or without an adapter.
 
 use crate::common;
 use penumbra::sampling::rng::Seeded;
@@ -70,10 +71,10 @@ fn kind_of(name: &str) -> Kind {
             tables: &[("runs.csv", REALTIME_ID)],
             gpu: true,
         },
-        "ao" | "ao-bundles" => Kind {
+        "ao" | "ao-bundles" | "ao-bundles-gpu" => Kind {
             units: "ao.csv",
             tables: &[("ao.csv", &["mesh", "structure", "issue"])],
-            gpu: false,
+            gpu: name.ends_with("-gpu"),
         },
         "walkthrough" | "dynamic" | "scaling" => Kind {
             units: "frames.csv",
@@ -116,6 +117,16 @@ fn read_rows(path: &Path) -> Vec<Row> {
                 .collect()
         })
         .collect()
+}
+
+/// The adapter and driver a results folder's manifest records.
+fn device(folder: &Path) -> (String, String) {
+    let path = folder.join("manifest.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let manifest: toml::Table = toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let adapter = &manifest["adapter"];
+    let field = |key: &str| adapter[key].as_str().unwrap_or_default().to_string();
+    (field("name"), field("driver"))
 }
 
 /// The experiment file with relative `scene` and `path` values made absolute (the copy runs from
@@ -287,17 +298,15 @@ fn reproduce(name: &str) -> Option<Vec<String>> {
     }
 
     // GPU numbers are f32 arithmetic on one device and driver: another adapter rounds
-    // differently, so they are compared only where the device is the committed one.
-    let device = |r: &Row| (r.get("adapter").cloned(), r.get("driver").cloned());
-    if let Some(now) = read_rows(&out.join(kind.units)).first().filter(|_| kind.gpu) {
-        if device(now) != device(unit) {
-            eprintln!(
-                "results/{name}: not compared: committed on {:?}, rendered now on {:?}",
-                device(unit),
-                device(now)
-            );
-            return None;
-        }
+    // differently, so they are compared only where the device is the committed one (as each
+    // run's manifest records it).
+    if kind.gpu && device(&out) != device(&committed) {
+        eprintln!(
+            "results/{name}: not compared: committed on {:?}, rendered now on {:?}",
+            device(&committed),
+            device(&out)
+        );
+        return None;
     }
     let mut problems = Vec::new();
     for (table, id) in kind.tables {
@@ -334,6 +343,7 @@ fn reproduce(name: &str) -> Option<Vec<String>> {
 const FOLDERS: &[&str] = &[
     "ao",
     "ao-bundles",
+    "ao-bundles-gpu",
     "body",
     "body-structures",
     "dynamic",
@@ -376,6 +386,7 @@ macro_rules! reproduces {
 reproduces! {
     ao_reproduces: "ao",
     ao_bundles_reproduces: "ao-bundles",
+    ao_bundles_gpu_reproduces: "ao-bundles-gpu",
     body_reproduces: "body",
     body_structures_reproduces: "body-structures",
     dynamic_reproduces: "dynamic",

@@ -213,8 +213,11 @@ fn flat_mirror(name: &str, backend: &mut dyn Backend) {
         .iter()
         .any(|p| matches!(p, Pass::Mirror { .. })));
     let (a1, dispatches) = render(backend, &whitted, &camera, w, h);
+    // The GPU splits the mirror pass: its one bounce a trace, the light's samples and a step,
+    // then the finish.
+    let mirror = if name == "gpu" { 4 } else { 1 };
     assert!(
-        dispatches == 3 || splits(backend),
+        dispatches == 2 + mirror || splits(backend),
         "{name}: primary, shadow, mirror; {dispatches}"
     );
     let (a0, _) = render(backend, &diffuse_only, &camera, w, h);
@@ -507,13 +510,12 @@ fn with_mirrors_in(
 
 use crate::common;
 
-/// Mirror chains under a disk light of many samples: the mirror kernel shades every vertex with
-/// all of a light's samples in one invocation (depth 16 x 4096 samples here), which an adapter
-/// that caps loop iterations (lavapipe: 65535 per loop nest) cannot finish. There the frame is
-/// refused naming the mirror pass, without retrying splits that cannot help; elsewhere it
-/// matches the CPU.
+/// Mirror chains under a disk light of many samples (depth 16 x 4096 samples here): the GPU's
+/// mirror pass shades each bounce's vertices light by light in the shadow pass's chunks, so an
+/// adapter that caps loop iterations (lavapipe: 65535 per loop nest) finishes them as one that
+/// does not, and both match the CPU.
 #[test]
-fn mirror_chains_past_the_loop_cap_are_refused_by_name_and_otherwise_match_the_cpu() {
+fn deep_mirror_chains_under_many_samples_match_the_cpu_on_any_adapter() {
     let Some(mut gpu) = common::gpu() else { return };
     let camera = Camera {
         position: DVec3::new(1.0, 0.0, 1.0),
@@ -542,24 +544,12 @@ fn mirror_chains_past_the_loop_cap_are_refused_by_name_and_otherwise_match_the_c
         height: h,
     };
     let c = CpuBackend::default().render(&scene, view, SAMPLING).unwrap();
-    let before = gpu.dispatches();
-    match gpu.render(&scene, view, SAMPLING) {
-        Err(e) => {
-            let e = format!("{e:#}");
-            assert!(gpu.loop_cap().is_some(), "refused without a loop cap: {e}");
-            assert!(
-                e.contains("mirror chains") && e.contains("16 bounces") && e.contains("CPU backend"),
-                "{e}"
-            );
-            let dispatched = gpu.dispatches() - before;
-            assert!(dispatched < 600, "no futile retries: {dispatched} dispatches");
-        }
-        Ok(g) => {
-            for i in 0..(w * h) as usize {
-                let (a, b) = (c.radiance[i] as f64, g.radiance[i] as f64);
-                assert!((a - b).abs() <= 1e-3 * a, "pixel {i}: cpu {a} gpu {b}");
-            }
-            assert_eq!(g.rays.shadow_total(), c.rays.shadow_total());
-        }
+    let g = gpu.render(&scene, view, SAMPLING).unwrap();
+    for i in 0..(w * h) as usize {
+        let (a, b) = (c.radiance[i] as f64, g.radiance[i] as f64);
+        assert!(a > 0.0, "pixel {i}: the chain brings light back");
+        assert!((a - b).abs() <= 1e-3 * a, "pixel {i}: cpu {a} gpu {b}");
     }
+    assert_eq!(g.rays.shadow_total(), c.rays.shadow_total());
+    assert_eq!(g.rays.reflection, c.rays.reflection);
 }

@@ -126,9 +126,8 @@ impl Declaration for AoSpec {
             rows.extend(o.rows);
             tuning.extend(o.tuning);
         }
-        let device = run.backend.adapter().describe();
         let seconds = run.started.elapsed().as_secs_f64();
-        report::write_ao(self, (&rows, &tuning), &device, seconds, run.out)?;
+        report::write_ao(self, (&rows, &tuning), run.backend.adapter(), seconds, run.out)?;
         tracing::info!("{} rows", rows.len());
         let mut details = toml::Table::new();
         details.insert("rows".into(), (rows.len() as i64).into());

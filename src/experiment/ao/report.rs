@@ -14,6 +14,7 @@ use crate::output::numbers::{per_triangle, thousands};
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{grouped_bars, Bar, Group};
 use crate::output::table::{float, write_rows};
+use crate::render::AdapterInfo;
 use serde::Serialize;
 
 /// A row of ao.csv: what was measured ([`Measured`]) after the mesh, the structure and its
@@ -212,7 +213,7 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
 pub fn write_ao(
     spec: &AoSpec,
     (rows, tuning): (&[AoRow], &[TuningRow]),
-    device: &str,
+    adapter: &AdapterInfo,
     seconds: f64,
     outputs: &Outputs,
 ) -> anyhow::Result<()> {
@@ -324,14 +325,21 @@ pub fn write_ao(
     grouped_bars(
         &out("plots/frame_time.png")?,
         &format!(
-            "AO frame time per mesh: {} rays per hit, {}x{}, CPU f64",
-            spec.ao.rays, spec.width, spec.height
+            "AO frame time per mesh: {} rays per hit, {}x{}, {}",
+            spec.ao.rays,
+            spec.width,
+            spec.height,
+            if on_gpu(adapter) {
+                format!("GPU {}", adapter.name)
+            } else {
+                "CPU f64".into()
+            }
         ),
         "frame time, median (s)",
         &names,
         &groups,
     )?;
-    let report = report(spec, rows, device, seconds);
+    let report = report(spec, rows, adapter, seconds);
     write_atomic(&out("report.md")?, report.as_bytes())?;
     page::write(
         outputs.dir(),
@@ -381,8 +389,15 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
         .collect()
 }
 
-fn report(spec: &AoSpec, rows: &[AoRow], device: &str, seconds: f64) -> String {
+/// Whether the rows were measured on the GPU backend (its bundles and counts are not the CPU's).
+fn on_gpu(adapter: &AdapterInfo) -> bool {
+    adapter.backend == "gpu"
+}
+
+fn report(spec: &AoSpec, rows: &[AoRow], adapter: &AdapterInfo, seconds: f64) -> String {
     let schedule = spec.header.schedule;
+    let device = adapter.describe();
+    let gpu = on_gpu(adapter);
     let tuned: Vec<String> = spec
         .structures
         .iter()
@@ -417,8 +432,13 @@ fn report(spec: &AoSpec, rows: &[AoRow], device: &str, seconds: f64) -> String {
     );
     md += "## Verdict\n\n";
     md += &verdict(spec, rows);
-    md += &open_question(spec, rows);
-    md += "\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited, a kd-tree packet's node once for its rays; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | bytes per triangle | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += &open_question(spec, rows, gpu);
+    let packets = if gpu {
+        "every ray walking on its own (on the GPU a bundle is an order of dispatch, so its counts are the single rays')"
+    } else {
+        "a kd-tree packet's node once for its rays"
+    };
+    md += &format!("\n## Ours\n\nFrame seconds: median [95 % interval]; nodes and tests: per frame, deterministic (nodes: tree nodes, or the field's tiles and tile-BSP leaves, visited, {packets}; tests: ray-triangle tests).\n\n| mesh | triangles | structure | parameters | build s | MB | bytes per triangle | frame s | Mrays/s | nodes | tests | same image |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         md += &format!(
             "| {} | {} | {} | {} | {:.2} | {:.1} | {} | {} | {:.2} | {:.3e} | {:.3e} | {} |\n",
@@ -466,8 +486,8 @@ fn report(spec: &AoSpec, rows: &[AoRow], device: &str, seconds: f64) -> String {
 /// A structure and how its rays were issued.
 type Variant<'a> = (&'a str, Issue);
 
-/// Every (structure, issue) the experiment timed, structures in file order (a structure without
-/// bundles of its own is timed with single rays only).
+/// Every (structure, issue) the experiment timed, structures in file order (on the CPU a
+/// structure without bundles of its own is timed with single rays only).
 fn variants(spec: &AoSpec, rows: &[AoRow]) -> Vec<(&'static str, Issue)> {
     spec.structures
         .iter()
@@ -481,7 +501,7 @@ fn variants(spec: &AoSpec, rows: &[AoRow]) -> Vec<(&'static str, Issue)> {
 /// against every other structure with the rays issued the same way, and what bundling gains
 /// each structure; one cell per mesh, `other`'s time over `subject`'s with its interval and the
 /// rule's word.
-pub fn open_question(spec: &AoSpec, rows: &[AoRow]) -> String {
+pub fn open_question(spec: &AoSpec, rows: &[AoRow], gpu: bool) -> String {
     if spec.issues.len() < 2 && spec.structures.len() < 3 {
         return String::new();
     }
@@ -505,7 +525,12 @@ pub fn open_question(spec: &AoSpec, rows: &[AoRow]) -> String {
             (s, Issue::Single),
         ));
     }
-    let mut md = "\n### The open question: SAH and ray bundles\n\nThe paper closes by asking how the field fares when a better split heuristic (SAH) and ray bundles are given to both algorithms. Each cell: the first named's frame time over the second's, median of per-round ratios with its 95 % interval, and the rule's word for the second (faster: above 1 beyond noise). Bundled: the AO rays of one grid line for 4096 receivers at a time, the field walking them in tile order, the kd-trees in packets of 8 (f32 SIMD lanes for the walk, f64 lanes for the triangle tests); a structure without bundles of its own (the BVHs) is timed with single rays only, its best order.\n\n| comparison |".to_string();
+    let bundled = if gpu {
+        "Bundled, on the GPU: the AO rays issued direction-major, one dispatch per grid line with every receiver's ray along it, so the invocations running side by side walk one direction's part of a structure (each ray still walks on its own: the order, not the walk, is what changes, and every structure can take it)"
+    } else {
+        "Bundled: the AO rays of one grid line for 4096 receivers at a time, the field walking them in tile order, the kd-trees in packets of 8 (f32 SIMD lanes for the walk, f64 lanes for the triangle tests); a structure without bundles of its own (the BVHs) is timed with single rays only, its best order"
+    };
+    let mut md = format!("\n### The open question: SAH and ray bundles\n\nThe paper closes by asking how the field fares when a better split heuristic (SAH) and ray bundles are given to both algorithms. Each cell: the first named's frame time over the second's, median of per-round ratios with its 95 % interval, and the rule's word for the second (faster: above 1 beyond noise). {bundled}.\n\n| comparison |");
     for m in &spec.meshes {
         md += &format!(" {} |", m.name);
     }

@@ -258,6 +258,7 @@ pub fn run_mesh(
     progress: &Progress,
 ) -> anyhow::Result<MeshOutcome> {
     let schedule = spec.header.schedule;
+    let on_gpu = backend.adapter().backend == "gpu";
     let bar = progress.bar(&format!("{}: structures", mesh.name), spec.structures.len() as u64);
     let mut out = MeshOutcome::default();
     let mut first: Option<Vec<f32>> = None;
@@ -268,7 +269,9 @@ pub fn run_mesh(
         out.tuning.extend(tried);
         // One build per structure: each way of issuing the rays shares it.
         let built = ao_scene(spec, mesh, settings.clone())?;
-        let bundles = built.accel.as_ref().is_some_and(|a| a.bundles());
+        // On the GPU a bundle is an order of dispatch, which every structure can take; on the
+        // CPU only a structure with a bundle walk of its own has one.
+        let bundles = on_gpu || built.accel.as_ref().is_some_and(|a| a.bundles());
         for &issue in spec.issues.iter().filter(|&&i| i == Issue::Single || bundles) {
             let scene = built.clone().with_ambient(Some(AmbientOcclusion {
                 issue,

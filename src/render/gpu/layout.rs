@@ -127,6 +127,9 @@ pub struct PassInfo {
 
 /// Bytes per pixel of the hit buffer (WGSL `Hit`).
 pub const HIT_BYTES: u64 = 48;
+/// Bytes per pixel of the mirror pass's chain buffer (WGSL `Chain`: two hits, the ray's direction
+/// and weight, and its running sums).
+pub const CHAIN_BYTES: u64 = 2 * HIT_BYTES + 48;
 
 const _: () = assert!(std::mem::size_of::<Params>() == 128);
 const _: () = assert!(std::mem::size_of::<GpuMeshTri>() == 32);

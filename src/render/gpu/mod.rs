@@ -3,9 +3,9 @@
 //! Setup (adapter, device with the adapter's real limits, pipelines, the loop-cap probe) happens
 //! once in [`GpuBackend::new`]; the scene's geometry is uploaded once and stays resident
 //! ([`resources`]); each frame runs the plan's passes (primary; one shadow pass per light, or
-//! the direct pass over every light where the scene has no shadows; Whitted's mirror chains and
-//! the ambient-occlusion pass where the scene asks; each in one dispatch or, on adapters that
-//! cap loop iterations, several) with a timestamp pair around each pass when the adapter
+//! the direct pass over every light where the scene has no shadows; Whitted's mirror chains, per
+//! bounce a trace, the lights' chunks and a step; the ambient-occlusion pass where the scene asks;
+//! each in one dispatch per step or, on adapters that cap loop iterations, per chunk) with a timestamp pair around each pass when the adapter
 //! supports timestamp queries, and reads the outputs back. Where switched on
 //! ([`Backend::count_work`]), frames read back count their work (queries, nodes, primitive tests)
 //! in atomics the kernels add to once per invocation; timed frames never count.
@@ -39,7 +39,7 @@ pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; the count of
 /// invocations whose loops were cut short; then as (low, high) words ambient-occlusion rays,
 /// reflection rays, and the work of frames that count it (queries, nodes, primitive tests); the
-/// count of mirror-chain invocations whose loops were cut short.
+/// count of reflected rays whose closest-hit walk was cut short (no smaller chunk helps those).
 pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 12;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
@@ -165,7 +165,7 @@ impl GpuBackend {
 
     /// Checks every buffer a frame needs against the adapter's binding and buffer limits, naming
     /// the buffer and the excess.
-    fn check_limits(&self, packed: &layout::Packed, view: View) -> anyhow::Result<()> {
+    fn check_limits(&self, packed: &layout::Packed, view: View, plan: &RenderPlan) -> anyhow::Result<()> {
         let limits = self.device.limits();
         let structure = packed.accel.as_ref().map(|(name, s)| (*name, s.buffers.len() as u32));
         storage_buffers_fit(
@@ -190,6 +190,9 @@ impl GpuBackend {
             ),
             ("ambient-occlusion buffer", view.pixels() as u64 * 8),
         ];
+        if plan.passes.iter().any(|p| matches!(p, Pass::Mirror { .. })) {
+            buffers.push(("mirror chain buffer", view.pixels() as u64 * layout::CHAIN_BYTES));
+        }
         if let Some((_, s)) = &packed.accel {
             buffers.extend(s.buffers.iter().map(|(label, b)| (*label, b.len() as u64)));
         }
@@ -226,26 +229,38 @@ impl GpuBackend {
                 label: None,
                 timestamp_writes,
             });
-            // The primary and mirror passes ignore group 1; a shadow pass runs one dispatch per
-            // sample chunk; the direct pass runs the shadow kernel (without occlusion tests) over
-            // every light's chunks.
-            let (pipeline, chunks): (_, Vec<&wgpu::BindGroup>) = match pass {
-                Pass::Primary { .. } => (&p.primary, vec![&r.passes[0][0]]),
-                Pass::Shadow { light, .. } => (&p.shadow, r.passes[*light].iter().collect()),
-                Pass::Direct { .. } => (&p.shadow, r.passes.iter().flatten().collect()),
-                Pass::Mirror { .. } => (&p.mirror, vec![&r.passes[0][0]]),
-                Pass::Ambient { .. } => (&p.ambient, r.ambient_passes.iter().collect()),
+            // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk;
+            // the direct pass runs the shadow kernel (without occlusion tests) over every light's
+            // chunks; the mirror pass, per bounce, a trace, every light's chunks and a step, then
+            // its finish (each dispatch sees the previous one's writes).
+            let every_light = || r.passes.iter().flatten();
+            let steps: Vec<(&wgpu::ComputePipeline, &wgpu::BindGroup)> = match pass {
+                Pass::Primary { .. } => vec![(&p.primary, &r.passes[0][0])],
+                Pass::Shadow { light, .. } => r.passes[*light].iter().map(|c| (&p.shadow, c)).collect(),
+                Pass::Direct { .. } => every_light().map(|c| (&p.shadow, c)).collect(),
+                Pass::Mirror { .. } => {
+                    let m = &p.mirror;
+                    let mut steps = Vec::new();
+                    for bounce in &r.mirror_passes {
+                        steps.push((&m.trace, bounce));
+                        steps.extend(every_light().map(|c| (&m.shade, c)));
+                        steps.push((&m.step, bounce));
+                    }
+                    steps.push((&m.finish, &r.passes[0][0]));
+                    steps
+                }
+                Pass::Ambient { .. } => r.ambient_passes.iter().map(|c| (&p.ambient, c)).collect(),
             };
-            cp.set_pipeline(pipeline);
             cp.set_bind_group(0, &r.bind0, &[]);
             if r.accel != NO_ACCEL {
                 cp.set_bind_group(2, &r.accel_group, &[]);
             }
-            for chunk in &chunks {
-                cp.set_bind_group(1, *chunk, &[]);
+            for (pipeline, info) in &steps {
+                cp.set_pipeline(pipeline);
+                cp.set_bind_group(1, *info, &[]);
                 cp.dispatch_workgroups(groups.0, groups.1, 1);
             }
-            self.dispatches.set(self.dispatches.get() + chunks.len() as u64);
+            self.dispatches.set(self.dispatches.get() + steps.len() as u64);
         }
     }
 
@@ -309,12 +324,10 @@ impl GpuBackend {
     /// can help (a BVH deeper than the traversal stack) and the frame is an error, never a silent
     /// answer.
     fn whole(&mut self, counters: &[u32], packed: &layout::Packed) -> anyhow::Result<bool> {
-        let chains = counters[CUT_SHORT_SLOT + 11];
-        if chains > 0 {
-            let samples: u32 = packed.lights.iter().map(|l| l.samples).sum();
+        let walks = counters[CUT_SHORT_SLOT + 11];
+        if walks > 0 {
             bail!(
-                "{chains} GPU invocations of Whitted's mirror chains ended a loop early: {} bounces, each shading every light with all its samples ({samples} in all) in one invocation, run past this adapter's loop cap {:?}, and the mirror pass is not split further; use the CPU backend for this scene",
-                packed.params.mirror_depth,
+                "{walks} GPU invocations of the mirror pass ended a reflected ray's closest-hit walk early: one query runs past this adapter's loop cap {:?} (or a BVH is deeper than the traversal stack), which no split of the pass can help; use the CPU backend for this scene",
                 self.loop_cap
             );
         }
@@ -374,7 +387,7 @@ impl Backend for GpuBackend {
         let plan = RenderPlan::new(scene, view)?;
         let mut packed = pack(scene, view, sampling)?;
         packed.params.stats = self.count_work as u32;
-        self.check_limits(&packed, view)?;
+        self.check_limits(&packed, view, &plan)?;
         let lights = scene.lights.len();
         let (r, counters) = loop {
             let r = self.resources(&packed, view, &plan, 0)?;
@@ -449,7 +462,7 @@ impl Backend for GpuBackend {
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
         let packed = pack(scene, view, sampling)?;
-        self.check_limits(&packed, view)?;
+        self.check_limits(&packed, view, &plan)?;
         loop {
             let r = self.resources(&packed, view, &plan, 0)?;
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;

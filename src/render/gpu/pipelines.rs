@@ -46,6 +46,14 @@ pub(super) struct Layouts {
     pub hooks: wgpu::BindGroupLayout,
 }
 
+/// The mirror pass's kernels (render.wgsl's `mirror_*`).
+pub(super) struct MirrorPipelines {
+    pub trace: wgpu::ComputePipeline,
+    pub shade: wgpu::ComputePipeline,
+    pub step: wgpu::ComputePipeline,
+    pub finish: wgpu::ComputePipeline,
+}
+
 /// One structure's pipelines.
 pub(super) struct Pipelines {
     /// Its buffers' layout (group 2).
@@ -53,7 +61,8 @@ pub(super) struct Pipelines {
     pub primary: wgpu::ComputePipeline,
     /// Also the plan's `direct` pass (`Params::shadows` off).
     pub shadow: wgpu::ComputePipeline,
-    pub mirror: wgpu::ComputePipeline,
+    /// The split mirror pass: per bounce a trace, shading chunks and a step; then a finish.
+    pub mirror: MirrorPipelines,
     pub ambient: wgpu::ComputePipeline,
     #[cfg(feature = "test-hooks")]
     hooks: Option<(wgpu::ComputePipeline, wgpu::ComputePipeline)>,
@@ -89,7 +98,7 @@ impl Layouts {
     pub fn new(device: &wgpu::Device) -> Layouts {
         // params; spheres, planes, lights, shared points; hits, visibility, radiance, counters;
         // mesh triangles; AO directions and output; the sampling schemes' tables; mirror weights;
-        // the lights' running sums between sample chunks.
+        // the lights' running sums between sample chunks; the mirror chains between bounces.
         let mut entries = vec![uniform(0)];
         entries.extend((1..=4).map(|b| storage(b, true)));
         entries.extend((5..=8).map(|b| storage(b, false)));
@@ -100,6 +109,7 @@ impl Layouts {
             storage(12, true),
             storage(13, true),
             storage(14, false),
+            storage(15, false),
         ]);
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -228,7 +238,12 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
     Pipelines {
         primary: entry(device, &module, "primary", &layout),
         shadow: entry(device, &module, "shadow", &layout),
-        mirror: entry(device, &module, "mirror", &layout),
+        mirror: MirrorPipelines {
+            trace: entry(device, &module, "mirror_trace", &layout),
+            shade: entry(device, &module, "mirror_shade", &layout),
+            step: entry(device, &module, "mirror_step", &layout),
+            finish: entry(device, &module, "mirror_finish", &layout),
+        },
         ambient: entry(device, &module, "ambient", &layout),
         accel,
         #[cfg(feature = "test-hooks")]

@@ -4,17 +4,20 @@
 //! timestamp queries) is made for each call. Timed repeats and warm-up frames of one call run
 //! over the same resources, and successive calls on one scene upload no geometry.
 
-use super::layout::{GpuLight, Packed, PassInfo, HIT_BYTES};
+use super::layout::{GpuLight, Packed, PassInfo, CHAIN_BYTES, HIT_BYTES};
 use super::pipelines::NO_ACCEL;
 use super::GpuBackend;
 use super::{COUNTER_WORDS, CUT_SHORT_SLOT};
 use crate::fingerprint::fnv1a;
-use crate::render::{plan::RenderPlan, View};
+use crate::render::plan::{Pass, RenderPlan};
+use crate::render::View;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 /// `PassInfo.light` of the AO pass's dispatches (no light has this index).
 const AMBIENT_PASS: u32 = u32::MAX;
+/// `PassInfo.light` of the mirror pass's trace and step dispatches (`first_sample`: the bounce).
+const MIRROR_PASS: u32 = u32::MAX - 1;
 
 /// The scene's static buffers and the hash of the packed content they hold.
 pub(super) struct SceneBuffers {
@@ -42,6 +45,8 @@ pub(super) struct FrameResources {
     pub radiance: wgpu::Buffer,
     /// Per light and pixel, the running sum of its sample terms between chunks.
     pub light_sums: wgpu::Buffer,
+    /// One bind group per bounce of the mirror pass (none without the pass).
+    pub mirror_passes: Vec<wgpu::BindGroup>,
     /// Per pixel, the AO pass's (unoccluded, total) weights.
     pub ambient: wgpu::Buffer,
     /// One bind group per dispatch of the AO pass's rays (none without the pass).
@@ -174,6 +179,11 @@ impl GpuBackend {
         );
         let radiance = self.output("radiance", pixels * 4);
         let light_sums = self.output("light sums", pixels * packed.lights.len().max(1) as u64 * 4);
+        let depth = plan.passes.iter().find_map(|p| match p {
+            Pass::Mirror { max_depth, .. } => Some(*max_depth),
+            _ => None,
+        });
+        let chains = self.output("mirror chains", if depth.is_some() { pixels * CHAIN_BYTES } else { 16 });
         let counters = self.output("ray counters", COUNTER_WORDS as u64 * 4);
         let ao_dirs = self.storage("ambient-occlusion directions", &packed.ao_dirs, [0f32; 4]);
         let ao_on = packed.params.ao_rays > 0;
@@ -195,6 +205,7 @@ impl GpuBackend {
             &tables,
             &s.mirrors,
             &light_sums,
+            &chains,
         ];
         let entries: Vec<_> = buffers
             .iter()
@@ -235,6 +246,9 @@ impl GpuBackend {
         })
             .map(|c| self.pass_info(AMBIENT_PASS, c * ao_chunk, ao_chunk))
             .collect();
+        let mirror_passes = (0..depth.unwrap_or(0))
+            .map(|bounce| self.pass_info(MIRROR_PASS, bounce, 0))
+            .collect();
         let queries = self.timestamps.then(|| {
             let count = 2 * plan.passes.len().max(1) as u32;
             let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -257,6 +271,7 @@ impl GpuBackend {
             visibility,
             radiance,
             light_sums,
+            mirror_passes,
             ambient,
             ambient_passes,
             counters,

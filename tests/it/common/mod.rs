@@ -285,14 +285,58 @@ pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
     rows
 }
 
-/// Pixels of the GPU's image `gpu` that differ from the CPU's `cpu` (same file name in both
-/// results folders) by more than `step`, and the largest difference: f32 against f64 decides a
-/// grazing ray the other way now and then, which moves a pixel by about one ray's weight.
-pub fn differing_from_cpu(gpu: &std::path::Path, cpu: &std::path::Path, file: &str, step: f32) -> (usize, usize, f32) {
-    let (g, _) = browser::exr(&gpu.join(file)).unwrap();
-    let (c, _) = browser::exr(&cpu.join(file)).unwrap();
-    assert_eq!(g.len(), c.len(), "{file}");
-    let diff: Vec<f32> = g.iter().zip(&c).map(|(a, b)| (a - b).abs()).collect();
-    let worst = diff.iter().cloned().fold(0.0, f32::max);
-    (diff.iter().filter(|&&d| d > step).count(), diff.len(), worst)
+/// Runs experiment file `exp` (an ao or frames kind, whose default backend is the f64 CPU)
+/// twice: with `--backend gpu` into `dir/gpu`, then as written into `dir/cpu`; returns both
+/// folders.
+pub fn on_gpu_and_cpu(dir: &std::path::Path, exp: &std::path::Path) -> (PathBuf, PathBuf) {
+    let (gpu, cpu) = (dir.join("gpu"), dir.join("cpu"));
+    let gpu_args = [
+        exp.as_os_str(),
+        "--backend".as_ref(),
+        "gpu".as_ref(),
+        "--out".as_ref(),
+        gpu.as_os_str(),
+    ];
+    let (code, err) = sweep(&gpu_args);
+    assert_eq!(code, 0, "on the GPU: {err}");
+    let (code, err) = sweep(&[exp.as_os_str(), "--out".as_ref(), cpu.as_os_str()]);
+    assert_eq!(code, 0, "on the CPU: {err}");
+    (gpu, cpu)
+}
+
+/// A results table: its header and rows.
+pub fn table(path: &std::path::Path) -> (csv::StringRecord, Vec<csv::StringRecord>) {
+    let mut reader = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header = reader.headers().unwrap().clone();
+    (header, reader.records().map(Result::unwrap).collect())
+}
+
+/// Every image the GPU's run wrote (`gpu/images/*.exr`) against the CPU's of the same name:
+/// (file, pixels differing by more than `step`, pixels, largest difference). f32 against f64
+/// decides a grazing ray the other way now and then, which moves a pixel by about one ray's
+/// weight.
+pub fn images_against_cpu(gpu: &std::path::Path, cpu: &std::path::Path, step: f32) -> Vec<(String, usize, usize, f32)> {
+    let mut files: Vec<String> = std::fs::read_dir(gpu.join("images"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|f| f.ends_with(".exr"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "{}: no images", gpu.display());
+    files
+        .into_iter()
+        .map(|file| {
+            let (g, _) = browser::exr(&gpu.join("images").join(&file)).unwrap();
+            let (c, _) = browser::exr(&cpu.join("images").join(&file)).unwrap();
+            assert_eq!(g.len(), c.len(), "{file}");
+            let diff: Vec<f32> = g.iter().zip(&c).map(|(a, b)| (a - b).abs()).collect();
+            let worst = diff.iter().cloned().fold(0.0, f32::max);
+            let off = diff.iter().filter(|&&d| d > step).count();
+            eprintln!(
+                "{file}: {off} of {} pixels differ from the CPU's by more than {step}, worst {worst}",
+                diff.len()
+            );
+            (file, off, diff.len(), worst)
+        })
+        .collect()
 }

@@ -1,12 +1,12 @@
 // The render plan's passes: `primary` (camera rays, closest hit), `shadow` (per light, one
 // dispatch per chunk of its samples, any-hit with early exit; with `params.shadows` off the
-// same kernel is the plan's `direct` pass: every target visible, no rays), `mirror` (Whitted's
-// mirror chains, src/render/mirror.rs) and `ambient` (where the scene asks for ambient
-// occlusion, one dispatch per chunk of its rays). Mirrors src/render/cpu.rs and
-// src/render/shading.rs in f32, in coordinates re-based on the camera's look-at point so that
-// large translations cost nothing. Shapes' structs and tests come from src/scene/shape/*.wgsl,
-// mesh queries from the scene's acceleration structure (accel_closest, accel_any), which counts
-// its nodes and primitive tests into `work_nodes` and `work_prims`.
+// same kernel is the plan's `direct` pass: every target visible, no rays), `mirror_*`
+// (Whitted's mirror chains, src/render/mirror.rs, split per bounce) and `ambient` (where the
+// scene asks for ambient occlusion, one dispatch per chunk of its rays). Mirrors
+// src/render/cpu.rs and src/render/shading.rs in f32, in coordinates re-based on the camera's
+// look-at point so that large translations cost nothing. Shapes' structs and tests come from
+// src/scene/shape/*.wgsl, mesh queries from the scene's acceleration structure (accel_closest,
+// accel_any), which counts its nodes and primitive tests into `work_nodes` and `work_prims`.
 
 struct Params {
     width: u32,
@@ -357,52 +357,132 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
     finish_invocation(CUT_SHORT_SLOT);
 }
 
-// Whitted's mirror chain from the pixel's receiver (src/render/mirror.rs in f32): the reflected
-// ray's closest hit, shaded from every light with all its samples (shadow rays where the scene
-// has shadows), followed again where it reflects, up to `params.mirror_depth` bounces. Radiance
-// leaving a vertex is (1 - m) x diffuse + m x reflected; a chain cut at the depth limit or
-// leaving the scene brings back nothing.
+// Whitted's mirror chains (src/render/mirror.rs in f32), split so that no invocation runs more
+// than one query's walk or one chunk of a light's samples: per bounce, `mirror_trace` follows
+// each pixel's reflected ray to its closest hit, `mirror_shade` shades that vertex from every
+// light, chunk by chunk as the shadow pass does (shadow rays where the scene has shadows), and
+// `mirror_step` folds it into the chain and turns the ray; `mirror_finish` adds what the chain
+// brought back. Radiance leaving a vertex is (1 - m) x diffuse + m x reflected; a chain cut at
+// the depth limit or leaving the scene brings back nothing more. The chain lives in `chains`
+// between the dispatches; `pass_info.first_sample` is the bounce.
+const CHAIN_NONE: u32 = 0u;
+const CHAIN_LIVE: u32 = 1u;
+const CHAIN_ENDED: u32 = 2u;
+
+// One pixel's mirror chain between the mirror pass's dispatches.
+struct Chain {
+    // The vertex the next reflected ray leaves.
+    at: Hit,
+    // The vertex the last reflected ray reached: shaded, then folded in.
+    next: Hit,
+    dir: vec3<f32>,
+    weight: f32,
+    reflected: f32,
+    // `next`'s irradiance over the lights shaded so far, and the light being shaded's samples
+    // gathered so far (its chunks' carry, as `light_sums` is the shadow pass's).
+    irradiance: f32,
+    visible: f32,
+    sum: f32,
+    state: u32,
+    _c0: u32,
+    _c1: u32,
+    _c2: u32,
+}
+
+@group(0) @binding(15) var<storage, read_write> chains: array<Chain>;
+
 @compute @workgroup_size(8, 8)
-fn mirror(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn mirror_trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
     let pixel = gid.y * params.width + gid.x;
-    var at = hits[pixel];
-    if (at.object == NO_HIT || at.mirror == 0.0) {
+    var c: Chain;
+    if (pass_info.first_sample == 0u) {
+        c.at = hits[pixel];
+        c.reflected = 0.0;
+        c.state = CHAIN_NONE;
+        if (c.at.object != NO_HIT && c.at.mirror != 0.0) {
+            c.state = CHAIN_LIVE;
+            c.weight = c.at.mirror;
+            c.dir = normalize(reflect(camera_ray(gid.xy)[1], c.at.normal));
+        }
+    } else {
+        c = chains[pixel];
+    }
+    if (c.state == CHAIN_LIVE) {
+        let origin = select(c.at.position, offset_origin(c.at.position, c.at.normal), c.at.triangle != NO_HIT);
+        c.next = closest(origin, c.dir, c.at.triangle);
+        if (c.next.object == NO_HIT) {
+            c.state = CHAIN_ENDED;
+        }
+        c.irradiance = 0.0;
+        c.visible = 0.0;
+        c.sum = 0.0;
+        add_wide(REFLECTION_RAYS_SLOT, 1u);
+    }
+    chains[pixel] = c;
+    // A closest-hit walk past the loop cap cannot be split further: its own slot.
+    finish_invocation(MIRROR_CUT_SLOT);
+}
+
+@compute @workgroup_size(8, 8)
+fn mirror_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
-    var weight = at.mirror;
-    var dir = normalize(reflect(camera_ray(gid.xy)[1], at.normal));
-    var reflected = 0.0;
-    var bounces = 0u;
-    // A flag rather than a break: lavapipe miscompiled early exits from loops under divergence.
-    var left_scene = false;
-    var b = 0u;
-    for (; b < params.mirror_depth && weight != 0.0 && !left_scene; b++) {
-        bounces += 1u;
-        let origin = select(at.position, offset_origin(at.position, at.normal), at.triangle != NO_HIT);
-        let next = closest(origin, dir, at.triangle);
-        left_scene = next.object == NO_HIT;
-        if (!left_scene && next.mirror < 1.0) {
-            var irradiance = 0.0;
-            for (var li = 0u; li < params.light_count; li++) {
-                let s = sample_light(li, next, 0u, lights[li].samples, gid.xy, pixel, LightSample(0.0, 0.0, 0u));
-                irradiance += light_finish(li, s).y;
-                add_wide(2u * li, s.rays);
-            }
-            reflected += weight * (1.0 - next.mirror) * next.albedo / PI * irradiance;
-        }
-        if (!left_scene) {
-            weight *= next.mirror;
-            dir = normalize(reflect(dir, next.normal));
-            at = next;
-        }
+    let pixel = gid.y * params.width + gid.x;
+    let li = pass_info.light;
+    let c = chains[pixel];
+    if (li >= params.light_count || c.state != CHAIN_LIVE || c.next.mirror >= 1.0) {
+        return;
     }
-    cut_short = cut_short || (b < params.mirror_depth && weight != 0.0 && !left_scene);
-    radiance[pixel] += reflected;
-    add_wide(REFLECTION_RAYS_SLOT, bounces);
-    finish_invocation(MIRROR_CUT_SLOT);
+    let first = pass_info.first_sample;
+    let s = sample_light(li, c.next, first, pass_info.sample_count, gid.xy, pixel, LightSample(c.visible, c.sum, 0u));
+    let samples = lights[li].samples;
+    if (pass_info.sample_count >= samples - min(first, samples)) {
+        chains[pixel].irradiance = c.irradiance + light_finish(li, s).y;
+        chains[pixel].visible = 0.0;
+        chains[pixel].sum = 0.0;
+    } else {
+        chains[pixel].visible = s.visible;
+        chains[pixel].sum = s.sum;
+    }
+    add_wide(2u * li, s.rays);
+    finish_invocation(CUT_SHORT_SLOT);
+}
+
+@compute @workgroup_size(8, 8)
+fn mirror_step(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    var c = chains[pixel];
+    if (c.state != CHAIN_LIVE) {
+        return;
+    }
+    if (c.next.mirror < 1.0) {
+        c.reflected += c.weight * (1.0 - c.next.mirror) * c.next.albedo / PI * c.irradiance;
+    }
+    c.weight *= c.next.mirror;
+    c.dir = normalize(reflect(c.dir, c.next.normal));
+    c.at = c.next;
+    if (c.weight == 0.0) {
+        c.state = CHAIN_ENDED;
+    }
+    chains[pixel] = c;
+}
+
+@compute @workgroup_size(8, 8)
+fn mirror_finish(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let pixel = gid.y * params.width + gid.x;
+    if (chains[pixel].state != CHAIN_NONE) {
+        radiance[pixel] += chains[pixel].reflected;
+    }
 }
 
 // Ambient occlusion (src/render/ambient.rs in f32): rays `first_sample ..` of the pass's chunk
