@@ -337,6 +337,39 @@ fn cases() -> Vec<Case> {
     c.files = files;
     c.env = vec![("PENUMBRA_MEMORY_BYTES", "4000000000")];
     v.push(c);
+    // Nested triangles sharing a corner, each 1/sqrt(2) the last: the builders peel them off one
+    // by one, a tree deeper than the GPU's traversal stack, refused before any work on the GPU.
+    let nested: String = (0..200)
+        .map(|i| {
+            let s = 0.3 * 0.5f64.powf(i as f64 / 2.0);
+            format!(
+                "v 0 0 0.5\nv {s:e} 0 0.5\nv 0 {s:e} 0.5\nf {} {} {}\n",
+                3 * i + 1,
+                3 * i + 2,
+                3 * i + 3
+            )
+        })
+        .collect();
+    for (structure, depth) in [("bvh", "the BVH is"), ("cwbvh", "the CWBVH is")] {
+        let (text, mut files) =
+            with_scene(&|t: String| format!("accelerator = \"{structure}\"\n{t}\n[[meshes]]\npath = \"nested.obj\"\n"));
+        files.push(("nested.obj", nested.clone().into_bytes()));
+        let mut c = case(
+            "a tree deeper than the GPU's traversal stack, on the GPU",
+            "tiny",
+            text,
+            &[
+                "s.toml",
+                "key `accelerator`",
+                depth,
+                "levels deep",
+                "backend = \"cpu\" or \"auto\"",
+            ],
+        );
+        c.files = files;
+        c.args = vec!["--backend", "gpu"];
+        v.push(c);
+    }
     v.push(case(
         "a light as large as the world",
         "tiny",

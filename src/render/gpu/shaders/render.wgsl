@@ -120,8 +120,21 @@ fn occluded(origin: vec3<f32>, d: vec3<f32>, skip: u32, skip_tri: u32) -> bool {
     return blocked(origin, d / len, len, skip, skip_tri);
 }
 
+// Moves the invocation's node and test counts into the frame's 64-bit counters once either
+// reaches 2^31, so that no private u32 wraps however many queries an invocation asks (each query
+// counts fewer than 2^31). Called before every query.
+fn keep_counts_narrow() {
+    if (params.stats != 0u && max(work_nodes, work_prims) >= 0x80000000u) {
+        add_wide(NODES_SLOT, work_nodes);
+        add_wide(PRIMS_SLOT, work_prims);
+        work_nodes = 0u;
+        work_prims = 0u;
+    }
+}
+
 // Any-hit along origin + t dir, 0 < t < len (len may be infinite), with the same skips.
 fn blocked(origin: vec3<f32>, dir: vec3<f32>, len: f32, skip: u32, skip_tri: u32) -> bool {
+    keep_counts_narrow();
     work_queries += 1u;
     var i = 0u;
     for (; i < params.sphere_count; i++) {
@@ -158,6 +171,7 @@ fn camera_ray(xy: vec2<u32>) -> array<vec3<f32>, 2> {
 // to the lower object id as on the CPU, then the accelerator within the distance found; the
 // point re-projected onto analytic surfaces, the normal facing the ray.
 fn closest(origin: vec3<f32>, dir: vec3<f32>, skip_tri: u32) -> Hit {
+    keep_counts_narrow();
     work_queries += 1u;
     work_prims += params.sphere_count + params.plane_count;
     // `best` indexes spheres, then planes.
@@ -231,8 +245,8 @@ fn add_wide(slot: u32, n: u32) {
 }
 
 // The end of every kernel: the invocation's work where the frame counts it, and whether a loop
-// was cut short, counted at `cut_slot` (the mirror kernel has its own: splitting the shadow and
-// AO passes further cannot help it).
+// was cut short, counted at `cut_slot` (the mirror pass's trace has its own: a single walk past
+// the cap is one no smaller chunk of samples can help).
 fn finish_invocation(cut_slot: u32) {
     if (params.stats != 0u) {
         add_wide(QUERIES_SLOT, work_queries);
