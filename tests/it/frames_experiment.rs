@@ -484,13 +484,28 @@ fn on_the_gpu_as_on_the_cpu(text: &str) -> (csv::StringRecord, Vec<csv::StringRe
     std::fs::write(&exp, text).unwrap();
     let (gpu, cpu) = common::on_gpu_and_cpu(dir.path(), &exp);
     let (header, rows) = common::table(&gpu.join("frames.csv"));
+    let (cpu_header, cpu_rows) = common::table(&cpu.join("frames.csv"));
+    assert_eq!(header, cpu_header);
+    assert_eq!(rows.len(), cpu_rows.len());
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    for r in &rows {
+    let count = |r: &csv::StringRecord, name: &str| -> u64 { r[col(name)].parse().unwrap() };
+    for (r, c) in rows.iter().zip(&cpu_rows) {
+        for id in ["triangles", "structure", "update", "shading", "viewpoint", "frame"] {
+            assert_eq!(r[col(id)], c[col(id)], "the same row order: {r:?} {c:?}");
+        }
         assert_eq!(&r[col("differing_pixels")], "0", "{r:?}");
+        assert!(count(r, "primitive_tests") > 0, "GPU work counted: {r:?}");
         assert!(
-            r[col("primitive_tests")].parse::<u64>().unwrap() > 0,
-            "GPU work counted: {r:?}"
+            count(r, "nodes_visited") > 0 || &r[col("structure")] == "brute",
+            "{r:?}"
         );
+        assert_eq!(count(r, "queries"), count(r, "rays"), "a query per ray: {r:?}");
+        // The same rays as the CPU's but where f32 sends a grazing ray to another surface.
+        assert_eq!(count(r, "primary_rays"), count(c, "primary_rays"), "{r:?}");
+        for kind in ["rays", "shadow_rays", "reflection_rays"] {
+            let (g, f) = (count(r, kind), count(c, kind));
+            assert!(g.abs_diff(f) * 100 <= f + 100, "{kind}: GPU {g}, CPU {f}: {r:?}");
+        }
     }
     let report = std::fs::read_to_string(gpu.join("report.md")).unwrap();
     assert!(report.contains("s on the GPU backend on "), "{report}");
@@ -536,9 +551,8 @@ fn random_scenes_at_two_sizes_run_on_the_gpu() {
     assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
 }
 
-/// The dynamic variant (the chrome ball rolling on the desk in view) on the GPU: every update
-/// method renders what a rebuild renders, the field's and the BVH's updates uploaded again each
-/// frame.
+/// The dynamic variant (the chrome ball rolling on the desk in view, in the wall mirrors and in
+/// itself) on the GPU: every update method renders what a rebuild renders.
 #[test]
 fn a_moving_part_runs_on_the_gpu() {
     if common::gpu().is_none() {

@@ -162,11 +162,10 @@ impl Declaration for FramesSpec {
             outcome.scenes.extend(o.scenes);
             outcome.tuning.extend(o.tuning);
         }
-        let device = run.backend.adapter().describe();
         report::write_frames(
             self,
             &outcome,
-            &device,
+            run.backend.adapter(),
             run.started.elapsed().as_secs_f64(),
             run.out.dir(),
         )?;

@@ -15,6 +15,7 @@ use crate::output::numbers::thousands;
 use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{image_grid, line_plot, Axes, Point, Series, Tile};
 use crate::output::table::{float, write_rows};
+use crate::render::AdapterInfo;
 use crate::scene::procedural::random;
 use serde::Serialize;
 use std::path::Path;
@@ -100,10 +101,16 @@ struct TuningCost {
 pub fn write_frames(
     spec: &FramesSpec,
     outcome: &FramesOutcome,
-    device: &str,
+    adapter: &AdapterInfo,
     seconds: f64,
     out: &Path,
 ) -> anyhow::Result<()> {
+    let device = adapter.describe();
+    let on = if adapter.backend == "gpu" {
+        format!("GPU {}", adapter.name)
+    } else {
+        "CPU f64".into()
+    };
     let rows = &outcome.frames;
     write_rows(
         &out.join("frames.csv"),
@@ -193,7 +200,7 @@ pub fn write_frames(
                 .collect()
         };
         let title = format!(
-            "{} shading, {}x{}, {} triangles, viewpoint {}, CPU f64",
+            "{} shading, {}x{}, {} triangles, viewpoint {}, {on}",
             shading.name(),
             spec.width,
             spec.height,
@@ -328,7 +335,7 @@ pub fn write_frames(
     for g in &galleries {
         write_shots(out, g)?;
     }
-    let report = report(spec, outcome, device, seconds);
+    let report = report(spec, outcome, &device, seconds);
     write_atomic(&out.join("report.md"), report.as_bytes())?;
     page::write(
         out,

@@ -225,7 +225,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         )
     } else {
         format!(
-            "- **Exactness FAILED**: frames differ from the first structure's ({}). Every structure is exact in f64, so this should be 0: some ray was decided differently.\n",
+            "- **Exactness FAILED**: frames differ from the first structure's ({}). Every structure runs one exact triangle test (in f64 on the CPU, the same f32 test on the GPU), so this should be 0: some ray was decided differently.\n",
             differing.join("; ")
         )
     };

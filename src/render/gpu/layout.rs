@@ -127,9 +127,9 @@ pub struct PassInfo {
 
 /// Bytes per pixel of the hit buffer (WGSL `Hit`).
 pub const HIT_BYTES: u64 = 48;
-/// Bytes per pixel of the mirror pass's chain buffer (WGSL `Chain`: two hits, the ray's direction
-/// and weight, and its running sums).
-pub const CHAIN_BYTES: u64 = 2 * HIT_BYTES + 48;
+/// Bytes per pixel of the mirror pass's chain buffer (WGSL `Chain`: its last vertex, the ray's
+/// direction and weight, and its running sums).
+pub const CHAIN_BYTES: u64 = HIT_BYTES + 48;
 
 const _: () = assert!(std::mem::size_of::<Params>() == 128);
 const _: () = assert!(std::mem::size_of::<GpuMeshTri>() == 32);
@@ -191,6 +191,21 @@ pub struct Packed {
     /// dispatch per direction, every receiver's ray along it, so a dispatch walks one
     /// direction's part of a structure.
     pub ao_direction_major: bool,
+}
+
+/// A mirror weight in f32 on the same side of 0 and of 1 as in f64: the kernels decide "no
+/// mirror" (m = 0) and "no diffuse part" (m = 1) by comparison, as the CPU does, so a weight
+/// f32 would round onto either end keeps the nearest value inside (a chain's contribution at
+/// such weights is below f32's resolution anyway).
+fn mirror_weight(m: f64) -> f32 {
+    let w = m as f32;
+    if w == 0.0 && m > 0.0 {
+        f32::MIN_POSITIVE
+    } else if w == 1.0 && m < 1.0 {
+        1.0 - f32::EPSILON / 2.0
+    } else {
+        w
+    }
 }
 
 /// Packs a scene, view and sampling choice into GPU structs; fails where the scene's
@@ -364,10 +379,25 @@ pub fn pack(scene: &Scene, view: View, sampling: Sampling) -> anyhow::Result<Pac
         ao_dirs,
         accel,
         tables: crate::sampling::tables::pack(&uses),
-        mirrors: scene.shapes.iter().map(|s| s.mirror() as f32).collect(),
+        mirrors: scene.shapes.iter().map(|s| mirror_weight(s.mirror())).collect(),
         ao_direction_major: scene
             .ambient
             .as_ref()
             .is_some_and(|a| a.issue == crate::accel::Issue::Bundled),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mirror_weight;
+
+    #[test]
+    fn mirror_weights_keep_their_side_of_0_and_1_in_f32() {
+        assert_eq!(mirror_weight(0.0), 0.0);
+        assert_eq!(mirror_weight(1.0), 1.0);
+        assert_eq!(mirror_weight(0.5), 0.5);
+        assert!(mirror_weight(1e-30) > 0.0 && mirror_weight(1e-300) > 0.0);
+        assert!(mirror_weight(0.99999999) < 1.0);
+        assert_eq!(mirror_weight(0.99999999), 1.0 - f32::EPSILON / 2.0);
+    }
 }

@@ -385,14 +385,13 @@ const CHAIN_ENDED: u32 = 2u;
 
 // One pixel's mirror chain between the mirror pass's dispatches.
 struct Chain {
-    // The vertex the next reflected ray leaves.
+    // The chain's last vertex: the receiver, then each reflected ray's closest hit, which the
+    // trace writes over the vertex it left (its origin and normal are spent by then).
     at: Hit,
-    // The vertex the last reflected ray reached: shaded, then folded in.
-    next: Hit,
     dir: vec3<f32>,
     weight: f32,
     reflected: f32,
-    // `next`'s irradiance over the lights shaded so far, and the light being shaded's samples
+    // `at`'s irradiance over the lights shaded so far, and the light being shaded's samples
     // gathered so far (its chunks' carry, as `light_sums` is the shadow pass's).
     irradiance: f32,
     visible: f32,
@@ -426,8 +425,8 @@ fn mirror_trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (c.state == CHAIN_LIVE) {
         let origin = select(c.at.position, offset_origin(c.at.position, c.at.normal), c.at.triangle != NO_HIT);
-        c.next = closest(origin, c.dir, c.at.triangle);
-        if (c.next.object == NO_HIT) {
+        c.at = closest(origin, c.dir, c.at.triangle);
+        if (c.at.object == NO_HIT) {
             c.state = CHAIN_ENDED;
         }
         c.irradiance = 0.0;
@@ -448,11 +447,11 @@ fn mirror_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel = gid.y * params.width + gid.x;
     let li = pass_info.light;
     let c = chains[pixel];
-    if (li >= params.light_count || c.state != CHAIN_LIVE || c.next.mirror >= 1.0) {
+    if (li >= params.light_count || c.state != CHAIN_LIVE || c.at.mirror >= 1.0) {
         return;
     }
     let first = pass_info.first_sample;
-    let s = sample_light(li, c.next, first, pass_info.sample_count, gid.xy, pixel, LightSample(c.visible, c.sum, 0u));
+    let s = sample_light(li, c.at, first, pass_info.sample_count, gid.xy, pixel, LightSample(c.visible, c.sum, 0u));
     let samples = lights[li].samples;
     if (pass_info.sample_count >= samples - min(first, samples)) {
         chains[pixel].irradiance = c.irradiance + light_finish(li, s).y;
@@ -466,6 +465,8 @@ fn mirror_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     finish_invocation(CUT_SHORT_SLOT);
 }
 
+// The chain ends where a vertex is no mirror at all (weight 0 on the host, as on the CPU), not
+// where the f32 product of weights underflows.
 @compute @workgroup_size(8, 8)
 fn mirror_step(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
@@ -476,13 +477,12 @@ fn mirror_step(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (c.state != CHAIN_LIVE) {
         return;
     }
-    if (c.next.mirror < 1.0) {
-        c.reflected += c.weight * (1.0 - c.next.mirror) * c.next.albedo / PI * c.irradiance;
+    if (c.at.mirror < 1.0) {
+        c.reflected += c.weight * (1.0 - c.at.mirror) * c.at.albedo / PI * c.irradiance;
     }
-    c.weight *= c.next.mirror;
-    c.dir = normalize(reflect(c.dir, c.next.normal));
-    c.at = c.next;
-    if (c.weight == 0.0) {
+    c.weight *= c.at.mirror;
+    c.dir = normalize(reflect(c.dir, c.at.normal));
+    if (c.at.mirror == 0.0) {
         c.state = CHAIN_ENDED;
     }
     chains[pixel] = c;
