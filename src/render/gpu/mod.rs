@@ -4,9 +4,10 @@
 //! once in [`GpuBackend::new`]; the scene's geometry is uploaded once and stays resident
 //! ([`resources`]); each frame runs the plan's passes (primary; one shadow pass per light, or
 //! the direct pass over every light where the scene has no shadows; Whitted's mirror chains, per
-//! bounce a trace, the lights' chunks and a step; the ambient-occlusion pass where the scene asks;
-//! each in one dispatch per step or, on adapters that cap loop iterations, per chunk) with a timestamp pair around each pass when the adapter
-//! supports timestamp queries, and reads the outputs back. Where switched on
+//! bounce a trace, the lights' chunks and a step; the ambient-occlusion pass where the scene
+//! asks; each in one dispatch per step or, on adapters that cap loop iterations, per chunk) with
+//! a timestamp pair around each pass when the adapter supports timestamp queries, and reads the
+//! outputs back. Where switched on
 //! ([`Backend::count_work`]), frames read back count their work (queries, nodes, primitive tests)
 //! in atomics the kernels add to once per invocation; timed frames never count.
 
