@@ -165,6 +165,20 @@ pub struct AdapterInfo {
 }
 
 impl AdapterInfo {
+    /// Whether this is the GPU backend (its bundles, counts and rounding are not the CPU's).
+    pub fn is_gpu(&self) -> bool {
+        self.backend == "gpu"
+    }
+
+    /// The device in a plot title's few words: `GPU <adapter>` or `CPU f64`.
+    pub fn short(&self) -> String {
+        if self.is_gpu() {
+            format!("GPU {}", self.name)
+        } else {
+            "CPU f64".into()
+        }
+    }
+
     /// The device in the words a report opens with: the CPU backend and its threads, or the GPU
     /// adapter, saying so where the adapter is Mesa's software rasteriser (its GPU times are a
     /// CPU's).

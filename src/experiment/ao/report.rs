@@ -329,11 +329,7 @@ pub fn write_ao(
             spec.ao.rays,
             spec.width,
             spec.height,
-            if on_gpu(adapter) {
-                format!("GPU {}", adapter.name)
-            } else {
-                "CPU f64".into()
-            }
+            adapter.short()
         ),
         "frame time, median (s)",
         &names,
@@ -389,15 +385,10 @@ fn galleries(spec: &AoSpec, rows: &[AoRow]) -> Vec<Gallery> {
         .collect()
 }
 
-/// Whether the rows were measured on the GPU backend (its bundles and counts are not the CPU's).
-fn on_gpu(adapter: &AdapterInfo) -> bool {
-    adapter.backend == "gpu"
-}
-
 fn report(spec: &AoSpec, rows: &[AoRow], adapter: &AdapterInfo, seconds: f64) -> String {
     let schedule = spec.header.schedule;
     let device = adapter.describe();
-    let gpu = on_gpu(adapter);
+    let gpu = adapter.is_gpu();
     let tuned: Vec<String> = spec
         .structures
         .iter()

@@ -258,7 +258,7 @@ pub fn run_mesh(
     progress: &Progress,
 ) -> anyhow::Result<MeshOutcome> {
     let schedule = spec.header.schedule;
-    let on_gpu = backend.adapter().backend == "gpu";
+    let on_gpu = backend.adapter().is_gpu();
     let bar = progress.bar(&format!("{}: structures", mesh.name), spec.structures.len() as u64);
     let mut out = MeshOutcome::default();
     let mut first: Option<Vec<f32>> = None;

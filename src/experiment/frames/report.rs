@@ -106,11 +106,7 @@ pub fn write_frames(
     out: &Path,
 ) -> anyhow::Result<()> {
     let device = adapter.describe();
-    let on = if adapter.backend == "gpu" {
-        format!("GPU {}", adapter.name)
-    } else {
-        "CPU f64".into()
-    };
+    let on = adapter.short();
     let rows = &outcome.frames;
     write_rows(
         &out.join("frames.csv"),
