@@ -122,7 +122,9 @@ pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
     let source = Source::read(path)?;
     let header = Header::read(&source)?;
     Ok(match header.kind {
-        Kind::Sweep => Box::new(sweep::Spec::from_source(&source, header)?),
+        Kind::Sweep => Box::new(core::Declared(sweep::Sweep::new(sweep::Spec::from_source(
+            &source, header,
+        )?))),
         Kind::Fps => Box::new(core::Declared(fps::FpsSpec::from_source(&source, header)?)),
         Kind::Ao => Box::new(core::Declared(ao::AoSpec::from_source(&source, header)?)),
         Kind::Frames => Box::new(core::Declared(frames::FramesSpec::from_source(&source, header)?)),

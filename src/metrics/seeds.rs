@@ -16,7 +16,7 @@ use super::error::PenumbraMask;
 use super::stats::t975;
 
 /// Squared bias and variance of one configuration over its seeds.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BiasVariance {
     /// Seeds the split rests on.
     pub seeds: usize,

@@ -358,3 +358,67 @@ mod tests {
         assert!(read_rows::<Head>(&path).is_empty(), "nothing read through the link");
     }
 }
+
+/// A list of rows held as the CSV text a table of them would be (header and rows), for a
+/// record that carries its own table inside a TOML journal: the rows read back exactly as the
+/// table's reader reads them.
+pub mod csv_text {
+    use super::*;
+
+    /// Writes `rows` as CSV text.
+    pub fn serialize<T: Serialize, S: Serializer>(rows: &[T], s: S) -> Result<S::Ok, S::Error> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for r in rows {
+            w.serialize(r).map_err(serde::ser::Error::custom)?;
+        }
+        let bytes = w.into_inner().map_err(serde::ser::Error::custom)?;
+        s.serialize_str(&String::from_utf8(bytes).map_err(serde::ser::Error::custom)?)
+    }
+
+    /// Reads rows from CSV text, by position (so rows made of parts read back); a row that does
+    /// not read is an error.
+    pub fn deserialize<'de, T: DeserializeOwned, D: Deserializer<'de>>(d: D) -> Result<Vec<T>, D::Error> {
+        let text = String::deserialize(d)?;
+        csv::Reader::from_reader(text.as_bytes())
+            .records()
+            .map(|r| r.and_then(|r| r.deserialize(None)))
+            .collect::<Result<Vec<T>, _>>()
+            .map_err(serde::de::Error::custom)
+    }
+}
+
+/// An image of f32 values held as the hex of their little-endian bits: exact, NaN payloads
+/// included, and a third the size of their decimal text.
+pub mod f32_hex {
+    use super::*;
+
+    /// Writes `values` as hex.
+    pub fn serialize<S: Serializer>(values: &[f32], s: S) -> Result<S::Ok, S::Error> {
+        let mut text = String::with_capacity(values.len() * 8);
+        for v in values {
+            for b in v.to_bits().to_le_bytes() {
+                text.push_str(&format!("{b:02x}"));
+            }
+        }
+        s.serialize_str(&text)
+    }
+
+    /// Reads values from hex; text that is not whole values' hex is an error.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f32>, D::Error> {
+        let text = String::deserialize(d)?;
+        let bad = || serde::de::Error::custom("an image's hex is not a whole number of f32 values");
+        if text.len() % 8 != 0 || !text.is_ascii() {
+            return Err(bad());
+        }
+        (0..text.len() / 8)
+            .map(|i| {
+                let mut bytes = [0u8; 4];
+                for (k, b) in bytes.iter_mut().enumerate() {
+                    let at = 8 * i + 2 * k;
+                    *b = u8::from_str_radix(&text[at..at + 2], 16).map_err(|_| bad())?;
+                }
+                Ok(f32::from_bits(u32::from_le_bytes(bytes)))
+            })
+            .collect()
+    }
+}

@@ -44,15 +44,7 @@ fn runs(backend: &mut dyn Backend) -> Vec<Record> {
     let path = dir.path().join("blue.toml");
     std::fs::write(&path, EXPERIMENT.replace("SCENE", &scene.display().to_string())).unwrap();
     let spec = Spec::load(&path).unwrap();
-    let outcome = run_sweep(
-        &spec,
-        backend,
-        &dir.path().join("journal"),
-        &dir.path().join("cache"),
-        true,
-        &Progress::default(),
-    )
-    .unwrap();
+    let outcome = run_sweep(&spec, backend, dir.path(), true, &Progress::default()).unwrap();
     assert_eq!(outcome.failures, 0);
     outcome.records
 }

@@ -47,8 +47,12 @@ fn resumed(dir: &Path, backend: &str) -> usize {
     let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
     let (code, stderr) = common::sweep(&args);
     assert_eq!(code, 0, "{stderr}");
-    let at = stderr.find(" groups resumed").expect("the summary line");
-    let digits: String = stderr[..at].chars().rev().take_while(|c| c.is_ascii_digit()).collect();
+    let Some(at) = stderr.find(" units taken from the journal") else {
+        return 0;
+    };
+    let line = stderr[..at].rsplit('\n').next().unwrap_or_default();
+    let of = line.rfind(" of ").expect("N of M units");
+    let digits: String = line[..of].chars().rev().take_while(|c| c.is_ascii_digit()).collect();
     digits.chars().rev().collect::<String>().parse().unwrap()
 }
 

@@ -1,5 +1,5 @@
-//! Every kind on the experiment core: the CI twins of ao, frames and fps run whole, as two shards
-//! merged, and killed after their first journaled unit then resumed, give the same tables but for
+//! Every kind on the experiment core: the CI twins of the sweep, ao, frames, realtime and fps run
+//! whole, as two shards merged, and killed after their first journaled unit then resumed, give the same tables but for
 //! the clock's columns; a merge missing a shard is refused with the command that reruns it and
 //! writes nothing; filters keep only the units and values named and refuse what a kind does not
 //! have.
@@ -134,6 +134,14 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
             );
         }
     }
+}
+
+#[test]
+fn sweep_sharded_merged_and_resumed_gives_the_whole_runs_tables() {
+    whole_sharded_and_resumed_agree(
+        &common::repo("experiments/ci.toml"),
+        &["runs.csv", "summary.csv", "ground_truth.csv", "timings.csv"],
+    );
 }
 
 #[test]

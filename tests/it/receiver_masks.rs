@@ -71,15 +71,7 @@ fn experiment(dir: &Path, sphere: (f64, f64), centre: (f64, f64), width: f64, ra
 }
 
 fn sweep(spec: &Spec, backend: &mut dyn Backend, dir: &Path) -> Outcome {
-    let out = run_sweep(
-        spec,
-        backend,
-        &dir.join("journal"),
-        &dir.join("cache"),
-        true,
-        &Progress::default(),
-    )
-    .unwrap();
+    let out = run_sweep(spec, backend, dir, true, &Progress::default()).unwrap();
     assert_eq!(out.failures, 0);
     out
 }

@@ -30,15 +30,7 @@ fn ci() -> &'static Ci {
         let thresholds = Thresholds::load(&common::repo("experiments/ci-thresholds.toml")).unwrap();
         let dir = tempfile::tempdir().unwrap();
         let mut backend = open_backend(spec.backend).unwrap();
-        let out = run_sweep(
-            &spec,
-            backend.as_mut(),
-            &dir.path().join("journal"),
-            &dir.path().join("cache"),
-            true,
-            &Progress::default(),
-        )
-        .unwrap();
+        let out = run_sweep(&spec, backend.as_mut(), dir.path(), true, &Progress::default()).unwrap();
         assert_eq!(out.failures, 0);
         let summaries = summarise(&out, &Default::default());
         Ci {

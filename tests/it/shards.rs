@@ -1,18 +1,15 @@
-//! Sharded sweeps: the deal of groups to shards (deterministic, complete, balanced, ground truths
-//! kept together where that pays), the CI experiment run as 3 shards and merged against the same
-//! experiment unsharded, refused merges (missing, unfinished, duplicated, foreign shards) that
-//! write nothing, a shard killed midway that resumes from its journal, and, where `sbatch` and a
-//! running Slurm exist, the job-array script end to end.
+//! Sharded sweeps on the experiment core: the deal of a sweep's groups to shards
+//! (deterministic, complete, balanced, ground truths kept together where that pays), refused
+//! merges (missing, unfinished, duplicated, foreign, edited or other-build shards) that write
+//! nothing, and, where `sbatch` and a running Slurm exist, the job-array script end to end. That a
+//! sharded, merged or killed-and-resumed sweep gives the whole run's tables is tested with every
+//! other kind's in `kinds_on_the_core.rs`.
 
 use crate::common;
-use penumbra::experiment::progress::Progress;
-
-use penumbra::experiment::sweep::merge::{merge_shards, MergePlan};
+use penumbra::experiment::core::shard::{deal, Shard};
+use penumbra::experiment::core::Declaration;
 use penumbra::experiment::sweep::run::{expand, Group};
-use penumbra::experiment::sweep::shard::{assign, run_shard, share, Shard};
-use penumbra::experiment::sweep::{run_sweep, Spec};
-use penumbra::output::table::write_rows;
-use penumbra::render::cpu::CpuBackend;
+use penumbra::experiment::sweep::{Spec, Sweep};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -33,6 +30,29 @@ fn run_ok(args: &[&OsStr]) -> String {
     let (code, err) = sweep(args);
     assert_eq!(code, 0, "sweep {args:?} failed:\n{err}");
     err
+}
+
+/// The share of each group of `spec` among `count`, as the core deals the sweep's units (an
+/// experiment that times nothing and draws no pictures has only groups).
+fn assign(spec: &Spec, groups: &[Group], count: u32) -> Vec<u32> {
+    let units = Sweep::new(spec.clone()).units();
+    assert_eq!(units.len(), groups.len(), "units other than groups");
+    let costs: Vec<_> = units.iter().map(|u| u.cost.clone()).collect();
+    deal(&costs, count).0
+}
+
+/// The CI experiment untimed (its timing unit, twice all its groups' rays, would hold a share
+/// alone).
+fn ci_untimed(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(ci()).unwrap();
+    let scenes = common::repo("experiments/scenes").display().to_string();
+    let path = dir.join("ci-untimed.toml");
+    let text = text
+        .replace("repeats = 6 ", "repeats = 0 ")
+        .replace("\"scenes/", &format!("\"{scenes}/"));
+    assert!(text.contains("repeats = 0"));
+    std::fs::write(&path, text).unwrap();
+    path
 }
 
 #[test]
@@ -61,7 +81,8 @@ fn group_rays(spec: &Spec) -> Vec<f64> {
 
 #[test]
 fn the_deal_covers_every_group_once_is_deterministic_and_balanced() {
-    let spec = Spec::load(&ci()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let spec = Spec::load(&ci_untimed(dir.path())).unwrap();
     let groups = expand(&spec);
     let rays = group_rays(&spec);
     let total: f64 = rays.iter().sum();
@@ -87,7 +108,6 @@ fn the_deal_covers_every_group_once_is_deterministic_and_balanced() {
     }
     // Shares follow the groups' keys, not their order in the file: the same experiment with its
     // seeds listed in another order is dealt alike, group by group.
-    let dir = tempfile::tempdir().unwrap();
     let (a, b) = (
         common::tiny_experiment(&dir.path().join("a"), |t| {
             t.replace("samples = [4, 16]", "samples = [4, 16, 64]")
@@ -162,114 +182,6 @@ fn groups_sharing_a_costly_ground_truth_stay_together_and_cheap_ones_spread() {
     assert!((load[0] - load[1]).abs() <= smallest, "unbalanced: {load:?}");
 }
 
-/// Asserts each of `files` is byte for byte the same under `a` and `b`.
-fn same_files(a: &Path, b: &Path, files: &[&str]) {
-    for file in files {
-        let (x, y) = (
-            std::fs::read(a.join(file)).unwrap(),
-            std::fs::read(b.join(file)).unwrap(),
-        );
-        assert!(x == y, "{file} differs");
-    }
-}
-
-/// The CI experiment: unsharded into `dir/full`, as 3 shards merged into `dir/sharded`.
-fn full_and_sharded(dir: &Path) -> (PathBuf, PathBuf) {
-    let full = dir.join("full");
-    let sharded = dir.join("sharded");
-    run_ok(&[ci().as_os_str(), os("--out"), full.as_os_str()]);
-    for k in 1..=3 {
-        let s = format!("{k}/3");
-        run_ok(&[
-            ci().as_os_str(),
-            os("--out"),
-            sharded.as_os_str(),
-            os("--shard"),
-            os(&s),
-        ]);
-        assert!(!sharded.join("runs.csv").exists(), "a shard wrote the final outputs");
-    }
-    run_ok(&[
-        ci().as_os_str(),
-        os("--out"),
-        sharded.as_os_str(),
-        os("--merge"),
-        os("3"),
-    ]);
-    (full, sharded)
-}
-
-#[test]
-fn three_shards_merged_give_the_unsharded_tables_and_figures() {
-    let _gpu = common::gpu();
-    let dir = tempfile::tempdir().unwrap();
-    let (full, sharded) = full_and_sharded(dir.path());
-    for table in ["runs.csv", "summary.csv"] {
-        let (a, b) = (
-            common::without_clock(&full.join(table)),
-            common::without_clock(&sharded.join(table)),
-        );
-        assert!(a.len() > 1);
-        assert_eq!(a, b, "{table} differs");
-    }
-    // Every run was rendered by exactly one shard, each shard a real share.
-    let mut shard_runs = 0;
-    for k in 1..=3 {
-        let n = common::without_clock(&sharded.join(format!("shards/{k}-of-3/records.csv"))).len() - 1;
-        assert!(n > 0, "shard {k} ran nothing");
-        shard_runs += n;
-    }
-    assert_eq!(shard_runs, common::without_clock(&full.join("runs.csv")).len() - 1);
-    same_files(
-        &full,
-        &sharded,
-        &[
-            "ground_truth.csv",
-            "images/fig2_measure.png",
-            "images/ground_truth.exr",
-            "plots/profiles.png",
-            "plots/profiles.svg",
-            "plots/rmse_vs_samples.png",
-        ],
-    );
-    // The merge timed every configuration itself, in one phase.
-    let timed = common::without_clock(&sharded.join("timings.csv")).len();
-    assert!(timed > 1, "the merge timed nothing");
-}
-
-#[test]
-fn a_sweep_over_two_radii_merged_from_two_shards_is_byte_identical_without_timing() {
-    let _gpu = common::gpu();
-    let dir = tempfile::tempdir().unwrap();
-    // Radii listed largest first and a timing-free sweep: every byte of the tables must match,
-    // rows in the unsharded order whichever shard rendered them.
-    let exp = common::tiny_experiment(dir.path(), |t| {
-        t.replace("light_radii = [0.02]", "light_radii = [0.03, 0.01]")
-    });
-    let (full, sharded) = (dir.path().join("full"), dir.path().join("sharded"));
-    run_ok(&[exp.as_os_str(), os("--out"), full.as_os_str()]);
-    for k in ["1/2", "2/2"] {
-        run_ok(&[exp.as_os_str(), os("--out"), sharded.as_os_str(), os("--shard"), os(k)]);
-    }
-    run_ok(&[
-        exp.as_os_str(),
-        os("--out"),
-        sharded.as_os_str(),
-        os("--merge"),
-        os("2"),
-    ]);
-    same_files(
-        &full,
-        &sharded,
-        &[
-            "runs.csv",
-            "summary.csv",
-            "ground_truth.csv",
-            "plots/width_vs_radius.png",
-        ],
-    );
-}
-
 #[test]
 fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_nothing() {
     let _gpu = common::gpu();
@@ -307,26 +219,21 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         assert!(!out.join("summary.csv").exists() && !out.join("report.md").exists());
     };
     let shard = |k: u32| out.join(format!("shards/{k}-of-3"));
-    // Shard 2 never ran: its runs are listed with the command that reruns it.
-    let spec = Spec::load(&ci()).unwrap();
-    let runs: usize = share(&spec, Shard { index: 2, count: 3 })
-        .iter()
-        .map(|g| g.runs.len())
-        .sum();
-    let incomplete = format!("shard 2/3 is incomplete ({runs} runs missing)");
+    // Shard 2 never ran: its units are listed with the command that reruns it.
     refused(
         &[os("3")],
         &[
             "2-of-3: no such shard folder",
-            &incomplete,
+            "shard 2/3 is incomplete (",
+            "units missing); rerun it: sweep",
             "--shard 2/3",
-            "seeds=[1, 2, 3, 4, 5, 6]",
+            "scheme=",
         ],
     );
     // The same shard twice.
     refused(
         &[shard(1).as_os_str(), shard(1).as_os_str(), shard(3).as_os_str()],
-        &["in more than one shard", "shard 2/3"],
+        &["units are in more than one shard", "shard 2/3"],
     );
     // Shards of another split under the results folder.
     let five = out.join("shards/2-of-5");
@@ -337,7 +244,7 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         &["shards of different splits (merging 3): 1/3", "2/5"],
     );
     // No shard readable at all: the refusal still names the split asked for, not 1/1.
-    refused(&[os("4")], &["shard 4/4 is incomplete", "--shard 1/4"]);
+    refused(&[os("4")], &["shard 2/4 is incomplete", "--shard 1/4"]);
     // A shard that did not finish (no manifest).
     run_ok(&[ci().as_os_str(), os("--out"), out.as_os_str(), os("--shard"), os("2/3")]);
     std::fs::remove_file(shard(2).join("shard.toml")).unwrap();
@@ -345,16 +252,17 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         &[os("3")],
         &["2-of-3: no shard.toml: the shard has not finished", "--shard 2/3"],
     );
-    // A shard whose records were edited after it finished.
+    // A shard whose journaled unit was edited after it finished.
     run_ok(&[ci().as_os_str(), os("--out"), out.as_os_str(), os("--shard"), os("2/3")]);
-    let records = shard(2).join("records.csv");
-    let text = std::fs::read_to_string(&records).unwrap();
-    std::fs::write(&records, text.replacen(",ok,", ",ok ,", 1)).unwrap();
-    refused(
-        &[os("3")],
-        &["records.csv is not the file shard 2/3 wrote", "--shard 2/3"],
-    );
-    std::fs::write(&records, text).unwrap();
+    let unit = std::fs::read_dir(shard(2).join(".journal"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| std::fs::read_to_string(p).unwrap().contains(",ok,"))
+        .expect("a journaled group");
+    let text = std::fs::read_to_string(&unit).unwrap();
+    std::fs::write(&unit, text.replacen(",ok,", ",ok ,", 1)).unwrap();
+    refused(&[os("3")], &["is not the file shard 2/3 wrote", "--shard 2/3"]);
+    std::fs::write(&unit, text).unwrap();
     // A shard run by another build of the binary (same code, one byte more).
     let other_build = dir.path().join("sweep-other");
     let mut exe = std::fs::read(env!("CARGO_BIN_EXE_sweep")).unwrap();
@@ -388,7 +296,7 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         os("2"),
     ]);
     assert_eq!(code, 4, "{err}");
-    assert!(err.contains("shard 2/2 ran another sweep"), "{err}");
+    assert!(err.contains("shard 2/2 ran under another inputs, axes"), "{err}");
     assert!(!tiny_out.join("runs.csv").exists());
     // With every shard of the right sweep the merge goes through.
     run_ok(&[
@@ -406,122 +314,6 @@ fn merges_missing_unfinished_duplicated_or_foreign_shards_are_refused_and_write_
         os("2"),
     ]);
     assert!(tiny_out.join("runs.csv").exists());
-}
-
-#[test]
-fn failed_runs_reach_the_merge_as_an_unsharded_sweep_records_them() {
-    let dir = tempfile::tempdir().unwrap();
-    let spec = Spec::load(&common::tiny_experiment(dir.path(), |t| t)).unwrap();
-    let full = run_sweep(
-        &spec,
-        &mut common::Flaky(CpuBackend::default()),
-        &dir.path().join("j"),
-        &dir.path().join("c"),
-        true,
-        &Progress::default(),
-    )
-    .unwrap();
-    assert!(full.failures > 0);
-    let results = dir.path().join("sharded");
-    for index in 1..=2 {
-        let done = run_shard(
-            &spec,
-            &mut common::Flaky(CpuBackend::default()),
-            Shard { index, count: 2 },
-            &results,
-            false,
-            &Progress::default(),
-        )
-        .unwrap();
-        assert!(done.manifest.failed > 0 || done.manifest.runs == 0);
-    }
-    let dirs: Vec<PathBuf> = (1..=2).map(|index| Shard { index, count: 2 }.dir(&results)).collect();
-    let plan = MergePlan {
-        dirs: &dirs,
-        split: Some(2),
-        rerun: "sweep tiny.toml --shard",
-        fresh: false,
-    };
-    let merged = merge_shards(
-        &spec,
-        &mut common::Flaky(CpuBackend::default()),
-        &plan,
-        &results,
-        &Progress::default(),
-    )
-    .unwrap();
-    assert_eq!(merged.failures, full.failures);
-    let table = |records: &[penumbra::experiment::sweep::Record], name: &str| {
-        let path = dir.path().join(name);
-        write_rows(&path, records).unwrap();
-        std::fs::read_to_string(path).unwrap()
-    };
-    let (a, b) = (table(&full.records, "a.csv"), table(&merged.records, "b.csv"));
-    assert!(a.contains("simulated device loss"));
-    assert_eq!(a, b);
-    // Splits of one seed are NaN: compared as text.
-    assert_eq!(format!("{:?}", full.groups), format!("{:?}", merged.groups));
-}
-
-#[test]
-fn a_shard_killed_midway_resumes_from_its_journal() {
-    let _gpu = common::gpu();
-    let dir = tempfile::tempdir().unwrap();
-    let (killed, clean) = (dir.path().join("killed"), dir.path().join("clean"));
-    let args = |out: &Path| -> Vec<std::ffi::OsString> {
-        vec![ci().into(), "--out".into(), out.into(), "--shard".into(), "2/3".into()]
-    };
-    let status = Command::new(env!("CARGO_BIN_EXE_sweep"))
-        .args(args(&killed))
-        .env("PENUMBRA_TEST_DIE_AFTER", "5")
-        .output()
-        .unwrap()
-        .status;
-    assert!(!status.success() && status.code().is_none(), "not killed: {status:?}");
-    let shard = killed.join("shards/2-of-3");
-    assert!(!shard.join("shard.toml").exists() && !shard.join("records.csv").exists());
-    let journaled = std::fs::read_to_string(shard.join(".journal/groups.csv")).unwrap();
-    assert_eq!(journaled.lines().count(), 1 + 5, "{journaled}");
-
-    let resumed = Command::new(env!("CARGO_BIN_EXE_sweep"))
-        .args(args(&killed))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&resumed.stderr);
-    assert!(resumed.status.success(), "{err}");
-    let manifest = std::fs::read_to_string(shard.join("shard.toml")).unwrap();
-    assert!(manifest.contains("resumed = 5\n"), "{manifest}");
-    let uninterrupted = Command::new(env!("CARGO_BIN_EXE_sweep"))
-        .args(args(&clean))
-        .output()
-        .unwrap();
-    assert!(uninterrupted.status.success());
-    let clean_shard = clean.join("shards/2-of-3");
-    for file in ["records.csv", "groups.csv"] {
-        let (a, b) = (
-            std::fs::read(shard.join(file)).unwrap(),
-            std::fs::read(clean_shard.join(file)).unwrap(),
-        );
-        assert!(a == b, "{file}: the resumed shard differs from an uninterrupted one");
-    }
-    // Figures of resumed groups come from the journal, identical to rendered ones.
-    let figures = |d: &Path| {
-        let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(d.join(".journal/figures"))
-            .unwrap()
-            .map(|e| e.unwrap())
-            .map(|e| {
-                (
-                    e.file_name().to_string_lossy().into_owned(),
-                    std::fs::read(e.path()).unwrap(),
-                )
-            })
-            .collect();
-        v.sort();
-        v
-    };
-    let f = figures(&shard);
-    assert!(!f.is_empty());
-    assert_eq!(f, figures(&clean_shard));
 }
 
 #[test]

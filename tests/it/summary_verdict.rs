@@ -25,15 +25,7 @@ fn sweep(seeds: &str) -> (Outcome, Vec<Summary>) {
     let exp = common::tiny_experiment(dir.path(), |t| t.replace("seeds = [1, 2]", seeds));
     let spec = Spec::load(&exp).unwrap();
     let mut cpu = CpuBackend::default();
-    let out = run_sweep(
-        &spec,
-        &mut cpu,
-        &dir.path().join("j"),
-        &dir.path().join("c"),
-        true,
-        &Progress::default(),
-    )
-    .unwrap();
+    let out = run_sweep(&spec, &mut cpu, dir.path(), true, &Progress::default()).unwrap();
     let summaries = summarise(&out, &Default::default());
     (out, summaries)
 }

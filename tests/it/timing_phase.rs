@@ -56,8 +56,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
         cpu: CpuBackend::default(),
         calls: vec![],
     };
-    let (journal, cache) = (dir.path().join("j"), dir.path().join("c"));
-    let out = run_sweep(&spec, &mut backend, &journal, &cache, true, &Progress::default()).unwrap();
+    let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 6 rounds,
     // plus the A/A control's visits.
     let configs = 8;
@@ -97,7 +96,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     }
     // A resumed sweep takes the timings from the journal and times nothing.
     backend.calls.clear();
-    let again = run_sweep(&spec, &mut backend, &journal, &cache, false, &Progress::default()).unwrap();
+    let again = run_sweep(&spec, &mut backend, dir.path(), false, &Progress::default()).unwrap();
     assert!(backend.calls.is_empty(), "{} frames re-timed", backend.calls.len());
     assert_eq!(again.timings.configs, out.timings.configs);
     assert_eq!(again.timings.noise.as_ref().map(|n| &n.1), Some(noise));
@@ -114,7 +113,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
     .unwrap();
     let wider = Spec::load(&exp).unwrap();
     backend.calls.clear();
-    let third = run_sweep(&wider, &mut backend, &journal, &cache, false, &Progress::default()).unwrap();
+    let third = run_sweep(&wider, &mut backend, dir.path(), false, &Progress::default()).unwrap();
     assert_eq!(third.timings.configs.len(), configs + 4);
     assert_eq!(backend.calls.len(), 6 * (configs + 4 + NOISE_VISITS as usize));
 }

@@ -21,6 +21,18 @@ use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 
+crate::axis_keys! {
+    /// The ambient-occlusion table's axes.
+    pub enum AoAxis {
+        /// A mesh.
+        Mesh => "mesh",
+        /// An acceleration structure.
+        Structure => "structure",
+        /// How rays are issued (single or bundled).
+        Issue => "issue",
+    }
+}
+
 impl Declaration for AoSpec {
     type Outcome = MeshOutcome;
 
@@ -35,28 +47,30 @@ impl Declaration for AoSpec {
         v
     }
 
-    fn axes(&self) -> Vec<Axis> {
+    type Axis = AoAxis;
+
+    fn axes(&self) -> Vec<Axis<AoAxis>> {
         vec![
             Axis {
-                name: "mesh",
+                key: AoAxis::Mesh,
                 values: self.meshes.iter().map(|m| m.name.clone()).collect(),
             },
             Axis {
-                name: "structure",
+                key: AoAxis::Structure,
                 values: self.structures.iter().map(|(s, _)| s.to_string()).collect(),
             },
             Axis {
-                name: "issue",
+                key: AoAxis::Issue,
                 values: self.issues.iter().map(|i| i.name().to_string()).collect(),
             },
         ]
     }
 
-    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+    fn restrict(&mut self, axis: AoAxis, keep: &[usize]) {
         match axis {
-            0 => keep_at(&mut self.meshes, keep),
-            1 => keep_at(&mut self.structures, keep),
-            _ => keep_at(&mut self.issues, keep),
+            AoAxis::Mesh => keep_at(&mut self.meshes, keep),
+            AoAxis::Structure => keep_at(&mut self.structures, keep),
+            AoAxis::Issue => keep_at(&mut self.issues, keep),
         }
     }
 
@@ -120,7 +134,7 @@ impl Declaration for AoSpec {
         run_mesh(self, &self.meshes[unit.at[0]], backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<MeshOutcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<MeshOutcome>, run: &mut RunContext) -> anyhow::Result<toml::Table> {
         let (mut rows, mut tuning) = (Vec::new(), Vec::new());
         for o in outcomes {
             rows.extend(o.rows);

@@ -11,10 +11,9 @@
 //! the report is always made from the journaled outcomes read back, so a resumed run, a merged
 //! one and an uninterrupted one write their non-timing outputs byte for byte alike.
 
-use super::filter::{self, Axis, Filter};
-use super::merge::{
-    differing_fields, list_lines, read_shard_manifest, rerun_command, shard_dirs, split_count, MergeRefused,
-};
+use super::filter::{self, Axis, AxisKey, Filter};
+use super::journal::{measure_all, Measured, UnitJournal};
+use super::merge::{merge_units, ShardManifest, SHARD_MANIFEST};
 use super::shard::{deal, share_line, Cost, Shard};
 use crate::experiment::cli::{BadInput, Cli};
 use crate::experiment::header::Header;
@@ -23,9 +22,7 @@ use crate::experiment::{Accepts, Experiment, Finished, RunContext};
 use crate::fingerprint::{build_id, fnv1a};
 use crate::render::{AdapterInfo, Backend, BackendChoice};
 use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
-use std::fmt::Write as _;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// One unit of work: measured whole, on one machine.
@@ -66,11 +63,14 @@ pub trait Declaration: Clone {
         None
     }
 
-    /// Its axes and their values, in the file's order.
-    fn axes(&self) -> Vec<Axis>;
+    /// Its axes' keys ([`crate::axis_keys!`]).
+    type Axis: AxisKey;
 
-    /// Keeps, on axis `axis` (an index into [`Declaration::axes`]), only the values at `keep`.
-    fn restrict(&mut self, axis: usize, keep: &[usize]);
+    /// Its axes and their values, in the file's order.
+    fn axes(&self) -> Vec<Axis<Self::Axis>>;
+
+    /// Keeps, on `axis`, only the values at `keep` (indices into its values, sorted).
+    fn restrict(&mut self, axis: Self::Axis, keep: &[usize]);
 
     /// Its units, in canonical order: the order outcomes reach the report.
     fn units(&self) -> Vec<Unit>;
@@ -78,58 +78,39 @@ pub trait Declaration: Clone {
     /// What `--dry-run` prints about `units` (their plans, sizes); the core adds the axes.
     fn plan(&self, units: &[Unit]) -> anyhow::Result<String>;
 
+    /// Where state that outlives a run may be kept (the results folder: a sweep's ground-truth
+    /// cache, shared by its shards and their merge); called once before any unit is measured.
+    fn keep_state_in(&mut self, _home: &Path) {}
+
+    /// What, beside its label, determines `unit`'s outcome on `adapter`, where that is less than
+    /// the default (every input's content and every axis's values): a unit keyed by it is taken
+    /// from the journal after edits that cannot change it (a sweep's group after another scheme
+    /// is added). It must name the device and the build.
+    fn unit_context(&self, _unit: &Unit, _adapter: &AdapterInfo) -> Option<String> {
+        None
+    }
+
     /// Measures one unit.
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<Self::Outcome>;
 
+    /// Runs of `outcome` that failed and were recorded as such rather than ending the run (a
+    /// sweep renders on past a failed run). A unit with failures is measured again on resume,
+    /// and the run exits with status 3 naming [`Declaration::FAILURES`].
+    fn failed(&self, _outcome: &Self::Outcome) -> usize {
+        0
+    }
+
+    /// The table whose rows say why runs failed.
+    const FAILURES: &'static str = "runs.csv";
+
     /// Writes the outputs from every unit's outcome (canonical order) into `run.out`; returns
-    /// the kind's table for the manifest.
-    fn report(&self, outcomes: Vec<Self::Outcome>, run: &RunContext) -> anyhow::Result<toml::Table>;
+    /// the kind's table for the manifest. It may use the device (a merge renders what no shard
+    /// left it, such as a ground truth missing from the cache).
+    fn report(&self, outcomes: Vec<Self::Outcome>, run: &mut RunContext) -> anyhow::Result<toml::Table>;
 }
 
 /// A declared kind as an experiment.
 pub struct Declared<D>(pub D);
-
-/// A shard's manifest, written last: the merge takes a shard only with it, only if it ran the
-/// same units under the same context, and only the unit files it lists, unchanged.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct ShardManifest {
-    /// `K/N`.
-    pub shard: String,
-    /// The experiment file it ran (for people; `identity` is what is compared).
-    pub experiment: String,
-    /// Hash of every unit key of the whole (filtered) experiment.
-    pub identity: String,
-    /// The keys' context ([`context`]): inputs, axes, device and build.
-    pub context: String,
-    /// The machine it ran on (times from shards on unlike machines are not comparable).
-    pub machine: String,
-    /// Units taken from the shard's journal rather than measured.
-    pub resumed: usize,
-    /// Seconds the shard ran.
-    pub seconds: f64,
-    /// Every unit of the share: its key and the FNV-1a of its journal file.
-    pub units: Vec<UnitFile>,
-}
-
-/// One journaled unit a shard holds.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct UnitFile {
-    /// The unit's key.
-    pub key: String,
-    /// FNV-1a of its journal file as written.
-    pub fnv1a: String,
-}
-
-/// A shard's manifest file.
-pub const SHARD_MANIFEST: &str = "shard.toml";
-
-/// What a unit's journal file holds.
-#[derive(Serialize, Deserialize)]
-struct Journaled<O> {
-    key: String,
-    label: String,
-    outcome: O,
-}
 
 /// Everything besides a unit's label that determines its outcome: the content of every input,
 /// the axes' values (a filtered run never takes an unfiltered run's unit), the device and the
@@ -143,7 +124,7 @@ pub fn context<D: Declaration>(spec: &D, adapter: &AdapterInfo) -> anyhow::Resul
     let axes: Vec<String> = spec
         .axes()
         .iter()
-        .map(|a| format!("{}:{}", a.name, a.values.join(",")))
+        .map(|a| format!("{}:{}", a.name(), a.values.join(",")))
         .collect();
     Ok(format!(
         "inputs={};axes={:016x};device={:?};build={:016x}",
@@ -154,142 +135,53 @@ pub fn context<D: Declaration>(spec: &D, adapter: &AdapterInfo) -> anyhow::Resul
     ))
 }
 
-/// A unit's key under `context`.
-pub fn unit_key(context: &str, unit: &Unit) -> String {
-    format!("{:016x}", fnv1a(format!("{context};{}", unit.label).as_bytes()))
+/// A unit's journal key: its label under `context`, or under what the kind says determines it
+/// ([`Declaration::unit_context`]).
+pub fn unit_key<D: Declaration>(spec: &D, context: &str, adapter: &AdapterInfo, unit: &Unit) -> String {
+    let text = match spec.unit_context(unit, adapter) {
+        Some(own) => format!("own:{own};{}", unit.label),
+        None => format!("{context};{}", unit.label),
+    };
+    format!("{:016x}", fnv1a(text.as_bytes()))
 }
 
 /// Hash of every unit key: which work an experiment (as filtered) is.
-fn identity(context: &str, units: &[Unit]) -> String {
-    let keys: Vec<String> = units.iter().map(|u| unit_key(context, u)).collect();
+pub(super) fn identity<D: Declaration>(spec: &D, context: &str, adapter: &AdapterInfo, units: &[Unit]) -> String {
+    let keys: Vec<String> = units.iter().map(|u| unit_key(spec, context, adapter, u)).collect();
     format!("{:016x}", fnv1a(keys.join(",").as_bytes()))
 }
 
-/// The first line of a journaled unit's file, before the FNV-1a of the rest.
-const CHECK: &str = "# fnv1a ";
-
-/// A folder of journaled units, one TOML file each, written atomically as each finishes.
-struct UnitJournal {
-    dir: PathBuf,
+/// `units`, and each one's share among `count`.
+pub(super) fn dealt(units: &[Unit], count: u32) -> (Vec<u32>, Vec<f64>) {
+    let costs: Vec<Cost> = units.iter().map(|u| u.cost.clone()).collect();
+    deal(&costs, count)
 }
 
-impl UnitJournal {
-    fn open(dir: &Path, fresh: bool) -> anyhow::Result<UnitJournal> {
-        if fresh && dir.exists() {
-            std::fs::remove_dir_all(dir)?;
-        }
-        std::fs::create_dir_all(dir)?;
-        Ok(UnitJournal { dir: dir.into() })
-    }
-
-    fn path(&self, key: &str) -> PathBuf {
-        self.dir.join(format!("{key}.toml"))
-    }
-
-    /// The outcome journaled under `key`: none if no file is there, and a refusal if one is
-    /// there but is not the file this run wrote (its first line, `# fnv1a HASH`, hashes the rest
-    /// as written: an edited, cut or foreign file would otherwise be taken as measured).
-    fn read<O: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Option<O>> {
-        if std::fs::symlink_metadata(path).is_err() {
-            return Ok(None);
-        }
-        let damaged = |why: &str| {
-            BadInput(format!(
-                "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
-                path.display()
-            ))
-        };
-        let text = crate::files::read_regular_text(path).map_err(|e| damaged(&format!("cannot be read ({e:#})")))?;
-        let (check, body) = text.split_once('\n').unwrap_or((&text, ""));
-        if check.strip_prefix(CHECK) != Some(&format!("{:016x}", fnv1a(body.as_bytes()))) {
-            return Err(damaged("has changed since it was written (its checksum does not match)").into());
-        }
-        let j: Journaled<O> = toml::from_str(body).map_err(|e| damaged(&format!("does not parse ({e})")))?;
-        if j.key != key {
-            return Err(damaged(&format!("holds unit {} under another unit's name", j.key)).into());
-        }
-        Ok(Some(j.outcome))
-    }
-
-    fn write<O: Serialize>(&self, key: &str, label: &str, outcome: O) -> anyhow::Result<()> {
-        let body = toml::to_string(&Journaled {
-            key: key.into(),
-            label: label.into(),
-            outcome,
-        })?;
-        let text = format!("{CHECK}{:016x}\n{body}", fnv1a(body.as_bytes()));
-        crate::files::write_atomic(&self.path(key), text.as_bytes())?;
-        die_after_journaled();
-        Ok(())
-    }
+/// The share of `units` that falls to `shard`.
+fn share(units: &[Unit], shard: Shard) -> Vec<Unit> {
+    let (shares, _) = dealt(units, shard.count);
+    units
+        .iter()
+        .zip(shares)
+        .filter(|(_, s)| *s == shard.index - 1)
+        .map(|(u, _)| u.clone())
+        .collect()
 }
 
-/// Test hook: with `PENUMBRA_TEST_DIE_AFTER=n` set, the process aborts (no cleanup, as when a
-/// node kills a job) right after its n-th journaled unit (a sweep's group, an ao mesh, a block of
-/// frames), so tests interrupt a run at a known point.
-pub fn die_after_journaled() {
-    #[cfg(feature = "test-hooks")]
-    {
-        use std::sync::atomic::{AtomicUsize, Ordering};
-        static JOURNALED: AtomicUsize = AtomicUsize::new(0);
-        let n = JOURNALED.fetch_add(1, Ordering::SeqCst) + 1;
-        let limit = std::env::var("PENUMBRA_TEST_DIE_AFTER")
-            .ok()
-            .and_then(|v| v.parse().ok());
-        if limit == Some(n) {
-            std::process::abort();
-        }
-    }
-}
-
-/// Measures `units` (or takes them from `journal`), each outcome read back from its file; returns
-/// the outcomes in `units`' order, how many were resumed, and each unit's key and file hash.
-fn measure_all<D: Declaration>(
+/// Measures every unit of `spec` in this process, resuming from the journal in `home`
+/// (`fresh` discards it first): what `sweep` does without `--shard` or `--merge`, and what
+/// library callers use to run a declared kind whole.
+pub fn measure_whole<D: Declaration>(
     spec: &D,
-    units: &[Unit],
-    context: &str,
-    journal: &UnitJournal,
+    home: &Path,
+    fresh: bool,
     backend: &mut dyn Backend,
     progress: &Progress,
-) -> anyhow::Result<(Vec<D::Outcome>, usize, Vec<UnitFile>)> {
-    // Every journaled unit is read before anything is measured: a damaged one is refused
-    // before hours of work, not after.
-    let mut journaled = Vec::with_capacity(units.len());
-    for unit in units {
-        let key = unit_key(context, unit);
-        let earlier = UnitJournal::read::<D::Outcome>(&journal.path(&key), &key)?;
-        journaled.push((key, earlier));
-    }
-    let bar = progress.bar("units", units.len() as u64);
-    let (mut outcomes, mut resumed, mut files) = (Vec::new(), 0, Vec::new());
-    for (unit, (key, earlier)) in units.iter().zip(journaled) {
-        let path = journal.path(&key);
-        let outcome = match earlier {
-            Some(o) => {
-                resumed += 1;
-                o
-            }
-            None => {
-                bar.message(unit.label.clone());
-                let measured = spec.measure(unit, backend, progress)?;
-                journal.write(&key, &unit.label, measured)?;
-                UnitJournal::read(&path, &key)?
-                    .ok_or_else(|| anyhow::anyhow!("{}: a journaled unit does not read back", path.display()))?
-            }
-        };
-        let bytes = crate::files::read_regular(&path)?;
-        files.push(UnitFile {
-            key,
-            fnv1a: format!("{:016x}", fnv1a(&bytes)),
-        });
-        outcomes.push(outcome);
-        bar.inc(1);
-    }
-    bar.finish();
-    if resumed > 0 {
-        tracing::info!("{resumed} of {} units taken from the journal", units.len());
-    }
-    Ok((outcomes, resumed, files))
+) -> anyhow::Result<Measured<D::Outcome>> {
+    let units = spec.units();
+    let context = context(spec, backend.adapter())?;
+    let journal = UnitJournal::open(&home.join(".journal"), fresh)?;
+    measure_all(spec, &units, &context, &journal, backend, progress)
 }
 
 impl<D: Declaration> Declared<D> {
@@ -300,9 +192,13 @@ impl<D: Declaration> Declared<D> {
         for (axis, keep) in filter::select(&axes, filters, filter::same_text).map_err(BadInput)? {
             // An earlier axis's restriction may have thinned this axis's values (fps: a scene
             // kept takes only its own light counts), so the kept values are found again.
-            let kept: Vec<&String> = keep.iter().map(|&i| &axes[axis].values[i]).collect();
-            let now: Vec<usize> = spec.axes()[axis]
-                .values
+            let values = |axes: &[Axis<D::Axis>]| -> Vec<String> {
+                let of = axes.iter().find(|a| a.key == axis).expect("a declared axis");
+                of.values.clone()
+            };
+            let before = values(&axes);
+            let kept: Vec<&String> = keep.iter().map(|&i| &before[i]).collect();
+            let now: Vec<usize> = values(&spec.axes())
                 .iter()
                 .enumerate()
                 .filter(|(_, v)| kept.contains(v))
@@ -311,23 +207,6 @@ impl<D: Declaration> Declared<D> {
             spec.restrict(axis, &now);
         }
         Ok(spec)
-    }
-
-    /// `units`, and each one's share among `count`.
-    fn dealt(units: &[Unit], count: u32) -> (Vec<u32>, Vec<f64>) {
-        let costs: Vec<Cost> = units.iter().map(|u| u.cost.clone()).collect();
-        deal(&costs, count)
-    }
-
-    /// The share of `units` that falls to `shard`.
-    fn share(units: &[Unit], shard: Shard) -> Vec<Unit> {
-        let (shares, _) = Self::dealt(units, shard.count);
-        units
-            .iter()
-            .zip(shares)
-            .filter(|(_, s)| *s == shard.index - 1)
-            .map(|(u, _)| u.clone())
-            .collect()
     }
 
     /// Runs `shard`'s share into `shard.dir(home)`: its journal, then `shard.toml` last.
@@ -341,18 +220,19 @@ impl<D: Declaration> Declared<D> {
         }
         let units = spec.units();
         let context = context(spec, run.backend.adapter())?;
-        let mine = Self::share(&units, shard);
+        let mine = share(&units, shard);
         let journal = UnitJournal::open(&dir.join(".journal"), run.cli.fresh)?;
-        let (_, resumed, files) = measure_all(spec, &mine, &context, &journal, run.backend, run.progress)?;
+        let measured = measure_all(spec, &mine, &context, &journal, run.backend, run.progress)?;
+        let resumed = measured.resumed;
         let manifest = ShardManifest {
             shard: shard.to_string(),
             experiment: run.cli.experiment.display().to_string(),
-            identity: identity(&context, &units),
+            identity: identity(spec, &context, run.backend.adapter(), &units),
             context,
             machine: crate::experiment::manifest::Machine::current().cpu,
             resumed,
             seconds: started.elapsed().as_secs_f64(),
-            units: files,
+            units: measured.files,
         };
         crate::files::write_atomic(&manifest_path, toml::to_string(&manifest)?.as_bytes())?;
         tracing::info!(
@@ -361,135 +241,11 @@ impl<D: Declaration> Declared<D> {
             manifest.seconds,
             dir.display()
         );
-        Ok(Finished::Shard { failed: None })
+        let journal = dir.join(".journal").display().to_string();
+        Ok(Finished::Shard {
+            failed: Some((measured.failed, journal)),
+        })
     }
-
-    /// The outcomes of every unit, from the shards `run.cli.merge` names, with the machines they
-    /// ran on and how many units they took from their journals; or a refusal listing what is
-    /// missing, duplicated or foreign and the shards to rerun.
-    fn merge(&self, spec: &D, run: &mut RunContext) -> anyhow::Result<(Vec<D::Outcome>, Vec<String>, usize)> {
-        let (dirs, given) = shard_dirs(&run.cli.merge, run.home)?;
-        let units = spec.units();
-        let context = context(spec, run.backend.adapter())?;
-        let identity = identity(&context, &units);
-        let mut problems = String::new();
-        let mut shards: Vec<(PathBuf, Shard, ShardManifest)> = Vec::new();
-        for dir in &dirs {
-            match read_shard(dir, &identity, &context) {
-                Ok((shard, m)) => shards.push((dir.clone(), shard, m)),
-                Err(e) => {
-                    let _ = writeln!(problems, "{e}");
-                }
-            }
-        }
-        let counts: Vec<u32> = shards.iter().map(|s| s.1.count).collect();
-        let count = split_count(given, &counts, &dirs);
-        if counts.iter().any(|&n| n != count) {
-            let listed: Vec<String> = shards.iter().map(|s| format!("{} ({})", s.1, s.0.display())).collect();
-            let _ = writeln!(
-                problems,
-                "shards of different splits (merging {count}): {}",
-                listed.join(", ")
-            );
-        }
-        let (owner, _) = Self::dealt(&units, count);
-        let mut held: HashMap<&str, Vec<usize>> = HashMap::new();
-        for (s, (_, _, m)) in shards.iter().enumerate() {
-            for f in &m.units {
-                held.entry(f.key.as_str()).or_default().push(s);
-            }
-        }
-        let mut missing: Vec<Vec<String>> = vec![Vec::new(); count as usize];
-        let mut duplicated = Vec::new();
-        let mut outcomes = Vec::new();
-        for (unit, &own) in units.iter().zip(&owner) {
-            let key = unit_key(&context, unit);
-            match held.get(key.as_str()).map(Vec::as_slice) {
-                None | Some([]) => missing[own as usize].push(unit.label.clone()),
-                Some([s]) => {
-                    let (dir, shard, m) = &shards[*s];
-                    let path = dir.join(".journal").join(format!("{key}.toml"));
-                    let want = &m.units.iter().find(|f| f.key == key).expect("held").fnv1a;
-                    let bytes = crate::files::read_regular(&path).ok();
-                    let outcome = bytes
-                        .filter(|b| format!("{:016x}", fnv1a(b)) == *want)
-                        .and_then(|_| UnitJournal::read::<D::Outcome>(&path, &key).ok().flatten());
-                    match outcome {
-                        Some(o) => outcomes.push(o),
-                        None => {
-                            let _ = writeln!(
-                                problems,
-                                "{}: the unit `{}` is not the file shard {shard} wrote (missing or changed since)",
-                                path.display(),
-                                unit.label
-                            );
-                        }
-                    }
-                }
-                Some(many) => {
-                    let holders: Vec<String> = many
-                        .iter()
-                        .map(|&s| format!("{} ({})", shards[s].1, shards[s].0.display()))
-                        .collect();
-                    duplicated.push(format!("{}: in {}", unit.label, holders.join(" and ")));
-                }
-            }
-        }
-        let rerun = rerun_command(run.cli);
-        for (own, lines) in missing.iter().enumerate().filter(|(_, l)| !l.is_empty()) {
-            let shard = Shard {
-                index: own as u32 + 1,
-                count,
-            };
-            let _ = writeln!(
-                problems,
-                "shard {shard} is incomplete ({} units missing); rerun it: {rerun} {shard}",
-                lines.len()
-            );
-            list_lines(&mut problems, lines);
-        }
-        if !duplicated.is_empty() {
-            let _ = writeln!(problems, "{} units are in more than one shard:", duplicated.len());
-            list_lines(&mut problems, &duplicated);
-        }
-        if !problems.is_empty() {
-            return Err(MergeRefused(format!("cannot merge the shards:\n{}", problems.trim_end())).into());
-        }
-        let mut machines: Vec<String> = shards.iter().map(|s| s.2.machine.clone()).collect();
-        machines.sort();
-        machines.dedup();
-        if machines.len() > 1 {
-            tracing::warn!(
-                "the shards ran on {} kinds of machine ({}): each unit's times compare only within it",
-                machines.len(),
-                machines.join("; ")
-            );
-        }
-        let resumed = shards.iter().map(|s| s.2.resumed).sum();
-        Ok((outcomes, machines, resumed))
-    }
-}
-
-/// Reads the manifest of the shard in `dir` (a folder of folders and regular files only), or
-/// says why it cannot be taken.
-fn read_shard(dir: &Path, identity: &str, context: &str) -> Result<(Shard, ShardManifest), String> {
-    let (shard, m) = read_shard_manifest(dir, SHARD_MANIFEST, |m: &ShardManifest| &m.shard)?;
-    if m.context != context {
-        return Err(format!(
-            "{}: shard {shard} ran under another {} than this merge (same inputs, axes, device and build \
-             are required: run the merge with the shards' binary on their kind of device)",
-            dir.display(),
-            differing_fields(&m.context, context).join(", ")
-        ));
-    }
-    if m.identity != identity {
-        return Err(format!(
-            "{}: shard {shard} ran other work (experiment file `{}`: other units or filters)",
-            dir.display(),
-            m.experiment
-        ));
-    }
-    Ok((shard, m))
 }
 
 impl<D: Declaration> Experiment for Declared<D> {
@@ -516,13 +272,13 @@ impl<D: Declaration> Experiment for Declared<D> {
         let spec = self.filtered(&cli.filter)?;
         let mut out = String::from("axes (--filter AXIS=VALUE):\n");
         for a in spec.axes() {
-            out += &format!("  {}: {}\n", a.name, a.values.join(", "));
+            out += &format!("  {}: {}\n", a.name(), a.values.join(", "));
         }
         let units = spec.units();
         let units = match cli.shard {
             Some(shard) => {
-                let (_, loads) = Self::dealt(&units, shard.count);
-                let mine = Self::share(&units, shard);
+                let (_, loads) = dealt(&units, shard.count);
+                let mine = share(&units, shard);
                 out += &share_line(&spec.header().name, shard, mine.len(), "units", &loads);
                 mine
             }
@@ -546,31 +302,32 @@ impl<D: Declaration> Experiment for Declared<D> {
     }
 
     fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
-        let spec = self.filtered(&run.cli.filter)?;
+        let mut spec = self.filtered(&run.cli.filter)?;
+        spec.keep_state_in(run.home);
         if let Some(shard) = run.cli.shard {
             return self.run_shard(&spec, shard, run);
         }
-        let (outcomes, resumed) = if run.cli.merge.is_empty() {
-            let units = spec.units();
-            let context = context(&spec, run.backend.adapter())?;
-            let journal = UnitJournal::open(&run.home.join(".journal"), run.cli.fresh)?;
-            let (outcomes, resumed, _) = measure_all(&spec, &units, &context, &journal, run.backend, run.progress)?;
-            (outcomes, resumed)
+        let measured = if run.cli.merge.is_empty() {
+            measure_whole(&spec, run.home, run.cli.fresh, run.backend, run.progress)?
         } else {
-            let (outcomes, machines, resumed) = self.merge(&spec, run)?;
+            let (measured, machines) = merge_units(&spec, run)?;
             tracing::info!(
                 "merged {} units from shards run on: {}",
-                outcomes.len(),
+                measured.outcomes.len(),
                 machines.join("; ")
             );
-            (outcomes, resumed)
+            measured
         };
-        let units = outcomes.len();
-        let mut details = spec.report(outcomes, run)?;
+        let (units, resumed, failed) = (measured.outcomes.len(), measured.resumed, measured.failed);
+        let mut details = spec.report(measured.outcomes, run)?;
         // A unit taken from a journal was measured by an earlier process (its times too): the
         // manifest says how many, so a rerun that measured nothing is not read as fresh timing.
         details.insert("units".into(), toml::Value::Integer(units as i64));
         details.insert("units_from_journal".into(), toml::Value::Integer(resumed as i64));
-        Ok(Finished::Results { details, failed: None })
+        let table = run.home.join(D::FAILURES).display().to_string();
+        Ok(Finished::Results {
+            details,
+            failed: Some((failed, table)),
+        })
     }
 }

@@ -4,13 +4,48 @@
 //! value its file does not list, is an error naming what there is, so a typo never runs an empty
 //! or unintended experiment.
 
+/// A kind's axis, by a typed key (an enum per kind, declared with [`axis_keys!`]): a filter,
+/// a dry run or the core names an axis by its key, never by its place in a list.
+pub trait AxisKey: Copy + PartialEq + std::fmt::Debug {
+    /// Its column and filter name.
+    fn name(self) -> &'static str;
+}
+
+/// Declares a kind's axis keys: an enum whose variants name their axis's column and filter
+/// name (`Scene => "scene"`), implementing [`AxisKey`].
+#[macro_export]
+macro_rules! axis_keys {
+    ($(#[$meta:meta])* $vis:vis enum $name:ident { $($(#[$doc:meta])* $var:ident => $text:literal,)* }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        $vis enum $name {
+            $($(#[$doc])* $var,)*
+        }
+
+        impl $crate::experiment::core::filter::AxisKey for $name {
+            fn name(self) -> &'static str {
+                match self {
+                    $($name::$var => $text,)*
+                }
+            }
+        }
+    };
+}
+
 /// One axis of a kind, as filters, dry runs and results-folder names see it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Axis {
-    /// Its column and filter name.
-    pub name: &'static str,
+pub struct Axis<K> {
+    /// Which axis.
+    pub key: K,
     /// Its values' texts, in the experiment file's order.
     pub values: Vec<String>,
+}
+
+impl<K: AxisKey> Axis<K> {
+    /// Its column and filter name.
+    pub fn name(&self) -> &'static str {
+        self.key.name()
+    }
 }
 
 /// One `AXIS=VALUE` filter, as written; checked against a kind's axes by [`select`].
@@ -46,15 +81,15 @@ impl std::fmt::Display for Filter {
     }
 }
 
-/// What `filters` keep of `axes`: per filtered axis (in declared order), its index and the
+/// What `filters` keep of `axes`: per filtered axis (in declared order), its key and the
 /// indices of the values kept, in the file's order. `same` says whether two value texts name the
 /// same value (numbers written two ways, `0.02` and `2e-2`, are one).
-pub fn select(
-    axes: &[Axis],
+pub fn select<K: AxisKey>(
+    axes: &[Axis<K>],
     filters: &[Filter],
     same: impl Fn(&str, &str) -> bool,
-) -> Result<Vec<(usize, Vec<usize>)>, String> {
-    let names: Vec<&str> = axes.iter().map(|a| a.name).collect();
+) -> Result<Vec<(K, Vec<usize>)>, String> {
+    let names: Vec<&str> = axes.iter().map(Axis::name).collect();
     for f in filters {
         if !names.contains(&f.axis.as_str()) {
             return Err(format!(
@@ -65,8 +100,8 @@ pub fn select(
         }
     }
     let mut out = Vec::new();
-    for (i, axis) in axes.iter().enumerate() {
-        let named: Vec<&Filter> = filters.iter().filter(|f| f.axis == axis.name).collect();
+    for axis in axes {
+        let named: Vec<&Filter> = filters.iter().filter(|f| f.axis == axis.name()).collect();
         if named.is_empty() {
             continue;
         }
@@ -75,7 +110,7 @@ pub fn select(
             let at = axis.values.iter().position(|v| same(v, &f.value)).ok_or_else(|| {
                 format!(
                     "--filter {f}: not among the experiment's {} values: {}",
-                    axis.name,
+                    axis.name(),
                     axis.values.join(", ")
                 )
             })?;
@@ -83,7 +118,7 @@ pub fn select(
         }
         keep.sort_unstable();
         keep.dedup();
-        out.push((i, keep));
+        out.push((axis.key, keep));
     }
     Ok(out)
 }
@@ -117,14 +152,21 @@ several values or restrict several axes";
 mod tests {
     use super::*;
 
-    fn axes() -> Vec<Axis> {
+    crate::axis_keys! {
+        enum Key {
+            Scheme => "scheme",
+            Radius => "light_radius",
+        }
+    }
+
+    fn axes() -> Vec<Axis<Key>> {
         vec![
             Axis {
-                name: "scheme",
+                key: Key::Scheme,
                 values: vec!["uniform".into(), "paper".into(), "sobol".into()],
             },
             Axis {
-                name: "light_radius",
+                key: Key::Radius,
                 values: vec!["0.01".into(), "0.02".into()],
             },
         ]
@@ -142,7 +184,7 @@ mod tests {
             same_text,
         )
         .unwrap();
-        assert_eq!(got, vec![(0, vec![0, 2]), (1, vec![1])]);
+        assert_eq!(got, vec![(Key::Scheme, vec![0, 2]), (Key::Radius, vec![1])]);
         let mut list = vec!['a', 'b', 'c'];
         keep_at(&mut list, &[0, 2]);
         assert_eq!(list, ['a', 'c']);

@@ -7,10 +7,12 @@
 
 pub mod declared;
 pub mod filter;
+pub mod journal;
 pub mod merge;
 pub mod shard;
 
-pub use declared::{Declaration, Declared, Unit};
-pub use filter::{Axis, Filter};
+pub use declared::{measure_whole, Declaration, Declared, Unit};
+pub use filter::{Axis, AxisKey, Filter};
+pub use journal::Measured;
 pub use merge::MergeRefused;
 pub use shard::{Cost, Shard};

@@ -30,6 +30,18 @@ impl FpsSpec {
     }
 }
 
+crate::axis_keys! {
+    /// The frame-rate table's axes.
+    pub enum FpsAxis {
+        /// A scene of the paper's Table 1.
+        Scene => "scene",
+        /// Lights on.
+        Lights => "lights",
+        /// Output resolution.
+        Resolution => "resolution",
+    }
+}
+
 impl Declaration for FpsSpec {
     type Outcome = Vec<FpsRow>;
 
@@ -58,30 +70,32 @@ impl Declaration for FpsSpec {
             .find_map(|(path, s)| crate::experiment::scene_gpu_gap(path, &s.scene))
     }
 
-    fn axes(&self) -> Vec<Axis> {
+    type Axis = FpsAxis;
+
+    fn axes(&self) -> Vec<Axis<FpsAxis>> {
         vec![
             Axis {
-                name: "scene",
+                key: FpsAxis::Scene,
                 values: self.scenes.iter().map(|s| s.name.clone()).collect(),
             },
             Axis {
-                name: "lights",
+                key: FpsAxis::Lights,
                 values: self.light_counts().iter().map(u32::to_string).collect(),
             },
             Axis {
-                name: "resolution",
+                key: FpsAxis::Resolution,
                 values: self.resolutions.iter().map(|[w, h]| format!("{w}x{h}")).collect(),
             },
         ]
     }
 
-    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+    fn restrict(&mut self, axis: FpsAxis, keep: &[usize]) {
         match axis {
-            0 => {
+            FpsAxis::Scene => {
                 keep_at(&mut self.scenes, keep);
                 keep_at(&mut self.scene_paths, keep);
             }
-            1 => {
+            FpsAxis::Lights => {
                 let counts = self.light_counts();
                 let kept: Vec<u32> = keep.iter().map(|&i| counts[i]).collect();
                 for s in &mut self.scenes {
@@ -95,7 +109,7 @@ impl Declaration for FpsSpec {
                 keep_at(&mut self.scenes, &with);
                 keep_at(&mut self.scene_paths, &with);
             }
-            _ => keep_at(&mut self.resolutions, keep),
+            FpsAxis::Resolution => keep_at(&mut self.resolutions, keep),
         }
     }
 
@@ -129,7 +143,7 @@ impl Declaration for FpsSpec {
         run_scenes(self, &unit.at, backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<Vec<FpsRow>>, run: &RunContext) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<Vec<FpsRow>>, run: &mut RunContext) -> anyhow::Result<toml::Table> {
         let rows: Vec<FpsRow> = outcomes.into_iter().flatten().collect();
         report::write_fps(
             self,

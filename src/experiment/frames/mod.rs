@@ -41,6 +41,18 @@ impl FramesSpec {
     }
 }
 
+crate::axis_keys! {
+    /// The frame-time experiments' axes.
+    pub enum FramesAxis {
+        /// A generated scene (its triangle count, or the classroom).
+        Scene => "scene",
+        /// Shading (OpenGL-like, Whitted).
+        Shading => "shading",
+        /// A camera path or viewpoint.
+        Viewpoint => "viewpoint",
+    }
+}
+
 impl Declaration for FramesSpec {
     type Outcome = FramesOutcome;
 
@@ -52,32 +64,34 @@ impl Declaration for FramesSpec {
         vec![self.path.clone()]
     }
 
-    fn axes(&self) -> Vec<Axis> {
+    type Axis = FramesAxis;
+
+    fn axes(&self) -> Vec<Axis<FramesAxis>> {
         vec![
             Axis {
-                name: "scene",
+                key: FramesAxis::Scene,
                 values: self.scene_names(),
             },
             Axis {
-                name: "shading",
+                key: FramesAxis::Shading,
                 values: self.shadings.iter().map(|(n, _)| n.name().to_string()).collect(),
             },
             Axis {
-                name: "viewpoint",
+                key: FramesAxis::Viewpoint,
                 values: self.viewpoints.clone(),
             },
         ]
     }
 
-    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+    fn restrict(&mut self, axis: FramesAxis, keep: &[usize]) {
         match axis {
-            0 => {
+            FramesAxis::Scene => {
                 if let Generator::RandomTriangles { counts, .. } = &mut self.generator {
                     keep_at(counts, keep);
                 }
             }
-            1 => keep_at(&mut self.shadings, keep),
-            _ => keep_at(&mut self.viewpoints, keep),
+            FramesAxis::Shading => keep_at(&mut self.shadings, keep),
+            FramesAxis::Viewpoint => keep_at(&mut self.viewpoints, keep),
         }
     }
 
@@ -153,7 +167,7 @@ impl Declaration for FramesSpec {
         run_block(self, &Block::of(&unit.at), backend, progress)
     }
 
-    fn report(&self, outcomes: Vec<FramesOutcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<FramesOutcome>, run: &mut RunContext) -> anyhow::Result<toml::Table> {
         let mut outcome = FramesOutcome::default();
         for o in outcomes {
             outcome.frames.extend(o.frames);

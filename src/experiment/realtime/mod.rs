@@ -45,6 +45,26 @@ impl Realtime {
     }
 }
 
+crate::axis_keys! {
+    /// The real-time pipelines' axes.
+    pub enum RealtimeAxis {
+        /// Still or moving scene.
+        Variant => "variant",
+        /// Disk sampling scheme.
+        Scheme => "scheme",
+        /// Shadow rays per pixel per frame.
+        Rays => "rays",
+        /// Frames accumulated.
+        Frames => "frames",
+        /// Running mean or moving average.
+        Accumulation => "accumulation",
+        /// Reconstruction filter.
+        Filter => "filter",
+        /// Seed of the sequence.
+        Seed => "seed",
+    }
+}
+
 impl Declaration for Realtime {
     type Outcome = Outcome;
 
@@ -67,50 +87,52 @@ impl Declaration for Realtime {
         v
     }
 
-    fn axes(&self) -> Vec<Axis> {
+    type Axis = RealtimeAxis;
+
+    fn axes(&self) -> Vec<Axis<RealtimeAxis>> {
         let s = &self.spec;
         vec![
             Axis {
-                name: "variant",
+                key: RealtimeAxis::Variant,
                 values: s.variants.iter().map(|v| v.name().to_string()).collect(),
             },
             Axis {
-                name: "scheme",
+                key: RealtimeAxis::Scheme,
                 values: s.schemes.iter().map(|v| v.name().to_string()).collect(),
             },
             Axis {
-                name: "rays",
+                key: RealtimeAxis::Rays,
                 values: s.rays.iter().map(u32::to_string).collect(),
             },
             Axis {
-                name: "frames",
+                key: RealtimeAxis::Frames,
                 values: s.frames.iter().map(u32::to_string).collect(),
             },
             Axis {
-                name: "accumulation",
+                key: RealtimeAxis::Accumulation,
                 values: s.accumulations.iter().map(|a| a.name().to_string()).collect(),
             },
             Axis {
-                name: "filter",
+                key: RealtimeAxis::Filter,
                 values: s.filters.iter().map(|f| f.name().to_string()).collect(),
             },
             Axis {
-                name: "seed",
+                key: RealtimeAxis::Seed,
                 values: s.seeds.iter().map(u32::to_string).collect(),
             },
         ]
     }
 
-    fn restrict(&mut self, axis: usize, keep: &[usize]) {
+    fn restrict(&mut self, axis: RealtimeAxis, keep: &[usize]) {
         let s = &mut self.spec;
         match axis {
-            0 => keep_at(&mut s.variants, keep),
-            1 => keep_at(&mut s.schemes, keep),
-            2 => keep_at(&mut s.rays, keep),
-            3 => keep_at(&mut s.frames, keep),
-            4 => keep_at(&mut s.accumulations, keep),
-            5 => keep_at(&mut s.filters, keep),
-            _ => keep_at(&mut s.seeds, keep),
+            RealtimeAxis::Variant => keep_at(&mut s.variants, keep),
+            RealtimeAxis::Scheme => keep_at(&mut s.schemes, keep),
+            RealtimeAxis::Rays => keep_at(&mut s.rays, keep),
+            RealtimeAxis::Frames => keep_at(&mut s.frames, keep),
+            RealtimeAxis::Accumulation => keep_at(&mut s.accumulations, keep),
+            RealtimeAxis::Filter => keep_at(&mut s.filters, keep),
+            RealtimeAxis::Seed => keep_at(&mut s.seeds, keep),
         }
     }
 
@@ -174,7 +196,7 @@ impl Declaration for Realtime {
         }
     }
 
-    fn report(&self, outcomes: Vec<Outcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
+    fn report(&self, outcomes: Vec<Outcome>, run: &mut RunContext) -> anyhow::Result<toml::Table> {
         report::write(&self.spec, outcomes, run)
     }
 }

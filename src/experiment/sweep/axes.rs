@@ -199,6 +199,23 @@ impl Display for Config {
     }
 }
 
+impl Axes {
+    /// The axes as the core's filters and dry runs see them: each one's name and its values'
+    /// texts.
+    pub fn declared(&self) -> Vec<crate::experiment::core::filter::Axis<Axis>> {
+        self.texts()
+            .into_iter()
+            .map(|(key, values)| crate::experiment::core::filter::Axis { key, values })
+            .collect()
+    }
+}
+
+impl crate::experiment::core::filter::AxisKey for Axis {
+    fn name(self) -> &'static str {
+        Axis::name(self)
+    }
+}
+
 fn texts<T: Display>(values: &[T]) -> Vec<String> {
     values.iter().map(|v| v.to_string()).collect()
 }

@@ -1,25 +1,23 @@
 //! The sweep: the file ([`spec`]) and its axes ([`axes`]), their expansion into runs ([`run`]),
-//! the per-radius references ([`reference`]), the runs ([`runner`]) and their records
-//! ([`record`]) with a resumable journal ([`journal`]), and the outputs ([`report`]). A sweep too
-//! big for one machine runs as shares ([`shard`]) merged back into one result ([`merge`]).
+//! the per-radius references ([`reference`]), a run measured ([`measure`]) into its record
+//! ([`record`]), the kind's units on the experiment core ([`experiment`]) and what they yield
+//! ([`units`], [`runner`]), the timing design ([`timing`]), and the outputs ([`report`]).
 
 pub mod axes;
 pub mod experiment;
-pub mod filter;
-pub mod journal;
 pub mod measure;
-pub mod merge;
 pub mod pictures;
 pub mod record;
 pub mod reference;
 pub mod report;
 pub mod run;
 pub mod runner;
-pub mod shard;
 pub mod spec;
 pub mod timing;
+pub mod units;
 
 pub use axes::{Config, Run};
+pub use experiment::Sweep;
 pub use record::Record;
 pub use runner::{run_sweep, Outcome};
 pub use spec::Spec;

@@ -5,18 +5,27 @@
 use super::run::{expand, Run};
 use super::runner::figure_samples;
 use super::spec::Spec;
-use crate::render::{Backend, Frame, Sampling, View};
+use crate::output::table::f32_hex;
+use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
+use serde::{Deserialize, Serialize};
 
-/// One rendered picture.
+/// One rendered picture: what is shown of its frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Picture {
     /// Shadow rays per pixel.
     pub samples: u32,
-    /// The frame (radiance is what is shown).
-    pub frame: Frame,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Outgoing radiance, row-major ([`crate::render::Frame::radiance`]).
+    #[serde(with = "f32_hex")]
+    pub radiance: Vec<f32>,
 }
 
 /// The pictures of an experiment with `[figures]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Pictures {
     /// Jittered sampling at the figures' ground-truth ray count.
     pub ground_truth: Picture,
@@ -48,7 +57,12 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
                     frame: 0,
                 },
             )?;
-            Ok(Picture { samples, frame })
+            Ok(Picture {
+                samples,
+                width: frame.width,
+                height: frame.height,
+                radiance: frame.radiance,
+            })
         };
     let ground_truth = render(
         DiskScheme::Jittered,

@@ -1,20 +1,23 @@
-//! The sweep: for each (lights on, light radius) pair build the reference once, then render
-//! every run, measure it, and stream the records to a journal so an interrupted sweep resumes
-//! where it stopped; then time every configuration in interleaved rounds (see [`super::timing`]).
+//! The sweep's units measured, and their outcomes put together for the report: a group renders
+//! every seed of one configuration against its (lights on, light radius) reference; the timing
+//! unit times every configuration in interleaved rounds ([`super::timing`]); the outcomes, in
+//! canonical order, become the [`Outcome`] the report reads, records listed reference by
+//! reference.
 
 use super::axes::Config;
-use super::journal::{Figure, Journal};
+use super::experiment::Sweep;
 use super::measure::{failed_record, measure_run};
 use super::record::{FrameTime, Record, Status};
 use super::reference::Reference;
 use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
-use super::timing::{self, ConfigTiming, Timings};
-use crate::experiment::progress::{Bar, Progress};
+use super::timing::{self, Timings};
+use super::units::{Figure, GroupOutcome, TimingOutcome, UnitOutcome};
+use crate::experiment::core::measure_whole;
+use crate::experiment::progress::Progress;
 use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::render::{Backend, RenderPlan, View};
-use crate::sampling::DiskScheme;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -36,10 +39,10 @@ pub struct Outcome {
     pub plan: RenderPlan,
     /// Frame times per configuration (empty when the experiment times nothing).
     pub timings: Timings,
+    /// The Fig. 2 pictures, when the experiment has `[figures]`.
+    pub pictures: Option<super::pictures::Pictures>,
     /// Runs that failed.
     pub failures: usize,
-    /// Groups taken from the journal rather than rendered.
-    pub resumed: usize,
 }
 
 /// Shadow-ray count whose images and profiles are kept for figures (the paper's 16, or the
@@ -82,199 +85,146 @@ pub fn verdict_radius(spec: &Spec) -> f64 {
         .expect("validated non-empty")
 }
 
-/// Runs the sweep. `journal_dir` holds the resumable journal; `fresh` discards it first.
+/// Runs the whole sweep in this process with the core's unit journal and the ground-truth cache
+/// under `home` (`fresh` discards the journal first), and puts its outcomes together.
 pub fn run_sweep(
     spec: &Spec,
     backend: &mut dyn Backend,
-    journal_dir: &Path,
-    cache: &Path,
+    home: &Path,
     fresh: bool,
     progress: &Progress,
 ) -> anyhow::Result<Outcome> {
-    let context = context_key(spec, backend.adapter());
-    let groups = expand(spec);
-    let mut journal = Journal::open(journal_dir, fresh)?;
-    let mut out = render_groups(spec, backend, &groups, &mut journal, cache, &context, progress)?;
-    time_phase(spec, backend, &groups, &mut out, &context, &mut journal, progress)?;
-    Ok(out)
+    let mut sweep = Sweep::new(spec.clone());
+    crate::experiment::core::Declaration::keep_state_in(&mut sweep, home);
+    let measured = measure_whole(&sweep, home, fresh, backend, progress)?;
+    assemble(&sweep, backend, measured.outcomes)
 }
 
-/// An outcome with nothing in it yet but the sweep's plan.
-pub(super) fn empty_outcome(spec: &Spec) -> anyhow::Result<Outcome> {
-    Ok(Outcome {
+/// Renders and measures every seed of `group` against `reference`; a failed render becomes a
+/// failed record and the group goes on.
+pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, reference: &Reference) -> GroupOutcome {
+    let context = context_key(spec, backend.adapter());
+    let mut records = Vec::new();
+    let mut images = Vec::new();
+    for run in &group.runs {
+        match measure_run(spec, backend, run, reference, &context) {
+            Ok((record, image)) => {
+                records.push(record);
+                images.push(image);
+            }
+            Err(e) => {
+                tracing::error!("run failed ({} seed={}): {e:#}", run.config(), run.seed);
+                records.push(failed_record(spec, backend, run, &context, &format!("{e:#}")));
+            }
+        }
+    }
+    let figure = (group.head().samples == figure_samples(spec))
+        .then(|| figure_of(reference, &images))
+        .flatten();
+    GroupOutcome {
+        records,
+        split: BiasVariance::measure(&images, &reference.ground_truth, &reference.mask),
+        figure,
+    }
+}
+
+/// The timing unit: every configuration of the sweep, and the A/A control, timed in the
+/// schedule's interleaved rounds (nothing when the experiment times nothing).
+pub fn time_all(spec: &Spec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<TimingOutcome> {
+    if spec.timing.repeats == 0 {
+        return Ok(TimingOutcome::default());
+    }
+    let groups = expand(spec);
+    let probe = timing::noise_probe(&groups, figure_samples(spec), verdict_radius(spec));
+    let visits = (groups.len() as u64 + probe.map_or(0, |_| timing::NOISE_VISITS as u64)) * spec.timing.repeats as u64;
+    let bar = progress.bar("timed frames", visits);
+    bar.message(format!("{} warm-up each, interleaved rounds", spec.timing.warmup));
+    let (configs, noise) = timing::time_groups(spec, backend, &groups, probe.map(|i| &groups[i]), &|| bar.inc(1))?;
+    bar.finish();
+    Ok(TimingOutcome {
+        configs,
+        noise: probe.zip(noise),
+    })
+}
+
+/// Puts the units' outcomes (canonical order: groups, pictures, timing) together for the
+/// report: each reference built again, from the ground-truth cache where a unit left it.
+pub fn assemble(sweep: &Sweep, backend: &mut dyn Backend, outcomes: Vec<UnitOutcome>) -> anyhow::Result<Outcome> {
+    let spec = &sweep.spec;
+    let groups = expand(spec);
+    let context = context_key(spec, backend.adapter());
+    let mut out = Outcome {
         records: Vec::new(),
         groups: Vec::new(),
         references: Vec::new(),
         profiles: Vec::new(),
         keep: Vec::new(),
         plan: sweep_plan(spec)?,
-        timings: Timings::default(),
+        timings: Timings {
+            seed: spec.timing.seed,
+            ..Timings::default()
+        },
+        pictures: None,
         failures: 0,
-        resumed: 0,
-    })
-}
-
-/// Renders and measures `groups` (all of a sweep, or a shard's share), taking completed groups
-/// from the journal; no timing. Records come reference by reference ([`by_reference`]), as an
-/// unsharded sweep lists them.
-pub(super) fn render_groups(
-    spec: &Spec,
-    backend: &mut dyn Backend,
-    groups: &[Group],
-    journal: &mut Journal,
-    cache: &Path,
-    context: &str,
-    progress: &Progress,
-) -> anyhow::Result<Outcome> {
-    let fig_n = figure_samples(spec);
-    if spec.axes.schemes.contains(&DiskScheme::SobolBluenoise) {
-        let mut counts = spec.axes.samples.clone();
-        counts.extend(spec.figures.as_ref().map(|f| f.samples));
-        crate::sampling::bluenoise::prepare(&counts);
-    }
-    let bar = progress.bar("runs", groups.iter().map(|g| g.runs.len() as u64).sum());
-    let mut out = empty_outcome(spec)?;
-    for ((lights, radius), share) in by_reference(groups) {
-        bar.message(format!("reference for {lights} light(s) of radius {radius} m"));
-        let reference = Reference::build(spec, backend, lights, radius, cache, context)?;
-        for warning in reference.warnings() {
-            // `println` on a hidden bar (stderr not a terminal, as in CI logs) prints nothing.
-            bar.suspend(|| tracing::warn!("{warning}"));
+    };
+    let mut measured: Vec<Option<GroupOutcome>> = Vec::new();
+    let mut timing = TimingOutcome::default();
+    for o in outcomes {
+        match o {
+            UnitOutcome::Group(g) => measured.push(Some(g)),
+            UnitOutcome::Pictures(p) => out.pictures = p,
+            UnitOutcome::Timing(t) => timing = t,
         }
-        for group in share {
-            let group_key = group.key(context);
-            let figure = (group.head().samples == fig_n).then(|| journal.figure(&group_key));
-            if let (Some((records, stats)), None | Some(Some(_))) = (journal.completed(group, context), &figure) {
-                if let Some(Some(f)) = figure {
-                    keep_figure(&mut out, &reference, group.config(), f);
-                }
-                out.records.extend(records);
-                out.groups.push(stats);
-                out.resumed += 1;
-                bar.inc(group.runs.len() as u64);
-                continue;
-            }
-            bar.message(group.config().to_string());
-            let (records, stats, images) = run_group(spec, backend, group, &reference, context, &bar);
-            if figure.is_some() {
-                if let Some(f) = figure_of(&reference, &images) {
-                    journal.save_figure(&group_key, &f)?;
-                    keep_figure(&mut out, &reference, group.config(), f);
-                }
-            }
-            let failed = records.iter().filter(|r| r.status != Status::Ok).count();
-            out.failures += failed;
-            if failed == 0 {
-                journal.append(&group_key, &records, &stats)?;
-                #[cfg(feature = "test-hooks")]
-                crate::experiment::core::declared::die_after_journaled();
-            }
-            out.records.extend(records);
-            out.groups.push(stats);
-        }
-        out.references.push(reference);
     }
-    bar.finish();
+    anyhow::ensure!(
+        measured.len() == groups.len(),
+        "{} group outcomes for {} configurations",
+        measured.len(),
+        groups.len()
+    );
+    for ((lights, radius), share) in by_reference(&groups) {
+        let reference = sweep.reference(backend, lights, radius)?;
+        for (i, g) in share {
+            let o = measured[i].take().expect("each group once");
+            if let Some(f) = o.figure {
+                keep_figure(&mut out, &reference, g.config(), f);
+            }
+            out.failures += o.records.iter().filter(|r| r.status != Status::Ok).count();
+            out.records.extend(o.records);
+            out.groups.push(GroupStats {
+                key: g.head().key(&context),
+                config: g.config(),
+                split: o.split,
+            });
+        }
+        out.references.push((*reference).clone());
+    }
+    if !timing.configs.is_empty() {
+        for (g, t) in groups.iter().zip(timing.configs) {
+            out.timings.configs.insert(g.head().key(&context), t);
+        }
+        out.timings.noise = timing.noise.map(|(i, t)| (groups[i].config(), t));
+        fill_timing_columns(&mut out, &groups, &context);
+    }
     Ok(out)
 }
 
-/// `groups` by the reference they are judged against, (lights on, light radius) pairs in order
-/// of first appearance: the order runs are rendered in and records listed.
-pub(super) fn by_reference(groups: &[Group]) -> Vec<((u32, f64), Vec<&Group>)> {
-    let mut pairs: Vec<((u32, f64), Vec<&Group>)> = Vec::new();
-    for g in groups {
+/// The groups (with their indices) judged against one reference: its (lights on, light radius)
+/// pair, and them.
+pub type ReferenceShare<'a> = ((u32, f64), Vec<(usize, &'a Group)>);
+
+/// `groups` (with their indices) by the reference they are judged against, (lights on, light
+/// radius) pairs in order of first appearance: the order records are listed in.
+pub fn by_reference(groups: &[Group]) -> Vec<ReferenceShare<'_>> {
+    let mut pairs: Vec<ReferenceShare> = Vec::new();
+    for (i, g) in groups.iter().enumerate() {
         let pair = (g.head().lights, g.head().light_radius);
         match pairs.iter_mut().find(|(p, _)| *p == pair) {
-            Some((_, share)) => share.push(g),
-            None => pairs.push((pair, vec![g])),
+            Some((_, share)) => share.push((i, g)),
+            None => pairs.push((pair, vec![(i, g)])),
         }
     }
     pairs
-}
-
-/// The timing phase over every group of the sweep that rendered, when the experiment times
-/// anything; fills the records' timing columns.
-pub(super) fn time_phase(
-    spec: &Spec,
-    backend: &mut dyn Backend,
-    groups: &[Group],
-    out: &mut Outcome,
-    context: &str,
-    journal: &mut Journal,
-    progress: &Progress,
-) -> anyhow::Result<()> {
-    if spec.timing.repeats > 0 {
-        out.timings = time_sweep(spec, backend, groups, out, context, journal, progress)?;
-        fill_timing_columns(out, groups, context);
-    }
-    Ok(())
-}
-
-/// The timing phase: every configuration whose runs all rendered, and the noise probe, timed in
-/// interleaved rounds (or taken from the journal under the same timing settings).
-fn time_sweep(
-    spec: &Spec,
-    backend: &mut dyn Backend,
-    groups: &[Group],
-    out: &Outcome,
-    context: &str,
-    journal: &mut Journal,
-    progress: &Progress,
-) -> anyhow::Result<Timings> {
-    let settings = timing::settings_key(&spec.timing);
-    let rendered: Vec<&Group> = groups
-        .iter()
-        .filter(|g| {
-            let key = g.head().key(context);
-            out.records.iter().any(|r| r.run_key == key && r.status == Status::Ok)
-        })
-        .collect();
-    let probe = timing::noise_probe(&rendered, figure_samples(spec), verdict_radius(spec));
-    let mut result = Timings {
-        seed: spec.timing.seed,
-        ..Timings::default()
-    };
-    let mut todo = Vec::new();
-    for g in &rendered {
-        let key = g.head().key(context);
-        match journal.timing(&key, &settings) {
-            Some(t) => {
-                result.configs.insert(key, t.clone());
-            }
-            None => todo.push(*g),
-        }
-    }
-    let noise_key = probe.map(|g| timing::noise_key(&g.head().key(context)));
-    let mut journaled_noise = noise_key.as_ref().and_then(|k| journal.timing(k, &settings)).cloned();
-    // Times are compared only within one interleaved phase: if anything must be timed, all is
-    // timed again, so no ranking sets frames from two processes (and two machine loads) apart.
-    if !todo.is_empty() || (probe.is_some() && journaled_noise.is_none()) {
-        todo = rendered.clone();
-        result.configs.clear();
-        journaled_noise = None;
-    }
-    let noise_todo = if journaled_noise.is_none() { probe } else { None };
-    if !todo.is_empty() || noise_todo.is_some() {
-        let visits =
-            (todo.len() as u64 + noise_todo.map_or(0, |_| timing::NOISE_VISITS as u64)) * spec.timing.repeats as u64;
-        let bar = progress.bar("timed frames", visits);
-        bar.message(format!("{} warm-up each, interleaved rounds", spec.timing.warmup));
-        let (timed, noise) = timing::time_groups(spec, backend, &todo, noise_todo, &|| bar.inc(1))?;
-        bar.finish();
-        let mut new: Vec<(String, ConfigTiming)> = todo.iter().map(|g| g.head().key(context)).zip(timed).collect();
-        if let (Some(k), Some(n)) = (&noise_key, &noise) {
-            new.push((k.clone(), n.clone()));
-        }
-        journal.append_timings(&settings, &new)?;
-        result.noise = noise.map(|n| (probe.expect("noise probe").config(), n));
-        result
-            .configs
-            .extend(new.into_iter().filter(|(k, _)| Some(k) != noise_key.as_ref()));
-    }
-    if let (Some(g), Some(n)) = (probe, journaled_noise) {
-        result.noise = Some((g.config(), n));
-    }
-    Ok(result)
 }
 
 /// Writes each configuration's timing into the records of all its seeds (a configuration is
@@ -303,7 +253,9 @@ fn fill_timing_columns(out: &mut Outcome, groups: &[Group], context: &str) {
         let Some(gk) = group_of.get(&r.run_key) else {
             continue;
         };
-        let Some(t) = out.timings.configs.get(gk) else { continue };
+        let Some(t) = out.timings.configs.get(gk) else {
+            continue;
+        };
         let frame = t.frame();
         let (primary, shadow) = rays[gk];
         let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] =
@@ -335,57 +287,11 @@ fn figure_of(reference: &Reference, images: &[Vec<f32>]) -> Option<Figure> {
 }
 
 /// Adds a group's figure to the outcome: its image, and its profile on on-axis scenes.
-pub(super) fn keep_figure(out: &mut Outcome, reference: &Reference, config: Config, figure: Figure) {
+fn keep_figure(out: &mut Outcome, reference: &Reference, config: Config, figure: Figure) {
     if let Some(means) = figure.profile_means {
         let mut profile = RadialProfile::new(&reference.receivers, &figure.image);
         profile.mean = means;
         out.profiles.push((config.clone(), profile));
     }
     out.keep.push((config, figure.image));
-}
-
-/// Renders and measures every seed of a group; a failed render becomes a failed record and the
-/// sweep goes on.
-fn run_group(
-    spec: &Spec,
-    backend: &mut dyn Backend,
-    group: &Group,
-    reference: &Reference,
-    context: &str,
-    bar: &Bar,
-) -> (Vec<Record>, GroupStats, Vec<Vec<f32>>) {
-    let mut records = Vec::new();
-    let mut images = Vec::new();
-    for run in &group.runs {
-        match measure_run(spec, backend, run, reference, context) {
-            Ok((record, image)) => {
-                records.push(record);
-                images.push(image);
-            }
-            Err(e) => {
-                bar.suspend(|| tracing::error!("run failed ({} seed={}): {e:#}", run.config(), run.seed));
-                records.push(failed_record(spec, backend, run, context, &format!("{e:#}")));
-            }
-        }
-        bar.inc(1);
-    }
-    let stats = GroupStats {
-        key: group.head().key(context),
-        config: group.config(),
-        split: BiasVariance::measure(&images, &reference.ground_truth, &reference.mask),
-    };
-    (records, stats, images)
-}
-
-/// What `--dry-run` prints: every configuration with its seeds, then the render plan.
-pub fn dry_run(spec: &Spec) -> anyhow::Result<String> {
-    let groups = expand(spec);
-    let runs: usize = groups.iter().map(|g| g.runs.len()).sum();
-    let mut out = format!("{}: {runs} runs in {} configurations\n", spec.name, groups.len());
-    for g in &groups {
-        let seeds: Vec<String> = g.runs.iter().map(|r| r.seed.to_string()).collect();
-        out += &format!("  {} seeds=[{}]\n", g.config(), seeds.join(", "));
-    }
-    out += &format!("render plan of a run:\n{}", sweep_plan(spec)?);
-    Ok(out)
 }

@@ -8,8 +8,7 @@
 use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::Spec;
-use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, Schedule};
-use crate::fingerprint::fnv1a;
+use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate};
 use crate::render::{Backend, Sampling, View};
 use std::collections::BTreeMap;
 
@@ -17,7 +16,7 @@ use std::collections::BTreeMap;
 pub const NOISE_VISITS: u32 = 1;
 
 /// The timed frames of one configuration, one per round in round order.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ConfigTiming {
     /// Seconds per timed frame, in the order they were taken.
     pub frame_seconds: Vec<f64>,
@@ -80,34 +79,17 @@ pub struct Timings {
     pub seed: u32,
 }
 
-/// Key of the timing settings: journaled timings are reused only under the same settings.
-pub fn settings_key(t: &Schedule) -> String {
-    let text = format!(
-        "warmup={};repeats={};order={:08x};control={NOISE_VISITS}",
-        t.warmup, t.repeats, t.seed
-    );
-    format!("{:016x}", fnv1a(text.as_bytes()))
-}
-
-/// Journal key of the A/A control's frames.
-pub fn noise_key(group_key: &str) -> String {
-    format!("noise-{group_key}")
-}
-
 /// The configuration timed twice as the A/A control: uniform sampling, per-pixel, at the figure
 /// ray count and the verdict's radius where swept, else the first configuration.
-pub fn noise_probe<'a>(groups: &'a [&'a Group], samples: u32, radius: f64) -> Option<&'a Group> {
-    groups
-        .iter()
-        .find(|g| {
-            let h = g.head();
-            h.scheme == crate::sampling::DiskScheme::Uniform
-                && h.pattern == crate::sampling::Pattern::PerPixel
-                && h.samples == samples
-                && h.light_radius == radius
-        })
-        .or(groups.first())
-        .copied()
+pub fn noise_probe(groups: &[Group], samples: u32, radius: f64) -> Option<usize> {
+    let probe = groups.iter().position(|g| {
+        let h = g.head();
+        h.scheme == crate::sampling::DiskScheme::Uniform
+            && h.pattern == crate::sampling::Pattern::PerPixel
+            && h.samples == samples
+            && h.light_radius == radius
+    });
+    probe.or((!groups.is_empty()).then_some(0))
 }
 
 /// Times `groups` (each by its first run) and, if `noise` is given, the A/A control, in the
@@ -115,7 +97,7 @@ pub fn noise_probe<'a>(groups: &'a [&'a Group], samples: u32, radius: f64) -> Op
 pub fn time_groups(
     spec: &Spec,
     backend: &mut dyn Backend,
-    groups: &[&Group],
+    groups: &[Group],
     noise: Option<&Group>,
     on_frame: &dyn Fn(),
 ) -> anyhow::Result<(Vec<ConfigTiming>, Option<ConfigTiming>)> {

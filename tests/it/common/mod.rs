@@ -252,8 +252,9 @@ pub fn hook_site(seed: u32, pixel: u32, frame: u32) -> penumbra::sampling::Site 
 }
 
 /// Columns whose values come from the clock (timing phases, builds, updates).
-const CLOCK_COLUMNS: [&str; 8] = [
+const CLOCK_COLUMNS: [&str; 9] = [
     "timed_frames",
+    "primary_s",
     "rays_per_s",
     "primary_rays_per_s",
     "shadow_rays_per_s",

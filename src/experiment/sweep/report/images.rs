@@ -169,7 +169,7 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
                 label: format!("picture: {} ({}), {} rays", run.scheme, run.pattern, pic.samples),
                 exr: format!("{stem}.exr"),
                 png: format!("{stem}.png"),
-                values: pic.frame.radiance.clone(),
+                values: pic.radiance.clone(),
                 key: vec![],
             }
         })
@@ -178,15 +178,15 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
         label: format!("picture: jittered (ground truth), {} rays", gt.samples),
         exr: "images/picture_ground_truth.exr".into(),
         png: "images/picture_ground_truth.png".into(),
-        values: gt.frame.radiance.clone(),
+        values: gt.radiance.clone(),
         key: vec![],
     });
     Ok(Gallery {
         title: format!("Fig. 2 pictures, seed {seed} (radiance)"),
-        width: gt.frame.width,
-        height: gt.frame.height,
+        width: gt.width,
+        height: gt.height,
         tone: Tone::Radiance {
-            p99: exposure(&Tone::radiance_stored(&gt.frame.radiance)),
+            p99: exposure(&Tone::radiance_stored(&gt.radiance)),
         },
         reference: Some(shots.len() - 1),
         against: None,

@@ -12,7 +12,6 @@ pub fn details(r: &Results) -> toml::Table {
     };
     put("runs", (r.outcome.records.len() as i64).into());
     put("failed_runs", (r.outcome.failures as i64).into());
-    put("resumed_groups", (r.outcome.resumed as i64).into());
     put(
         "seeds",
         toml::Value::Array(s.axes.seeds.iter().map(|&x| toml::Value::from(x as i64)).collect()),

@@ -22,12 +22,11 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     let radius = verdict_radius(spec);
     let mut s = format!("# {}: soft-shadow sampling sweep\n\n", spec.name);
     s += &format!(
-        "Experiment `{}`, scene `{}`; {} runs ({} failed, {} groups resumed from the journal) on **{}** ({}, {}, {}) in {:.0} s.\n\n",
+        "Experiment `{}`, scene `{}`; {} runs ({} failed) on **{}** ({}, {}, {}) in {:.0} s.\n\n",
         spec.path.display(),
         spec.scene_path.display(),
         outcome.records.len(),
         outcome.failures,
-        outcome.resumed,
         adapter.name,
         adapter.backend,
         adapter.api,

@@ -12,14 +12,14 @@ use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
 fn display(p: &Picture, p99: f64) -> Rgb {
-    tonemap_with(&p.frame.radiance, p.frame.width, p.frame.height, p99)
+    tonemap_with(&p.radiance, p.width, p.height, p99)
 }
 
 /// Mean FLIP of every picture against the ground-truth picture, per configuration, one value per
 /// seed in seed order.
 pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
     let gt = &pictures.ground_truth;
-    let p99 = exposure(&gt.frame.radiance);
+    let p99 = exposure(&gt.radiance);
     let reference = display(gt, p99);
     let mut out = PictureFlip::new();
     for (run, p) in &pictures.runs {
@@ -65,7 +65,7 @@ pub fn shown(spec: &Spec) -> Vec<(DiskScheme, Pattern)> {
 /// ground truth's exposure.
 pub fn write_fig2_picture(spec: &Spec, pictures: &Pictures, seed: u32, path: &Path) -> anyhow::Result<()> {
     let gt = &pictures.ground_truth;
-    let p99 = exposure(&gt.frame.radiance);
+    let p99 = exposure(&gt.radiance);
     let mut tiles: Vec<(String, Rgb)> = Vec::new();
     for (scheme, pattern) in shown(spec) {
         let found = pictures
