@@ -17,9 +17,9 @@ use super::merge::{
 };
 use super::shard::{deal, share_line, Cost, Shard};
 use crate::experiment::cli::{BadInput, Cli};
+use crate::experiment::contract::{Accepts, Experiment, Finished, RunContext};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::{Accepts, Experiment, Finished, RunContext};
 use crate::fingerprint::{build_id, fnv1a};
 use crate::render::{AdapterInfo, Backend, BackendChoice};
 use serde::de::DeserializeOwned;

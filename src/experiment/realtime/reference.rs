@@ -4,7 +4,7 @@
 //! (G-buffer, receivers) the filters and the blocker estimate read.
 
 use super::spec::{RealtimeSpec, Variant};
-use crate::experiment::sweep::reference::{exact_image, has_exact_answer, shadow_image, GROUND_TRUTH_SEED};
+use crate::experiment::shadow::{exact_image, has_exact_answer, shadow_image, GROUND_TRUTH_SEED};
 use crate::metrics::edge::EdgeProfile;
 use crate::metrics::{PenumbraMask, Receivers};
 use crate::render::cpu::closest_hit;

@@ -5,14 +5,13 @@
 
 use super::runner::{Outcome, Picture, Row, Series, Timed, REFERENCE};
 use super::spec::RealtimeSpec;
-use crate::experiment::sweep::reference::has_exact_answer;
-use crate::experiment::sweep::report::plots::scheme_look;
+use crate::experiment::contract::RunContext;
+use crate::experiment::shadow::has_exact_answer;
 use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, MARGIN, RULE};
-use crate::experiment::RunContext;
 use crate::files::write_atomic;
 use crate::metrics::stats::mean_ci;
 use crate::output::page::{self, Gallery, Page, Shot, Tone};
-use crate::output::plots::{line_panels, Axes, Panel, Point, Series as PlotSeries};
+use crate::output::plots::{line_panels, scheme_look, Axes, Panel, Point, Series as PlotSeries};
 use crate::output::table::write_rows;
 use crate::sampling::DiskScheme;
 use serde::Serialize;

@@ -6,7 +6,7 @@
 use super::reference::{RefFrame, References};
 use super::spec::{RealtimeSpec, Variant};
 use crate::experiment::progress::Progress;
-use crate::experiment::sweep::reference::shadow_image;
+use crate::experiment::shadow::shadow_image;
 use crate::experiment::timing::{median_interval, Estimate};
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::metrics::{penumbra_coverage, ErrorMetrics};
