@@ -12,7 +12,7 @@ use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::metrics::{penumbra_coverage, ErrorMetrics};
 use crate::output::images::grey;
 use crate::render::denoise::penumbra::{blocker_distance, kernel_sigma};
-use crate::render::denoise::{Accumulation, Accumulator, Filter, GBuffer, Input};
+use crate::render::denoise::{Accumulation, Accumulator, BlockerHistory, Filter, GBuffer, Input};
 use crate::render::shading::Receiver;
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern, Site};
@@ -199,7 +199,7 @@ struct History {
     accumulation: Accumulation,
     image: Accumulator,
     /// One per light, for the blocker estimate.
-    blockers: Vec<Accumulator>,
+    blockers: Vec<BlockerHistory>,
 }
 
 /// Measures one (variant, scheme, rays) unit over every seed.
@@ -235,7 +235,7 @@ pub fn measure(
                     .scene
                     .lights
                     .iter()
-                    .map(|_| Accumulator::new(a, (w * h) as usize))
+                    .map(|_| BlockerHistory::new(a, (w * h) as usize))
                     .collect(),
             })
             .collect();
@@ -266,7 +266,7 @@ pub fn measure(
                 false => vec![vec![f64::NAN; image.len()]; scene.lights.len()],
             };
             for hist in &mut histories {
-                hist.image.add(&image, &blocker[0]);
+                hist.image.add(&image);
                 for (acc, b) in hist.blockers.iter_mut().zip(&blocker) {
                     acc.add(&image, b);
                 }
@@ -394,7 +394,7 @@ pub fn measure(
 }
 
 /// The penumbra filter's per-pixel sigma: the widest any light's blocker estimate asks for.
-fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[Accumulator]) -> Vec<f32> {
+fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<f32> {
     let mut sigma = vec![0f32; gbuffer.depth.len()];
     for (light, acc) in scene.lights.iter().zip(blockers) {
         let Light::Disk(d) = light else { continue };
@@ -461,11 +461,11 @@ pub fn time(
         let frame = backend.render(&scene0, view, sampling)?;
         let shadow = shadow_image(&frame.visibility);
         let b = blockers(&scene0, &guides.receivers, sampling, rays0, w);
-        image.add(&shadow, &b[0]);
+        image.add(&shadow);
         if blocker_accs.is_empty() {
             blocker_accs = b
                 .iter()
-                .map(|_| Accumulator::new(Accumulation::Mean, (w * h) as usize))
+                .map(|_| BlockerHistory::new(Accumulation::Mean, (w * h) as usize))
                 .collect();
         }
         for (acc, bl) in blocker_accs.iter_mut().zip(&b) {
