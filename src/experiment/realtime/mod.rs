@@ -11,11 +11,13 @@
 //! render and filter in the same interleaved rounds, so frame-time budgets compare like with
 //! like.
 
+pub mod pipeline;
 pub mod reference;
 pub mod report;
 pub mod runner;
 pub mod spec;
 
+pub use pipeline::Pipeline;
 pub use spec::{RealtimeSpec, Variant};
 
 use crate::experiment::contract::RunContext;
