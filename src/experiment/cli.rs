@@ -1,7 +1,6 @@
 //! The `sweep` command line, shared by every kind, and the errors that choose its exit status.
 
-use super::core::filter::{self, Filter};
-use super::core::shard::Shard;
+use super::args::{Filter, Shard, FILTER_HELP};
 use crate::render::BackendChoice;
 use std::path::PathBuf;
 
@@ -62,7 +61,7 @@ pub struct Cli {
     #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
     pub merge: Vec<PathBuf>,
     /// Subset filters; the help text names the axes from the axis list.
-    #[arg(long, value_name = "AXIS=VALUE", help = filter::HELP)]
+    #[arg(long, value_name = "AXIS=VALUE", help = FILTER_HELP)]
     pub filter: Vec<Filter>,
     /// More log output (repeatable).
     #[arg(short, long, action = clap::ArgAction::Count)]

@@ -4,11 +4,12 @@
 //! outcome to the exit status stated in `--help`.
 
 use super::cli::{BadInput, Cli, RunsFailed};
+use super::contract::{Experiment, Finished, RunContext};
 use super::core::MergeRefused;
+use super::kinds::load;
 use super::manifest::{peak_rss, utc, Build, Input, Machine, Manifest, RunInfo, SCHEMA};
 use super::outputs::{check_home, resolve_home, Outputs};
 use super::progress::Progress;
-use super::{load, Experiment, Finished, RunContext};
 use crate::render::{cpu::CpuBackend, open_backend, Backend, BackendChoice};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -65,7 +66,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
 
 /// Runs `experiment` into the results folder `home` ([`resolve_home`]).
 fn run_into(
-    experiment: &dyn super::Experiment,
+    experiment: &dyn Experiment,
     cli: &Cli,
     choice: BackendChoice,
     home: &std::path::Path,

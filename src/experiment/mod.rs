@@ -1,135 +1,37 @@
-//! Experiments: one contract ([`Experiment`]) that every kind implements and one [`driver`] that
-//! runs any of them. The kinds: [`sweep`] (sampling schemes swept and measured against a ground
+//! Experiments: one contract ([`contract`]: [`Experiment`]) that every kind implements, one
+//! registry ([`kinds`]: [`load`]) that reads a file into its kind, and one [`driver`] that runs
+//! any of them. The kinds: [`sweep`] (sampling schemes swept and measured against a ground
 //! truth), [`fps`] (the paper's frame rates), [`ao`] (the visibility-field paper's
-//! ambient-occlusion table) and [`frames`] (its frame-time figures: scaling, walkthrough, dynamic
-//! scenes).
+//! ambient-occlusion table), [`frames`] (its frame-time figures: scaling, walkthrough, dynamic
+//! scenes) and [`realtime`] (few-ray pipelines accumulated and filtered). No kind imports
+//! another: what two kinds share sits below them ([`shadow`], [`core`]).
 //!
 //! The driver owns what every kind shares: the header (`kind`, `name`, `backend`, `[timing]`,
 //! [`header`]) validated once, the command line's refusals, the output folder and its atomic
 //! replacement ([`outputs`]), the manifest ([`manifest`]), logging and progress ([`progress`]),
-//! and the timing method ([`timing`]). A kind is its spec, its runner and its report.
+//! and the timing method ([`timing`]). A kind is its spec, its runner and its report. This
+//! module only declares the parts and hands on the contract's names and [`load`].
 
 pub mod ao;
+pub mod args;
 pub mod cli;
 pub mod comparison;
+pub mod contract;
 pub mod core;
 pub mod driver;
 pub mod fps;
 pub mod frames;
 pub mod header;
 pub mod kind;
+pub mod kinds;
 pub mod manifest;
 pub mod outputs;
 pub mod progress;
 pub mod realtime;
+pub mod shadow;
 pub mod sweep;
 pub mod timing;
 
-use crate::config::{ConfigError, Source};
-use crate::render::Backend;
-use cli::Cli;
-use header::Header;
-use kind::Kind;
-use outputs::Outputs;
-use progress::Progress;
-use std::path::{Path, PathBuf};
-
-/// What a kind accepts beyond the shared command line (every kind takes `--filter`, `--shard`
-/// and `--merge`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Accepts {
-    /// Whether it runs on the GPU; a kind that does not times the f64 CPU backend, where every
-    /// structure is exact, and refuses `--backend gpu`.
-    pub gpu: bool,
-    /// The backend where neither the file nor the command line names one.
-    pub backend: crate::render::BackendChoice,
-}
-
-/// Everything a kind's run may use.
-pub struct RunContext<'a> {
-    /// The device.
-    pub backend: &'a mut dyn Backend,
-    /// The command line.
-    pub cli: &'a Cli,
-    /// The results folder, where state that outlives a run stays (a sweep's journal, its
-    /// ground-truth cache, shards); never the outputs themselves.
-    pub home: &'a Path,
-    /// Where this run's outputs go, swapped in as one set when the run succeeds.
-    pub out: &'a Outputs,
-    /// Progress bars or, off a terminal, timestamped log lines.
-    pub progress: &'a Progress,
-    /// When the run started (reports state its length).
-    pub started: std::time::Instant,
-}
-
-/// How a run ended.
-pub enum Finished {
-    /// The outputs are written; `details` is the kind's table in the manifest; `failed` names
-    /// runs that failed and the table saying why (exit status 3).
-    Results {
-        /// The kind's part of the manifest.
-        details: toml::Table,
-        /// Failed runs and the file whose rows say why.
-        failed: Option<(usize, String)>,
-    },
-    /// A share of an experiment, written into its own folder; no result set to swap in.
-    Shard {
-        /// Failed runs and the file whose rows say why.
-        failed: Option<(usize, String)>,
-    },
-}
-
-/// An experiment of any kind, read from its file.
-pub trait Experiment {
-    /// The shared keys.
-    fn header(&self) -> &Header;
-
-    /// What it accepts beyond the shared command line.
-    fn accepts(&self) -> Accepts;
-
-    /// Every file it read (experiment, scenes, meshes), hashed into the manifest.
-    fn inputs(&self) -> Vec<PathBuf>;
-
-    /// What of it the GPU cannot run (a structure without a GPU form), located at its file and
-    /// key; the driver asks before it chooses a
-    /// backend. Kinds that render on the CPU only say nothing.
-    fn gpu_gap(&self) -> Option<String> {
-        None
-    }
-
-    /// What `--dry-run` prints: every unit and its render plan.
-    fn dry_run(&self, cli: &Cli) -> anyhow::Result<String>;
-
-    /// The results folder's name under `results/` (a sweep run with filters appends them).
-    fn folder(&self, _cli: &Cli) -> anyhow::Result<String> {
-        Ok(self.header().name.clone())
-    }
-
-    /// Runs and writes the outputs into `run.out`.
-    fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished>;
-}
-
-/// What of `scene`, read from `path`, the GPU cannot run: its structure without a GPU form
-/// ([`crate::accel::Accelerator::gpu_refusal`]), at the scene's key. Every pass of the render
-/// plan has a GPU kernel.
-pub(crate) fn scene_gpu_gap(path: &Path, scene: &crate::scene::Scene) -> Option<String> {
-    let refusal = scene.accel.as_ref()?.gpu_refusal()?;
-    Some(format!("{}: key `accelerator`: {refusal}", path.display()))
-}
-
-/// Reads an experiment file of any kind: the shared header first, then the kind's own keys.
-pub fn load(path: &Path) -> Result<Box<dyn Experiment>, ConfigError> {
-    let source = Source::read(path)?;
-    let header = Header::read(&source)?;
-    Ok(match header.kind {
-        Kind::Sweep => Box::new(core::Declared(sweep::Sweep::new(sweep::Spec::from_source(
-            &source, header,
-        )?))),
-        Kind::Fps => Box::new(core::Declared(fps::FpsSpec::from_source(&source, header)?)),
-        Kind::Ao => Box::new(core::Declared(ao::AoSpec::from_source(&source, header)?)),
-        Kind::Frames => Box::new(core::Declared(frames::FramesSpec::from_source(&source, header)?)),
-        Kind::Realtime => Box::new(core::Declared(realtime::Realtime::new(
-            realtime::RealtimeSpec::from_source(&source, header)?,
-        ))),
-    })
-}
+pub(crate) use contract::scene_gpu_gap;
+pub use contract::{Accepts, Experiment, Finished, RunContext};
+pub use kinds::load;

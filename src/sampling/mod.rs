@@ -28,6 +28,12 @@ use std::str::FromStr;
 
 pub use rng::Stream;
 
+/// Lights a frame samples: each has its own stream of shadow-ray targets and, for the
+/// screen-arranged schemes, its own scramble table ([`tables::MAX_COUNTS`]); the renderers'
+/// per-light ray counters and the GPU's light buffer are sized for this, and a scene file with
+/// more is refused where it lists them.
+pub const MAX_LIGHTS: usize = 8;
+
 /// How the n shadow-ray targets of one receiver point are chosen on the unit disk.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum DiskScheme {

@@ -16,7 +16,7 @@ use super::DiskScheme;
 
 /// Most distinct scramble tables one frame carries: one per light and one for the ambient
 /// pass, so no frame can ask for more.
-pub const MAX_COUNTS: usize = crate::render::plan::MAX_LIGHTS + 1;
+pub const MAX_COUNTS: usize = super::MAX_LIGHTS + 1;
 
 /// Where the points header starts: after the pmj02 and mask offsets and the count table.
 pub const POINTS_HEADER: usize = 3 + 2 * MAX_COUNTS;

@@ -99,9 +99,9 @@ pub struct Scene {
     pub shading: Shading,
 }
 
-/// Lights a scene may hold: the renderers' per-light ray counters and the GPU's light buffer are
-/// sized for this, so a scene file with more is refused where it lists them.
-pub const MAX_LIGHTS: usize = 8;
+/// Lights a scene may hold ([`crate::sampling::MAX_LIGHTS`]); a scene file with more is refused
+/// where it lists them.
+pub use crate::sampling::MAX_LIGHTS;
 
 /// The light transport a scene asks for (the visibility-field paper's two shadings, Section 6):
 /// OpenGL-like is `shadows = false` (local diffuse shading from every light, no rays beyond the

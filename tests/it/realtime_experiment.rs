@@ -43,9 +43,8 @@ fn frames_continue_on(backend: &mut dyn Backend) {
     for scheme in [DiskScheme::Sobol, DiskScheme::Pmj02] {
         let (few, many) = (sphere(4), sphere(16));
         let mut acc = Accumulator::new(Accumulation::Mean, 24 * 24);
-        let none = vec![f64::NAN; 24 * 24];
         for f in 0..4 {
-            acc.add(&shadow(backend, &few, scheme, f), &none);
+            acc.add(&shadow(backend, &few, scheme, f));
         }
         let whole = shadow(backend, &many, scheme, 0);
         let accumulated = acc.image();

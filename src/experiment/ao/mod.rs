@@ -13,11 +13,11 @@ pub mod spec;
 pub use runner::{run_ao, run_mesh, AoRow, MeshOutcome, TuningRow};
 pub use spec::AoSpec;
 
+use crate::experiment::contract::RunContext;
 use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 

@@ -4,6 +4,8 @@
 //! value its file does not list, is an error naming what there is, so a typo never runs an empty
 //! or unintended experiment.
 
+pub use crate::experiment::args::{Filter, FILTER_HELP as HELP};
+
 /// A kind's axis, by a typed key (an enum per kind, declared with [`axis_keys!`]): a filter,
 /// a dry run or the core names an axis by its key, never by its place in a list.
 pub trait AxisKey: Copy + PartialEq + std::fmt::Debug {
@@ -45,39 +47,6 @@ impl<K: AxisKey> Axis<K> {
     /// Its column and filter name.
     pub fn name(&self) -> &'static str {
         self.key.name()
-    }
-}
-
-/// One `AXIS=VALUE` filter, as written; checked against a kind's axes by [`select`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct Filter {
-    /// The axis name.
-    pub axis: String,
-    /// The value as written.
-    pub value: String,
-}
-
-impl std::str::FromStr for Filter {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Filter, String> {
-        let (axis, value) = s
-            .split_once('=')
-            .ok_or_else(|| format!("`{s}`: a filter is AXIS=VALUE (the axes are listed by --dry-run)"))?;
-        let (axis, value) = (axis.trim(), value.trim());
-        if axis.is_empty() || value.is_empty() {
-            return Err(format!("`{s}`: a filter is AXIS=VALUE, both non-empty"));
-        }
-        Ok(Filter {
-            axis: axis.into(),
-            value: value.into(),
-        })
-    }
-}
-
-impl std::fmt::Display for Filter {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}={}", self.axis, self.value)
     }
 }
 
@@ -141,12 +110,6 @@ pub fn keep_at<T>(list: &mut Vec<T>, keep: &[usize]) {
 pub fn label(filters: &[Filter]) -> String {
     filters.iter().map(Filter::to_string).collect::<Vec<_>>().join(",")
 }
-
-/// `--filter`'s help.
-pub const HELP: &str = "Run only the work whose AXIS has VALUE (each kind's axes are listed by \
---dry-run: a sweep's scheme, pattern, samples, light_radius, lights, accelerator, seed; ao's mesh, \
-structure, issue; frames' scene, shading, viewpoint; fps' scene, lights, resolution); repeat to keep \
-several values or restrict several axes";
 
 #[cfg(test)]
 mod tests {

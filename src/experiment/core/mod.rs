@@ -3,7 +3,7 @@
 //! journaled as they finish so a killed run resumes, and put back together by `--merge`
 //! ([`merge`]), which refuses a missing, duplicated or foreign shard with the command that
 //! reruns it. A kind is a [`declared::Declaration`]: axes, units, a measure for one unit, and a
-//! report; [`declared::Declared`] makes it an [`super::Experiment`]. Nothing here knows a kind.
+//! report; [`declared::Declared`] makes it an [`super::contract::Experiment`]. Nothing here knows a kind.
 
 pub mod declared;
 pub mod filter;

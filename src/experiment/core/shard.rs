@@ -10,48 +10,7 @@
 //! only where that finishes sooner. The deal depends on the experiment
 //! alone (costs and key texts), not on the machine, so every shard and the merge compute it alike.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
-use std::str::FromStr;
-
-/// Most shards an experiment splits into.
-pub const MAX_SHARDS: u32 = 10_000;
-
-/// The K-th of N shares (1 <= K <= N), as `--shard K/N` and Slurm's array index give it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Shard {
-    /// K, from 1.
-    pub index: u32,
-    /// N.
-    pub count: u32,
-}
-
-impl FromStr for Shard {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Shard, String> {
-        let bad = || format!("expected K/N with 1 <= K <= N <= {MAX_SHARDS} (e.g. 2/8), got `{s}`");
-        let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count) = (k.trim().parse::<u32>(), n.trim().parse::<u32>());
-        match (index, count) {
-            (Ok(index), Ok(count)) if (1..=count).contains(&index) && count <= MAX_SHARDS => Ok(Shard { index, count }),
-            _ => Err(bad()),
-        }
-    }
-}
-
-impl fmt::Display for Shard {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-impl Shard {
-    /// The shard's folder under a results folder: `shards/K-of-N`.
-    pub fn dir(&self, results: &Path) -> PathBuf {
-        results.join("shards").join(format!("{}-of-{}", self.index, self.count))
-    }
-}
+pub use crate::experiment::args::{Shard, MAX_SHARDS};
 
 /// What dealing a unit costs: its own work, and a setup it may share with other units.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,11 +12,11 @@ pub mod spec;
 pub use runner::{run_fps, run_scenes, FpsRow};
 pub use spec::{timed_scene, FpsScene, FpsSpec};
 
+use crate::experiment::contract::RunContext;
 use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 
@@ -67,7 +67,7 @@ impl Declaration for FpsSpec {
         self.scene_paths
             .iter()
             .zip(&self.scenes)
-            .find_map(|(path, s)| crate::experiment::scene_gpu_gap(path, &s.scene))
+            .find_map(|(path, s)| crate::experiment::contract::scene_gpu_gap(path, &s.scene))
     }
 
     type Axis = FpsAxis;

@@ -14,11 +14,11 @@ pub mod verdict;
 pub use runner::{run_block, run_frames, Block, FramesOutcome};
 pub use spec::{FramesSpec, Generator};
 
+use crate::experiment::contract::RunContext;
 use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::RunContext;
 use crate::render::Backend;
 use std::path::PathBuf;
 

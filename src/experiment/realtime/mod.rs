@@ -11,18 +11,20 @@
 //! render and filter in the same interleaved rounds, so frame-time budgets compare like with
 //! like.
 
+pub mod pipeline;
 pub mod reference;
 pub mod report;
 pub mod runner;
 pub mod spec;
 
+pub use pipeline::Pipeline;
 pub use spec::{RealtimeSpec, Variant};
 
+use crate::experiment::contract::RunContext;
 use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::RunContext;
 use crate::render::Backend;
 use runner::Outcome;
 use std::path::PathBuf;
@@ -77,7 +79,7 @@ impl Declaration for Realtime {
     }
 
     fn gpu_gap(&self) -> Option<String> {
-        crate::experiment::scene_gpu_gap(&self.spec.scene_path, &self.spec.scene)
+        crate::experiment::contract::scene_gpu_gap(&self.spec.scene_path, &self.spec.scene)
     }
 
     fn inputs(&self) -> Vec<PathBuf> {

@@ -4,15 +4,13 @@
 //! (G-buffer, receivers) the filters and the blocker estimate read.
 
 use super::spec::{RealtimeSpec, Variant};
-use crate::experiment::sweep::reference::{exact_image, has_exact_answer, shadow_image, GROUND_TRUTH_SEED};
+use crate::experiment::shadow::{exact_image, has_exact_answer, shadow_image, GROUND_TRUTH_SEED};
 use crate::metrics::edge::EdgeProfile;
 use crate::metrics::{PenumbraMask, Receivers};
-use crate::render::cpu::closest_hit;
-use crate::render::denoise::GBuffer;
+use crate::render::denoise::gbuffer::{self, GBuffer};
 use crate::render::shading::Receiver;
 use crate::render::{Backend, Sampling, View, NO_HIT, NO_RECEIVER};
 use crate::sampling::{DiskScheme, Pattern};
-use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
@@ -80,15 +78,9 @@ impl References {
             width: spec.width,
             height: spec.height,
         };
-        let receivers: Vec<Option<Receiver>> = (0..view.pixels() as u32)
-            .into_par_iter()
-            .map(|i| {
-                let ray = view.camera.ray(i % view.width, i / view.width, view.width, view.height);
-                closest_hit(&scene, ray.origin, ray.direction)
-            })
-            .collect();
+        let receivers = gbuffer::receivers(&scene, view);
         let g = Arc::new(Guides {
-            gbuffer: GBuffer::new(&scene, view),
+            gbuffer: GBuffer::from_receivers(view, &receivers),
             receivers,
         });
         self.guides.lock().expect("not poisoned").insert(key, g.clone());

@@ -3,36 +3,41 @@
 //! error against frames, report.md with the verdict at fixed frame-time budgets, and the page
 //! with every filter's picture beside the exact image.
 
-use super::runner::{Outcome, Picture, Row, Series, Timed, REFERENCE};
-use super::spec::RealtimeSpec;
-use crate::experiment::sweep::reference::has_exact_answer;
-use crate::experiment::sweep::report::plots::scheme_look;
+use super::pipeline::{Pipeline, Slot, REFERENCE};
+use super::runner::{Outcome, Picture, Row, Run, Series, Timed};
+use super::spec::{RealtimeSpec, Variant};
+use crate::experiment::contract::RunContext;
+use crate::experiment::shadow::has_exact_answer;
 use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, MARGIN, RULE};
-use crate::experiment::RunContext;
 use crate::files::write_atomic;
 use crate::metrics::stats::mean_ci;
 use crate::output::page::{self, Gallery, Page, Shot, Tone};
-use crate::output::plots::{line_panels, Axes, Panel, Point, Series as PlotSeries};
-use crate::output::table::write_rows;
+use crate::output::plots::{line_panels, scheme_look, Axes, Panel, Point, Series as PlotSeries};
+use crate::output::table::{cells, write_rows};
 use crate::sampling::DiskScheme;
 use serde::Serialize;
 use std::fmt::Write as _;
 
-/// One pipeline at one frame count over its seeds: a row of summary.csv.
-#[derive(Clone, Debug, Serialize)]
+/// One pipeline at one frame count over its seeds: a row of summary.csv, the pipeline's columns
+/// then its statistics'.
+#[derive(Clone, Debug)]
 pub struct Summary {
-    /// `static` or `moving`.
-    pub variant: String,
-    /// Disk scheme.
-    pub scheme: String,
-    /// Shadow rays per pixel per light per frame.
-    pub rays: u32,
-    /// Frames accumulated.
-    pub frames: u32,
-    /// `mean` or `ema`.
-    pub accumulation: String,
-    /// Reconstruction filter.
-    pub filter: String,
+    /// The pipeline.
+    pub pipeline: Pipeline,
+    /// What its seeds measured.
+    pub stats: Stats,
+}
+
+impl Summary {
+    /// The parts whose fields are summary.csv's columns, in order.
+    pub fn columns(&self) -> (&Pipeline, &Stats) {
+        (&self.pipeline, &self.stats)
+    }
+}
+
+/// A pipeline's measures over its seeds.
+#[derive(Clone, Debug, Serialize)]
+pub struct Stats {
     /// Seeds behind the means.
     pub seeds: usize,
     /// Mean RMSE against the exact image over its penumbra.
@@ -72,13 +77,9 @@ pub struct Summary {
     pub taps_per_pixel: f64,
 }
 
-/// A timed slot as a row of timings.csv.
+/// A timed slot's columns of timings.csv after the slot's own.
 #[derive(Serialize)]
-struct TimingRow<'a> {
-    what: &'a str,
-    scheme: &'a str,
-    rays: u32,
-    filter: &'a str,
+struct TimingColumns<'a> {
     frame_s: f64,
     frame_s_lo: f64,
     frame_s_hi: f64,
@@ -118,84 +119,60 @@ fn gather(outcomes: Vec<Outcome>) -> Measured {
 impl Measured {
     /// Per-round seconds of a pipeline's frame: its render plus its filter (none: nothing).
     fn frame_seconds(&self, scheme: &str, rays: u32, filter: &str) -> Option<Vec<f64>> {
-        let render = self
-            .slots
-            .iter()
-            .find(|s| s.what == "render" && s.scheme == scheme && s.rays == rays)?;
+        let seconds = |slot: Slot| self.slots.iter().find(|s| s.slot == slot).map(|s| &s.seconds);
+        let render = seconds(Slot::render(scheme, rays))?;
         if filter == "none" {
-            return Some(render.seconds.clone());
+            return Some(render.clone());
         }
-        let f = self.slots.iter().find(|s| s.what == "filter" && s.filter == filter)?;
-        Some(render.seconds.iter().zip(&f.seconds).map(|(a, b)| a + b).collect())
+        let f = seconds(Slot::filter(filter))?;
+        Some(render.iter().zip(f).map(|(a, b)| a + b).collect())
     }
 }
 
 /// summary.csv's rows, in runs.csv's order of first appearance.
 fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
-    let mut keys: Vec<(String, String, u32, u32, String, String)> = Vec::new();
+    let mut keys: Vec<&Pipeline> = Vec::new();
     for r in &m.rows {
-        let k = (
-            r.variant.clone(),
-            r.scheme.clone(),
-            r.rays,
-            r.frames,
-            r.accumulation.clone(),
-            r.filter.clone(),
-        );
-        if !keys.contains(&k) {
-            keys.push(k);
+        if !keys.contains(&&r.pipeline) {
+            keys.push(&r.pipeline);
         }
     }
-    keys.iter()
-        .map(|(variant, scheme, rays, frames, acc, filter)| {
-            let rows: Vec<&Row> = m
-                .rows
-                .iter()
-                .filter(|r| {
-                    &r.variant == variant
-                        && &r.scheme == scheme
-                        && r.rays == *rays
-                        && r.frames == *frames
-                        && &r.accumulation == acc
-                        && &r.filter == filter
-                })
-                .collect();
-            let col = |f: fn(&Row) -> f64| rows.iter().map(|r| f(r)).collect::<Vec<f64>>();
+    keys.into_iter()
+        .map(|p| {
+            let runs: Vec<&Run> = m.rows.iter().filter(|r| r.pipeline == *p).map(|r| &r.run).collect();
+            let col = |f: fn(&Run) -> f64| runs.iter().map(|r| f(r)).collect::<Vec<f64>>();
             let (rmse, flip) = (mean_ci(&col(|r| r.rmse)), mean_ci(&col(|r| r.flip)));
             let width = mean_ci(&col(|r| r.width_px / r.exact_width_px));
             let stability = mean_ci(&col(|r| r.stability));
-            let (lag_frames, lag_censored) = match variant.as_str() {
-                "moving" => lag(spec, m, scheme, *rays, acc, filter),
-                _ => (f64::NAN, 0),
+            let (lag_frames, lag_censored) = match p.on(Variant::Moving) {
+                true => lag(spec, m, p),
+                false => (f64::NAN, 0),
             };
             let time = m
-                .frame_seconds(scheme, *rays, filter)
+                .frame_seconds(&p.scheme, p.rays, &p.filter)
                 .map_or(Estimate::NAN, |s| median_interval(&s));
             Summary {
-                variant: variant.clone(),
-                scheme: scheme.clone(),
-                rays: *rays,
-                frames: *frames,
-                accumulation: acc.clone(),
-                filter: filter.clone(),
-                seeds: rows.len(),
-                rmse: rmse.mean,
-                rmse_ci95: rmse.ci95,
-                flip: flip.mean,
-                flip_ci95: flip.ci95,
-                width_ratio: width.mean,
-                width_ratio_ci95: width.ci95,
-                area_ratio: mean_ci(&col(|r| r.area_ratio)).mean,
-                lost_share: mean_ci(&col(|r| r.lost_share)).mean,
-                stability: stability.mean,
-                stability_ci95: stability.ci95,
-                lag_frames,
-                lag_censored,
-                frame_s: time.median,
-                frame_s_lo: time.lo,
-                frame_s_hi: time.hi,
-                shadow_rays: rows.first().map_or(0, |r| r.shadow_rays),
-                taps_per_pixel: rows.first().map_or(0.0, |r| r.taps_per_pixel),
+                pipeline: p.clone(),
+                stats: Stats {
+                    seeds: runs.len(),
+                    rmse: rmse.mean,
+                    rmse_ci95: rmse.ci95,
+                    flip: flip.mean,
+                    flip_ci95: flip.ci95,
+                    width_ratio: width.mean,
+                    width_ratio_ci95: width.ci95,
+                    area_ratio: mean_ci(&col(|r| r.area_ratio)).mean,
+                    lost_share: mean_ci(&col(|r| r.lost_share)).mean,
+                    stability: stability.mean,
+                    stability_ci95: stability.ci95,
+                    lag_frames,
+                    lag_censored,
+                    frame_s: time.median,
+                    frame_s_lo: time.lo,
+                    frame_s_hi: time.hi,
+                    shadow_rays: runs.first().map_or(0, |r| r.shadow_rays),
+                    taps_per_pixel: runs.first().map_or(0.0, |r| r.taps_per_pixel),
+                },
             }
         })
         .collect()
@@ -206,31 +183,21 @@ fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
 /// settled)`, where `stop` is its error at the stop and `settled` the same pipeline's static
 /// error at the last frame count (same seed); the most over seeds, and how many seeds never got
 /// there.
-fn lag(spec: &RealtimeSpec, m: &Measured, scheme: &str, rays: u32, acc: &str, filter: &str) -> (f64, usize) {
+fn lag(spec: &RealtimeSpec, m: &Measured, pipeline: &Pipeline) -> (f64, usize) {
     let last = spec.max_frames();
+    let (moving, settled) = (pipeline.at(Variant::Moving, last), pipeline.at(Variant::Static, last));
     let (mut worst, mut censored) = (0.0f64, 0usize);
     let mut any = false;
-    for s in m
-        .series
-        .iter()
-        .filter(|s| s.scheme == scheme && s.rays == rays && s.accumulation == acc && s.filter == filter)
-    {
-        let Some(settled) = m.rows.iter().find(|r| {
-            r.variant == "static"
-                && r.scheme == scheme
-                && r.rays == rays
-                && r.frames == last
-                && r.accumulation == acc
-                && r.filter == filter
-                && r.seed == s.seed
-        }) else {
+    for s in m.series.iter().filter(|s| s.pipeline == moving) {
+        let Some(settled) = m.rows.iter().find(|r| r.pipeline == settled && r.run.seed == s.seed) else {
             return (f64::NAN, 0);
         };
         let Some(&at_stop) = s.rmse.first() else {
             return (f64::NAN, 0);
         };
         any = true;
-        let bound = settled.rmse + spec.lag_fraction * (at_stop - settled.rmse).max(0.0);
+        let settled = settled.run.rmse;
+        let bound = settled + spec.lag_fraction * (at_stop - settled).max(0.0);
         match s.rmse.iter().position(|&e| e <= bound) {
             Some(k) => worst = worst.max(k as f64),
             None => censored += 1,
@@ -253,13 +220,6 @@ fn show(m: f64, ci: f64, digits: usize) -> String {
     }
 }
 
-fn pipeline(s: &Summary) -> String {
-    format!(
-        "{} x {} ray(s), {} frame(s), {}, {}",
-        s.scheme, s.rays, s.frames, s.accumulation, s.filter
-    )
-}
-
 /// The verdict at one budget: the least-error static pipeline that is not slower than the budget
 /// frame and keeps its width within the tolerance.
 fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme: &str, rays: u32) -> String {
@@ -277,17 +237,17 @@ fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme
     );
     let mut eligible: Vec<(&Summary, Estimate)> = summary
         .iter()
-        .filter(|s| s.variant == "static")
+        .filter(|s| s.pipeline.on(Variant::Static))
         .filter_map(|s| {
-            let t = m.frame_seconds(&s.scheme, s.rays, &s.filter)?;
+            let t = m.frame_seconds(&s.pipeline.scheme, s.pipeline.rays, &s.pipeline.filter)?;
             let ratio = paired_ratio(&t, &budget);
             let fits = Comparison::of(&ratio) != Comparison::Slower && ratio.median <= 1.0 + MARGIN;
             fits.then_some((s, ratio))
         })
         .collect();
     // Within the tolerance only when the whole seed interval is: a mean inside it by luck is not.
-    let within = |s: &Summary| (s.width_ratio - 1.0).abs() + s.width_ratio_ci95 <= spec.width_tolerance;
-    eligible.sort_by(|a, b| a.0.rmse.total_cmp(&b.0.rmse));
+    let within = |s: &Summary| (s.stats.width_ratio - 1.0).abs() + s.stats.width_ratio_ci95 <= spec.width_tolerance;
+    eligible.sort_by(|a, b| a.0.stats.rmse.total_cmp(&b.0.stats.rmse));
     let _ = writeln!(
         out,
         "Pipelines on the still scene whose frame (render + filter) fits the budget (the timing rule does not call it slower and the median of per-round ratios is at most {:.2}), least RMSE first; `ok` where the whole 95 % seed interval of the width lies within {:.0} % of exact (the moving scene's lag is judged in its own table):\n",
@@ -303,10 +263,10 @@ fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme
         let _ = writeln!(
             out,
             "| {} | {} | {} | {} | {} | {} |",
-            pipeline(s),
-            show(s.rmse, s.rmse_ci95, 4),
-            show(s.flip, s.flip_ci95, 4),
-            show(s.width_ratio, s.width_ratio_ci95, 3),
+            s.pipeline.label(),
+            show(s.stats.rmse, s.stats.rmse_ci95, 4),
+            show(s.stats.flip, s.stats.flip_ci95, 4),
+            show(s.stats.width_ratio, s.stats.width_ratio_ci95, 3),
             ratio.show_ratio(2),
             if within(s) { "ok" } else { "no" }
         );
@@ -317,9 +277,9 @@ fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme
                 out,
                 "\n**Answer:** at this budget the least error with the width within {:.0} % is **{}**: RMSE {}, width {} of exact, time {} of the budget.",
                 100.0 * spec.width_tolerance,
-                pipeline(s),
-                show(s.rmse, s.rmse_ci95, 4),
-                show(s.width_ratio, s.width_ratio_ci95, 3),
+                s.pipeline.label(),
+                show(s.stats.rmse, s.stats.rmse_ci95, 4),
+                show(s.stats.width_ratio, s.stats.width_ratio_ci95, 3),
                 ratio.show_ratio(2)
             );
         }
@@ -338,13 +298,21 @@ fn budget_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary], scheme
 /// noise accumulated and filtered, per frame count: paired differences over the same seeds.
 fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> String {
     let mut out = String::from("\n## The paper's claim restated\n\n");
-    let paper: Vec<&Row> = m
+    let first_acc = spec.accumulations.first().map(|a| a.name()).unwrap_or("mean");
+    let paper_pipeline = Pipeline {
+        variant: Variant::Static.name().into(),
+        scheme: "paper".into(),
+        rays: 16,
+        frames: 1,
+        accumulation: first_acc.into(),
+        filter: "none".into(),
+    };
+    let paper: Vec<&Run> = m
         .rows
         .iter()
-        .filter(|r| r.variant == "static" && r.scheme == "paper" && r.rays == 16 && r.frames == 1 && r.filter == "none")
+        .filter(|r| r.pipeline == paper_pipeline)
+        .map(|r| &r.run)
         .collect();
-    let first_acc = spec.accumulations.first().map(|a| a.name()).unwrap_or("mean");
-    let paper: Vec<&Row> = paper.into_iter().filter(|r| r.accumulation == first_acc).collect();
     if paper.is_empty() {
         out += "Not answered: the paper's pipeline (paper x 16 rays, 1 frame, no filter) is not in this run.\n";
         return out;
@@ -362,24 +330,21 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
     for &frames in &spec.frames {
         let best = summary
             .iter()
-            .filter(|s| s.variant == "static" && blue.contains(&s.scheme.as_str()) && s.rays <= 4 && s.frames == frames)
-            .min_by(|a, b| a.rmse.total_cmp(&b.rmse));
+            .filter(|s| {
+                s.pipeline.on(Variant::Static)
+                    && blue.contains(&s.pipeline.scheme.as_str())
+                    && s.pipeline.rays <= 4
+                    && s.pipeline.frames == frames
+            })
+            .min_by(|a, b| a.stats.rmse.total_cmp(&b.stats.rmse));
         let Some(best) = best else { continue };
         let diffs: Vec<f64> = paper
             .iter()
             .filter_map(|p| {
                 m.rows
                     .iter()
-                    .find(|r| {
-                        r.variant == "static"
-                            && r.scheme == best.scheme
-                            && r.rays == best.rays
-                            && r.frames == frames
-                            && r.accumulation == best.accumulation
-                            && r.filter == best.filter
-                            && r.seed == p.seed
-                    })
-                    .map(|r| r.rmse - p.rmse)
+                    .find(|r| r.pipeline == best.pipeline && r.run.seed == p.seed)
+                    .map(|r| r.run.rmse - p.rmse)
             })
             .collect();
         let d = mean_ci(&diffs);
@@ -393,10 +358,10 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
             "equal within noise"
         };
         // Closer only when the intervals of the two distances from exact do not overlap.
-        let (db, dp) = ((best.width_ratio - 1.0).abs(), (paper_width.mean - 1.0).abs());
-        let wider = if db + best.width_ratio_ci95 < dp - paper_width.ci95 {
+        let (db, dp) = ((best.stats.width_ratio - 1.0).abs(), (paper_width.mean - 1.0).abs());
+        let wider = if db + best.stats.width_ratio_ci95 < dp - paper_width.ci95 {
             "blue noise"
-        } else if dp + paper_width.ci95 < db - best.width_ratio_ci95 {
+        } else if dp + paper_width.ci95 < db - best.stats.width_ratio_ci95 {
             "paper"
         } else {
             "not clearly"
@@ -405,9 +370,9 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
         let _ = writeln!(
             out,
             "| {frames} | {} | {} | {word} | {}; {} | {wider} |",
-            pipeline(best),
+            best.pipeline.label(),
             show(d.mean, d.ci95, 4),
-            show(best.width_ratio, best.width_ratio_ci95, 3),
+            show(best.stats.width_ratio, best.stats.width_ratio_ci95, 3),
             show(paper_width.mean, paper_width.ci95, 3),
         );
     }
@@ -421,22 +386,21 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
 pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> anyhow::Result<toml::Table> {
     let dir = run.out.dir();
     let m = gather(outcomes);
-    write_rows(&dir.join("runs.csv"), m.rows.iter())?;
+    write_rows(&dir.join("runs.csv"), m.rows.iter().map(Row::columns))?;
     let summary = summarise(spec, &m);
-    write_rows(&dir.join("summary.csv"), summary.iter())?;
+    write_rows(&dir.join("summary.csv"), summary.iter().map(Summary::columns))?;
     write_rows(
         &dir.join("timings.csv"),
-        m.slots.iter().map(|s| TimingRow {
-            what: &s.what,
-            scheme: &s.scheme,
-            rays: s.rays,
-            filter: &s.filter,
-            frame_s: s.time.median,
-            frame_s_lo: s.time.lo,
-            frame_s_hi: s.time.hi,
-            timed_frames: s.seconds.len(),
-            work: s.work,
-            work_unit: &s.work_unit,
+        m.slots.iter().map(|s| {
+            let columns = TimingColumns {
+                frame_s: s.time.median,
+                frame_s_lo: s.time.lo,
+                frame_s_hi: s.time.hi,
+                timed_frames: s.seconds.len(),
+                work: s.work,
+                work_unit: &s.work_unit,
+            };
+            (&s.slot, columns)
         }),
     )?;
     plot(spec, &summary, dir)?;
@@ -471,7 +435,7 @@ pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> a
     md += &lag_section(spec, &summary);
     md += "\n![RMSE against frames](plots/rmse_frames.svg)\n";
     write_atomic(&dir.join("report.md"), md.as_bytes())?;
-    let galleries = galleries(spec, &m);
+    let galleries = galleries(spec, &m)?;
     for g in &galleries {
         page::write_shots(dir, g)?;
     }
@@ -493,9 +457,10 @@ fn cost_section(m: &Measured) -> String {
     let mut out = String::from("\n## Cost per frame\n\n| what | median ms [95 %] | work |\n| --- | --- | --- |\n");
     for s in &m.slots {
         let t = s.time.scaled(1e3);
-        let name = match s.what.as_str() {
-            "render" => format!("render {} x {} ray(s)", s.scheme, s.rays),
-            _ => format!("filter {}", s.filter),
+        let slot = &s.slot;
+        let name = match slot.what.as_str() {
+            "render" => format!("render {} x {} ray(s)", slot.scheme, slot.rays),
+            _ => format!("filter {}", slot.filter),
         };
         let _ = writeln!(out, "| {name} | {} | {} {} |", t.show(3), s.work, s.work_unit);
     }
@@ -509,7 +474,7 @@ fn lag_section(spec: &RealtimeSpec, summary: &[Summary]) -> String {
     let last = spec.max_frames();
     let rows: Vec<&Summary> = summary
         .iter()
-        .filter(|s| s.variant == "moving" && s.frames == last)
+        .filter(|s| s.pipeline.on(Variant::Moving) && s.pipeline.frames == last)
         .collect();
     if rows.is_empty() {
         return String::new();
@@ -521,16 +486,16 @@ fn lag_section(spec: &RealtimeSpec, summary: &[Summary]) -> String {
         100.0 * (1.0 - spec.lag_fraction)
     );
     for s in rows {
-        let lag = match s.lag_censored {
-            0 => show(s.lag_frames, f64::NAN, 0),
+        let lag = match s.stats.lag_censored {
+            0 => show(s.stats.lag_frames, f64::NAN, 0),
             c => format!("never ({c} seed(s))"),
         };
         let _ = writeln!(
             out,
             "| {} | {lag} | {} | {} |",
-            pipeline(s),
-            show(s.rmse, s.rmse_ci95, 4),
-            show(s.stability, s.stability_ci95, 4)
+            s.pipeline.label(),
+            show(s.stats.rmse, s.stats.rmse_ci95, 4),
+            show(s.stats.stability, s.stats.stability_ci95, 4)
         );
     }
     out
@@ -544,27 +509,28 @@ fn plot(spec: &RealtimeSpec, summary: &[Summary], dir: &std::path::Path) -> anyh
     let rays = spec.rays[0];
     let shown: Vec<&Summary> = summary
         .iter()
-        .filter(|s| s.variant == "static" && s.accumulation == acc && s.rays == rays)
+        .filter(|s| s.pipeline.on(Variant::Static) && s.pipeline.accumulation == acc && s.pipeline.rays == rays)
         .collect();
     let mut panels: Vec<Panel> = Vec::new();
     for s in &shown {
-        let at = match panels.iter().position(|p| p.title == s.filter) {
+        let at = match panels.iter().position(|p| p.title == s.pipeline.filter) {
             Some(i) => i,
             None => {
                 panels.push(Panel {
-                    title: s.filter.clone(),
+                    title: s.pipeline.filter.clone(),
                     series: vec![],
                 });
                 panels.len() - 1
             }
         };
-        let point = Point::ci(s.frames as f64, s.rmse, s.rmse_ci95);
+        let point = Point::ci(s.pipeline.frames as f64, s.stats.rmse, s.stats.rmse_ci95);
         let series = &mut panels[at].series;
-        match series.iter_mut().find(|l| l.name == s.scheme) {
+        match series.iter_mut().find(|l| l.name == s.pipeline.scheme) {
             Some(l) => l.points.push(point),
             None => series.push(PlotSeries {
-                name: s.scheme.clone(),
+                name: s.pipeline.scheme.clone(),
                 look: s
+                    .pipeline
                     .scheme
                     .parse::<DiskScheme>()
                     .map_or(series.len(), |d| scheme_look(d, &spec.schemes)),
@@ -595,11 +561,16 @@ fn plot(spec: &RealtimeSpec, summary: &[Summary], dir: &std::path::Path) -> anyh
 
 /// Per variant: the exact image, then every picture the units kept (first seed, first
 /// accumulation, at the first and last frame counts).
-fn galleries(spec: &RealtimeSpec, m: &Measured) -> Vec<Gallery> {
+fn galleries(spec: &RealtimeSpec, m: &Measured) -> anyhow::Result<Vec<Gallery>> {
     let mut out = Vec::new();
     for &variant in &spec.variants {
-        let of_variant = |p: &&Picture| p.variant == variant.name();
-        let Some(reference) = m.pictures.iter().filter(of_variant).find(|p| p.filter == REFERENCE) else {
+        let of_variant = |p: &&Picture| p.pipeline.on(variant);
+        let Some(reference) = m
+            .pictures
+            .iter()
+            .filter(of_variant)
+            .find(|p| p.pipeline.filter == REFERENCE)
+        else {
             continue;
         };
         let exact = has_exact_answer(&spec.scene);
@@ -610,32 +581,26 @@ fn galleries(spec: &RealtimeSpec, m: &Measured) -> Vec<Gallery> {
             values: reference.values.clone(),
             key: vec![("variant".into(), variant.name().into())],
         }];
-        for p in m.pictures.iter().filter(of_variant).filter(|p| p.filter != REFERENCE) {
+        for p in m
+            .pictures
+            .iter()
+            .filter(of_variant)
+            .filter(|p| p.pipeline.filter != REFERENCE)
+        {
+            let k = &p.pipeline;
             let stem = format!(
                 "{}_{}_{}_{}f_{}_{}",
-                variant.name(),
-                p.scheme,
-                p.rays,
-                p.frames,
-                p.accumulation,
-                p.filter
+                k.variant, k.scheme, k.rays, k.frames, k.accumulation, k.filter
             );
             shots.push(Shot {
                 label: format!(
                     "{} x {}, {} frame(s), {}, {}",
-                    p.scheme, p.rays, p.frames, p.accumulation, p.filter
+                    k.scheme, k.rays, k.frames, k.accumulation, k.filter
                 ),
                 exr: format!("images/{stem}.exr"),
                 png: format!("images/{stem}.png"),
                 values: p.values.clone(),
-                key: vec![
-                    ("variant".into(), p.variant.clone()),
-                    ("scheme".into(), p.scheme.clone()),
-                    ("rays".into(), p.rays.to_string()),
-                    ("frames".into(), p.frames.to_string()),
-                    ("accumulation".into(), p.accumulation.clone()),
-                    ("filter".into(), p.filter.clone()),
-                ],
+                key: cells(k)?,
             });
         }
         out.push(Gallery {
@@ -652,5 +617,5 @@ fn galleries(spec: &RealtimeSpec, m: &Measured) -> Vec<Gallery> {
             shots,
         });
     }
-    out
+    Ok(out)
 }

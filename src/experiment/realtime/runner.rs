@@ -3,16 +3,17 @@
 //! the exact image of the current frame; or the timing unit, every render and filter timed in
 //! interleaved rounds.
 
+use super::pipeline::{Pipeline, Slot};
 use super::reference::{RefFrame, References};
 use super::spec::{RealtimeSpec, Variant};
 use crate::experiment::progress::Progress;
-use crate::experiment::sweep::reference::shadow_image;
+use crate::experiment::shadow::shadow_image;
 use crate::experiment::timing::{median_interval, Estimate};
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::metrics::{penumbra_coverage, ErrorMetrics};
 use crate::output::images::grey;
 use crate::render::denoise::penumbra::{blocker_distance, kernel_sigma};
-use crate::render::denoise::{Accumulation, Accumulator, Filter, GBuffer, Input};
+use crate::render::denoise::{Accumulation, Accumulator, BlockerHistory, Filter, GBuffer, Input};
 use crate::render::shading::Receiver;
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern, Site};
@@ -20,21 +21,26 @@ use crate::scene::{Light, Scene};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
-/// One pipeline at one frame count and seed: a row of runs.csv.
+/// One pipeline at one frame count and seed: a row of runs.csv, the pipeline's columns then the
+/// run's ([`Row::columns`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
-    /// `static` or `moving`.
-    pub variant: String,
-    /// Disk scheme.
-    pub scheme: String,
-    /// Shadow rays per pixel per light per frame.
-    pub rays: u32,
-    /// Frames accumulated.
-    pub frames: u32,
-    /// `mean` or `ema`.
-    pub accumulation: String,
-    /// Reconstruction filter.
-    pub filter: String,
+    /// The pipeline.
+    pub pipeline: Pipeline,
+    /// Its seed and what it measured.
+    pub run: Run,
+}
+
+impl Row {
+    /// The parts whose fields are runs.csv's columns, in order.
+    pub fn columns(&self) -> (&Pipeline, &Run) {
+        (&self.pipeline, &self.run)
+    }
+}
+
+/// One seed's run of a pipeline: its seed and what it measured.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Run {
     /// Seed of the sequence.
     pub seed: u32,
     /// RMSE against the current frame's exact image over its penumbra.
@@ -65,14 +71,8 @@ pub struct Row {
 /// A moving run's error after the occluder stops, one value per frame: what lag is read from.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Series {
-    /// Disk scheme.
-    pub scheme: String,
-    /// Shadow rays per pixel per light per frame.
-    pub rays: u32,
-    /// `mean` or `ema`.
-    pub accumulation: String,
-    /// Reconstruction filter.
-    pub filter: String,
+    /// The pipeline on the moving variant, through the last frame.
+    pub pipeline: Pipeline,
     /// Seed of the sequence.
     pub seed: u32,
     /// RMSE at frames stop, stop + 1, ..., the last.
@@ -83,37 +83,17 @@ pub struct Series {
 /// the last frame count with each filter, and one raw frame at the most rays (the paper's use).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Picture {
-    /// `static` or `moving`.
-    pub variant: String,
-    /// Disk scheme (empty for the reference).
-    pub scheme: String,
-    /// Shadow rays per pixel per light per frame.
-    pub rays: u32,
-    /// Frames accumulated.
-    pub frames: u32,
-    /// `mean` or `ema`.
-    pub accumulation: String,
-    /// Reconstruction filter, or [`REFERENCE`].
-    pub filter: String,
+    /// Whose output it is ([`Pipeline::reference`] for the reference itself).
+    pub pipeline: Pipeline,
     /// Visibility on the receiver plane, row-major.
     pub values: Vec<f32>,
 }
 
-/// The `filter` of the picture that holds the reference itself (exact, or the high-sample
-/// render where the scene has none).
-pub const REFERENCE: &str = "reference";
-
 /// One timed slot: a render of (scheme, rays) or a filter.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Timed {
-    /// `render` or `filter`.
-    pub what: String,
-    /// A render's scheme.
-    pub scheme: String,
-    /// A render's rays per pixel.
-    pub rays: u32,
-    /// A filter's name.
-    pub filter: String,
+    /// What it times.
+    pub slot: Slot,
     /// Seconds per round.
     pub seconds: Vec<f64>,
     /// Their median and 95 % interval.
@@ -199,7 +179,7 @@ struct History {
     accumulation: Accumulation,
     image: Accumulator,
     /// One per light, for the blocker estimate.
-    blockers: Vec<Accumulator>,
+    blockers: Vec<BlockerHistory>,
 }
 
 /// Measures one (variant, scheme, rays) unit over every seed.
@@ -235,7 +215,7 @@ pub fn measure(
                     .scene
                     .lights
                     .iter()
-                    .map(|_| Accumulator::new(a, (w * h) as usize))
+                    .map(|_| BlockerHistory::new(a, (w * h) as usize))
                     .collect(),
             })
             .collect();
@@ -266,7 +246,7 @@ pub fn measure(
                 false => vec![vec![f64::NAN; image.len()]; scene.lights.len()],
             };
             for hist in &mut histories {
-                hist.image.add(&image, &blocker[0]);
+                hist.image.add(&image);
                 for (acc, b) in hist.blockers.iter_mut().zip(&blocker) {
                     acc.add(&image, b);
                 }
@@ -306,6 +286,7 @@ pub fn measure(
                     if settled {
                         after_stop[slot].push(rmse);
                     }
+                    let pipeline = Pipeline::new(variant, scheme, rays, frames, hist.accumulation, filter);
                     if judged {
                         let stability = match (&previous[slot], f) {
                             (Some(prev), f) if f > 0 => {
@@ -324,34 +305,26 @@ pub fn measure(
                             PIXELS_PER_DEGREE,
                         )?;
                         rows.push(Row {
-                            variant: variant.name().into(),
-                            scheme: scheme.name().into(),
-                            rays,
-                            frames,
-                            accumulation: hist.accumulation.name().into(),
-                            filter: filter.name().into(),
-                            seed,
-                            rmse,
-                            flip,
-                            width_px: reference.edge.width_10_90(&measured),
-                            exact_width_px: reference.width_px,
-                            area_ratio,
-                            lost_share,
-                            stability,
-                            shadow_rays: frame.rays.shadow_total(),
-                            taps_per_pixel: out.taps as f64 / receiving.max(1) as f64,
-                            adapter: backend.adapter().name.clone(),
-                            driver: backend.adapter().driver.clone(),
+                            pipeline: pipeline.clone(),
+                            run: Run {
+                                seed,
+                                rmse,
+                                flip,
+                                width_px: reference.edge.width_10_90(&measured),
+                                exact_width_px: reference.width_px,
+                                area_ratio,
+                                lost_share,
+                                stability,
+                                shadow_rays: frame.rays.shadow_total(),
+                                taps_per_pixel: out.taps as f64 / receiving.max(1) as f64,
+                                adapter: backend.adapter().name.clone(),
+                                driver: backend.adapter().driver.clone(),
+                            },
                         });
                     }
                     if seed == spec.seeds[0] && a == 0 && k == 0 && frames == last {
                         pictures.push(Picture {
-                            variant: variant.name().into(),
-                            scheme: String::new(),
-                            rays: 0,
-                            frames,
-                            accumulation: String::new(),
-                            filter: REFERENCE.into(),
+                            pipeline: Pipeline::reference(variant, frames),
                             values: reference.image.clone(),
                         });
                     }
@@ -360,12 +333,7 @@ pub fn measure(
                     let kept = seed == spec.seeds[0] && a == 0 && (fewest || raw);
                     if judged && kept {
                         pictures.push(Picture {
-                            variant: variant.name().into(),
-                            scheme: scheme.name().into(),
-                            rays,
-                            frames,
-                            accumulation: hist.accumulation.name().into(),
-                            filter: filter.name().into(),
+                            pipeline,
                             values: measured.clone(),
                         });
                     }
@@ -378,10 +346,7 @@ pub fn measure(
             for (a, hist) in histories.iter().enumerate() {
                 for (k, &filter) in spec.filters.iter().enumerate() {
                     series.push(Series {
-                        scheme: scheme.name().into(),
-                        rays,
-                        accumulation: hist.accumulation.name().into(),
-                        filter: filter.name().into(),
+                        pipeline: Pipeline::new(variant, scheme, rays, last, hist.accumulation, filter),
                         seed,
                         rmse: std::mem::take(&mut after_stop[a * spec.filters.len() + k]),
                     });
@@ -394,7 +359,7 @@ pub fn measure(
 }
 
 /// The penumbra filter's per-pixel sigma: the widest any light's blocker estimate asks for.
-fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[Accumulator]) -> Vec<f32> {
+fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<f32> {
     let mut sigma = vec![0f32; gbuffer.depth.len()];
     for (light, acc) in scene.lights.iter().zip(blockers) {
         let Light::Disk(d) = light else { continue };
@@ -461,11 +426,11 @@ pub fn time(
         let frame = backend.render(&scene0, view, sampling)?;
         let shadow = shadow_image(&frame.visibility);
         let b = blockers(&scene0, &guides.receivers, sampling, rays0, w);
-        image.add(&shadow, &b[0]);
+        image.add(&shadow);
         if blocker_accs.is_empty() {
             blocker_accs = b
                 .iter()
-                .map(|_| Accumulator::new(Accumulation::Mean, (w * h) as usize))
+                .map(|_| BlockerHistory::new(Accumulation::Mean, (w * h) as usize))
                 .collect();
         }
         for (acc, bl) in blocker_accs.iter_mut().zip(&b) {
@@ -502,10 +467,7 @@ pub fn time(
             };
             let shadow_rays = backend.render(&scene, view, sampling)?.rays.shadow_total();
             slots.push(Timed {
-                what: "render".into(),
-                scheme: scheme.name().into(),
-                rays,
-                filter: String::new(),
+                slot: Slot::render(scheme.name(), rays),
                 seconds: vec![],
                 time: Estimate::NAN,
                 work: shadow_rays,
@@ -517,10 +479,7 @@ pub fn time(
     let filters: Vec<Filter> = spec.filters.iter().copied().filter(|&f| f != Filter::None).collect();
     for &filter in &filters {
         slots.push(Timed {
-            what: "filter".into(),
-            scheme: String::new(),
-            rays: 0,
-            filter: filter.name().into(),
+            slot: Slot::filter(filter.name()),
             seconds: vec![],
             time: Estimate::NAN,
             work: input.taps(filter),

@@ -2,18 +2,14 @@
 //! how far the ground truth is from the exact answer (the check that lets it judge the runs).
 
 use super::spec::Spec;
+pub use crate::experiment::shadow::{exact_image, has_exact_answer, shadow_image, ExactQuality, GROUND_TRUTH_SEED};
 use crate::fingerprint::fnv1a;
 use crate::metrics::{ErrorMetrics, PenumbraMask, RadialProfile, Receivers};
-use crate::reference::{visible_fraction_estimate, Integral, OnAxis};
-use crate::render::{Backend, Sampling, View, NO_RECEIVER};
+use crate::reference::OnAxis;
+use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
-use crate::scene::{Light, Scene};
 use anyhow::Context;
-use rayon::prelude::*;
 use std::path::Path;
-
-/// Seed of the ground-truth render (independent of the sweep's seeds).
-pub const GROUND_TRUTH_SEED: u32 = 0x6a09_e667;
 
 /// Everything the runs of one (lights on, light radius) pair are judged against.
 #[derive(Clone)]
@@ -25,7 +21,7 @@ pub struct Reference {
     /// Ground-truth shadow image: per pixel, the mean visibility of the lights in use
     /// (jittered, thousands of rays per pixel per light).
     pub ground_truth: Vec<f32>,
-    /// Exact shadow image of receiver-plane pixels ([`NO_RECEIVER`] elsewhere), when the scene
+    /// Exact shadow image of receiver-plane pixels ([`crate::render::NO_RECEIVER`] elsewhere), when the scene
     /// has an exact answer: disk lights and analytic shapes only.
     pub exact: Option<Vec<f32>>,
     /// The exact image's quadrature accuracy, when there is an exact image.
@@ -40,22 +36,6 @@ pub struct Reference {
     pub on_axis: Option<OnAxis>,
     /// Radial profile of the exact image (on-axis scenes).
     pub exact_profile: Option<RadialProfile>,
-}
-
-/// The shadow image of a frame: per pixel, the mean visibility over its lights; pixels with no
-/// receiver stay [`NO_RECEIVER`].
-pub fn shadow_image(visibility: &[Vec<f32>]) -> Vec<f32> {
-    let n = visibility.len() as f32;
-    (0..visibility[0].len())
-        .map(|i| {
-            let v0 = visibility[0][i];
-            if v0 == NO_RECEIVER {
-                NO_RECEIVER
-            } else {
-                visibility.iter().map(|v| v[i]).sum::<f32>() / n
-            }
-        })
-        .collect()
 }
 
 impl Reference {
@@ -192,64 +172,6 @@ impl Reference {
             tolerance
         )]
     }
-}
-
-/// The exact reference covers disk lights and analytic shapes (no meshes, no point lights).
-pub fn has_exact_answer(scene: &Scene) -> bool {
-    crate::reference::occluders(scene).is_some() && scene.lights.iter().all(|l| matches!(l, Light::Disk(_)))
-}
-
-/// How accurate an exact image is, from its quadrature's own estimates.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ExactQuality {
-    /// Worst error bound of a receiver pixel's visibility.
-    pub max_error_bound: f64,
-    /// Receiver pixels where some quadrature panel reached the depth limit.
-    pub depth_limited_pixels: usize,
-}
-
-/// Exact shadow image (mean over the scene's disk lights) at every receiver pixel, with its
-/// quadrature's accuracy (rayon; the penumbra dominates the cost).
-pub fn exact_image(scene: &Scene, pixels: usize, plane: usize, receivers: &Receivers) -> (Vec<f32>, ExactQuality) {
-    let (_, pl) = scene.plane(plane).expect("the measured plane was validated");
-    let (spheres, planes) = crate::reference::occluders(scene).expect("an exact answer exists");
-    let points: Vec<(usize, glam::DVec3)> = receivers
-        .pixels
-        .iter()
-        .zip(&receivers.points)
-        .map(|(&(i, _), &p)| (i, pl.reproject(p)))
-        .collect();
-    let disks: Vec<_> = scene
-        .lights
-        .iter()
-        .filter_map(|l| if let Light::Disk(d) = l { Some(d) } else { None })
-        .collect();
-    let values: Vec<(usize, f32, Integral)> = points
-        .par_iter()
-        .map(|&(i, p)| {
-            let e = disks
-                .iter()
-                .map(|l| visible_fraction_estimate(p, pl.normal, l, &spheres, &planes))
-                .fold(Integral::default(), |a, b| a + b);
-            let k = disks.len() as f64;
-            (
-                i,
-                (e.value / k) as f32,
-                Integral {
-                    error: e.error / k,
-                    ..e
-                },
-            )
-        })
-        .collect();
-    let mut image = vec![NO_RECEIVER; pixels];
-    let mut quality = ExactQuality::default();
-    for (i, v, e) in values {
-        image[i] = v;
-        quality.max_error_bound = quality.max_error_bound.max(e.error);
-        quality.depth_limited_pixels += (e.depth_limited > 0) as usize;
-    }
-    (image, quality)
 }
 
 const MAGIC: &[u8; 8] = b"PNBRGT02";

@@ -19,7 +19,7 @@ mod ticks;
 pub use bars::{grouped_bars, Bar, Group};
 pub use grid::{image_grid, ColourBar, Tile};
 pub use line::{line_panels, line_plot, Axes, Panel, Point, Reference, Series};
-pub use style::{colour, look, Look, Marker, LOOKS};
+pub use style::{colour, look, scheme_look, Look, Marker, LOOKS};
 
 use super::images::{write_png, Rgb};
 use crate::files::write_atomic;

@@ -3,6 +3,7 @@
 //! series tell apart by shape where colours do not.
 
 use super::error;
+use crate::sampling::DiskScheme;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -333,6 +334,21 @@ pub fn clip(line: &[(i32, i32)], rect: (i32, i32, i32, i32)) -> Vec<Vec<(i32, i3
         out.push(line.to_vec());
     }
     out
+}
+
+/// The look index of `scheme` among an experiment's `schemes`: a built-in scheme's place in
+/// [`DiskScheme::ALL`], so that it looks the same in every plot of every experiment; a user's
+/// points scheme takes the first index no built-in of `schemes` holds, in the order listed.
+pub fn scheme_look(scheme: DiskScheme, schemes: &[DiskScheme]) -> usize {
+    if let Some(i) = DiskScheme::ALL.iter().position(|s| *s == scheme) {
+        return i;
+    }
+    let mut users = schemes.iter().filter(|s| !s.is_built_in());
+    let nth = users.position(|s| *s == scheme).unwrap_or(0);
+    (0..)
+        .filter(|i| !schemes.iter().any(|s| DiskScheme::ALL.get(*i) == Some(s)))
+        .nth(nth)
+        .unwrap_or(0)
 }
 
 #[cfg(test)]

@@ -1,5 +1,7 @@
 //! Temporal accumulation of one pixel's values over frames, with the first and second moments a
-//! variance-guided filter reads (SVGF's temporal integration, Schied et al. 2017, sec. 4.1).
+//! variance-guided filter reads (SVGF's temporal integration, Schied et al. 2017, sec. 4.1)
+//! ([`Accumulator`]), and, apart from it, of the blocker distances a light's shadow rays met,
+//! which the penumbra filter sizes its kernel by ([`BlockerHistory`]).
 //! The camera is fixed, so a pixel's history is its own (no reprojection); a moving occluder
 //! leaves behind the ghost that the lag metric measures.
 
@@ -57,8 +59,7 @@ impl FromStr for Accumulation {
     }
 }
 
-/// One view's accumulated history: per pixel the moments of its frames' values and of the
-/// blocker distances its shadow rays met.
+/// One view's accumulated image history: per pixel the moments of its frames' values.
 #[derive(Clone, Debug)]
 pub struct Accumulator {
     mode: Accumulation,
@@ -67,8 +68,6 @@ pub struct Accumulator {
     history: Vec<u32>,
     m1: Vec<f64>,
     m2: Vec<f64>,
-    blocker: Vec<f64>,
-    blocked_frames: Vec<u32>,
 }
 
 impl Accumulator {
@@ -80,8 +79,6 @@ impl Accumulator {
             history: vec![0; pixels],
             m1: vec![0.0; pixels],
             m2: vec![0.0; pixels],
-            blocker: vec![f64::NAN; pixels],
-            blocked_frames: vec![0; pixels],
         }
     }
 
@@ -90,9 +87,8 @@ impl Accumulator {
         self.frames
     }
 
-    /// Adds one frame: its shadow image (`NO_RECEIVER` where none) and, per pixel, the mean
-    /// distance to the blockers its shadow rays met (NaN where none met one).
-    pub fn add(&mut self, image: &[f32], blocker: &[f64]) {
+    /// Adds one frame: its shadow image (`NO_RECEIVER` where none).
+    pub fn add(&mut self, image: &[f32]) {
         self.frames += 1;
         for (i, &v) in image.iter().enumerate() {
             if v == NO_RECEIVER {
@@ -105,16 +101,6 @@ impl Accumulator {
             let v = v as f64;
             self.m1[i] += w * (v - self.m1[i]);
             self.m2[i] += w * (v * v - self.m2[i]);
-            if blocker[i].is_finite() {
-                self.blocked_frames[i] += 1;
-                let wb = self.mode.weight(self.blocked_frames[i]);
-                let old = if self.blocker[i].is_nan() {
-                    blocker[i]
-                } else {
-                    self.blocker[i]
-                };
-                self.blocker[i] = old + wb * (blocker[i] - old);
-            }
         }
     }
 
@@ -160,6 +146,46 @@ impl Accumulator {
             })
             .collect()
     }
+}
+
+/// One light's accumulated blocker distances, combined over frames as the image is
+/// ([`Accumulation`]) but counting, per pixel, only the frames where some shadow ray met a
+/// blocker; kept apart from the image's history, which it never changes.
+#[derive(Clone, Debug)]
+pub struct BlockerHistory {
+    mode: Accumulation,
+    blocker: Vec<f64>,
+    blocked_frames: Vec<u32>,
+}
+
+impl BlockerHistory {
+    /// An empty history of `pixels` pixels.
+    pub fn new(mode: Accumulation, pixels: usize) -> BlockerHistory {
+        BlockerHistory {
+            mode,
+            blocker: vec![f64::NAN; pixels],
+            blocked_frames: vec![0; pixels],
+        }
+    }
+
+    /// Adds one frame: per pixel, the mean distance to the blockers its shadow rays met (NaN
+    /// where none met one), at the pixels with a receiver in its shadow image (`NO_RECEIVER`
+    /// where none: those keep their history).
+    pub fn add(&mut self, image: &[f32], blocker: &[f64]) {
+        for (i, &v) in image.iter().enumerate() {
+            if v == NO_RECEIVER || !blocker[i].is_finite() {
+                continue;
+            }
+            self.blocked_frames[i] += 1;
+            let w = self.mode.weight(self.blocked_frames[i]);
+            let old = if self.blocker[i].is_nan() {
+                blocker[i]
+            } else {
+                self.blocker[i]
+            };
+            self.blocker[i] = old + w * (blocker[i] - old);
+        }
+    }
 
     /// Per pixel, the accumulated blocker distance (NaN where no shadow ray met a blocker).
     pub fn blocker(&self) -> &[f64] {
@@ -174,13 +200,12 @@ mod tests {
     #[test]
     fn the_mean_is_the_mean_and_the_ema_forgets_geometrically() {
         let frames = [0.0f32, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 0.0];
-        let none = [f64::NAN];
         let mut mean = Accumulator::new(Accumulation::Mean, 1);
         let mut ema = Accumulator::new(Accumulation::Ema(0.25), 1);
         let mut reference = 0.0;
         for (k, &v) in frames.iter().enumerate() {
-            mean.add(&[v], &none);
-            ema.add(&[v], &none);
+            mean.add(&[v]);
+            ema.add(&[v]);
             // Direct: alpha = max(0.25, 1/k).
             let w = (1.0 / (k + 1) as f64).max(0.25);
             reference = (1.0 - w) * reference + w * v as f64;
@@ -195,20 +220,32 @@ mod tests {
     #[test]
     fn a_pixel_that_gains_a_receiver_starts_its_history_afresh() {
         let mut a = Accumulator::new(Accumulation::Mean, 1);
-        a.add(&[NO_RECEIVER], &[f64::NAN]);
-        a.add(&[0.25], &[f64::NAN]);
-        a.add(&[0.75], &[f64::NAN]);
+        a.add(&[NO_RECEIVER]);
+        a.add(&[0.25]);
+        a.add(&[0.75]);
         assert_eq!(a.image(), vec![0.5]);
     }
 
     #[test]
     fn pixels_without_a_receiver_stay_without() {
         let mut a = Accumulator::new(Accumulation::Ema(0.1), 2);
-        a.add(&[NO_RECEIVER, 0.5], &[f64::NAN, 2.0]);
-        a.add(&[NO_RECEIVER, 0.5], &[f64::NAN, 4.0]);
+        let mut b = BlockerHistory::new(Accumulation::Ema(0.1), 2);
+        for (image, blocker) in [([NO_RECEIVER, 0.5], [1.0, 2.0]), ([NO_RECEIVER, 0.5], [1.0, 4.0])] {
+            a.add(&image);
+            b.add(&image, &blocker);
+        }
         assert_eq!(a.image(), vec![NO_RECEIVER, 0.5]);
         assert_eq!(a.variance()[0], 0.0);
-        assert!(a.blocker()[0].is_nan());
-        assert!((a.blocker()[1] - 3.0).abs() < 1e-12);
+        assert!(b.blocker()[0].is_nan());
+        assert!((b.blocker()[1] - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn blocker_distances_average_over_the_frames_that_met_a_blocker() {
+        let mut b = BlockerHistory::new(Accumulation::Mean, 1);
+        for blocker in [2.0, f64::NAN, 4.0] {
+            b.add(&[0.5], &[blocker]);
+        }
+        assert!((b.blocker()[0] - 3.0).abs() < 1e-12);
     }
 }

@@ -1,8 +1,10 @@
 //! The guides a real-time filter reads per pixel: depth, normal and footprint of the surface
 //! the camera sees. A rasteriser writes these for free; here the CPU casts the camera rays in
-//! f64 once per view, so both backends filter with the same guides.
+//! f64 once per view, so both backends filter with the same guides; a caller that has cast them
+//! already (for the surfaces its shadow rays leave from) makes the guides from those hits.
 
 use crate::render::cpu::closest_hit;
+use crate::render::shading::Receiver;
 use crate::render::View;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -25,13 +27,21 @@ pub struct GBuffer {
 impl GBuffer {
     /// Casts every camera ray of `view` into `scene`.
     pub fn new(scene: &Scene, view: View) -> GBuffer {
+        GBuffer::from_receivers(view, &receivers(scene, view))
+    }
+
+    /// The guides of `view` from the surface each of its camera rays met (row-major, none where
+    /// a ray met nothing), as [`receivers`] casts them.
+    pub fn from_receivers(view: View, receivers: &[Option<Receiver>]) -> GBuffer {
         let (w, h) = (view.width, view.height);
-        let texels: Vec<(f32, [f32; 3], f32, DVec3)> = (0..w * h)
-            .into_par_iter()
-            .map(|i| {
+        let texels: Vec<(f32, [f32; 3], f32, DVec3)> = receivers
+            .par_iter()
+            .enumerate()
+            .map(|(i, hit)| {
+                let i = i as u32;
                 let (x, y) = (i % w, i / w);
                 let ray = view.camera.ray(x, y, w, h);
-                let Some(hit) = closest_hit(scene, ray.origin, ray.direction) else {
+                let Some(hit) = hit else {
                     return (f32::INFINITY, [0.0; 3], 0.0, DVec3::NAN);
                 };
                 // Where the next pixel's ray meets the tangent plane: the footprint's side.
@@ -71,4 +81,16 @@ impl GBuffer {
             point: vec![DVec3::ZERO; pixels],
         }
     }
+}
+
+/// The surface each camera ray of `view` meets in `scene`, row-major (none where it meets
+/// nothing): what the guides are made from and the shadow rays leave from.
+pub fn receivers(scene: &Scene, view: View) -> Vec<Option<Receiver>> {
+    (0..view.pixels() as u32)
+        .into_par_iter()
+        .map(|i| {
+            let ray = view.camera.ray(i % view.width, i / view.width, view.width, view.height);
+            closest_hit(scene, ray.origin, ray.direction)
+        })
+        .collect()
 }

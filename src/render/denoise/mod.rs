@@ -12,7 +12,7 @@ pub mod cpu;
 pub mod gbuffer;
 pub mod penumbra;
 
-pub use accumulate::{Accumulation, Accumulator};
+pub use accumulate::{Accumulation, Accumulator, BlockerHistory};
 pub use gbuffer::GBuffer;
 
 use serde::{Deserialize, Serialize};

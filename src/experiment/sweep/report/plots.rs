@@ -11,6 +11,7 @@ use crate::experiment::sweep::record::{Aggregated, Status};
 use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::metrics::spectrum::BIN;
 use crate::metrics::stats::{mean_ci, MeanCi};
+pub use crate::output::plots::scheme_look;
 use crate::output::plots::{line_panels, line_plot, Axes, Panel, Point, Reference as RefLine, Series};
 use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
@@ -26,21 +27,6 @@ struct Filter<'a> {
     slice: &'a Slice,
     /// The experiment's schemes, which give each its look ([`scheme_look`]).
     schemes: &'a [DiskScheme],
-}
-
-/// The look index of `scheme` among an experiment's `schemes`: a built-in scheme's place in
-/// [`DiskScheme::ALL`], so that it looks the same in every plot of every experiment; a user's
-/// points scheme takes the first index no built-in of `schemes` holds, in the order listed.
-pub fn scheme_look(scheme: DiskScheme, schemes: &[DiskScheme]) -> usize {
-    if let Some(i) = DiskScheme::ALL.iter().position(|s| *s == scheme) {
-        return i;
-    }
-    let mut users = schemes.iter().filter(|s| !s.is_built_in());
-    let nth = users.position(|s| *s == scheme).unwrap_or(0);
-    (0..)
-        .filter(|i| !schemes.iter().any(|s| DiskScheme::ALL.get(*i) == Some(s)))
-        .nth(nth)
-        .unwrap_or(0)
 }
 
 /// One panel per pattern swept (its series: one per scheme) of one metric against a per-summary
