@@ -11,15 +11,14 @@
 //! once per frame. Before each shading and viewpoint every structure renders the path's first
 //! frame `warmup` times, untimed (warm caches).
 
-use super::spec::{FramesSpec, ShadingName};
+use super::spec::{FramesSpec, ShadingName, SAMPLING};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, UpdateMethod, Updated};
 use crate::experiment::progress::Progress;
 use crate::mesh::Triangles;
 use crate::metrics::stats::median;
-use crate::render::{Backend, Frame, RayCounts, Sampling, View};
-use crate::sampling::{DiskScheme, Pattern};
+use crate::render::{Backend, Frame, RayCounts, View};
 use crate::scene::procedural::Generated;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -27,14 +26,6 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// The frames' sampling (point lights need none; fixed for the record).
-pub const SAMPLING: Sampling = Sampling {
-    scheme: DiskScheme::Uniform,
-    pattern: Pattern::PerPixel,
-    seed: 1,
-    frame: 0,
-};
 
 /// One frame of one structure, timed.
 #[derive(Clone, Debug, Serialize, Deserialize)]
