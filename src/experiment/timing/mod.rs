@@ -37,7 +37,7 @@ pub mod rule;
 pub mod schedule;
 pub mod series;
 
-pub use estimate::Estimate;
+pub use estimate::{Estimate, EstimateColumns, FRAME_S};
 pub use interval::{coverage, interval_rank, median_interval, paired_ratio};
 pub use rule::{Comparison, MARGIN, MAX_DIGITS, NEAR_THRESHOLD, RULE};
 pub use schedule::{Schedule, DEFAULT_SEED};
