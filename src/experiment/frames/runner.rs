@@ -11,7 +11,9 @@
 //! once per frame. Before each shading and viewpoint every structure renders the path's first
 //! frame `warmup` times, untimed (warm caches).
 
-use super::spec::{FramesSpec, ShadingName, SAMPLING};
+pub use super::spec::SAMPLING;
+
+use super::spec::{FramesSpec, ShadingName};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, UpdateMethod, Updated};

@@ -7,6 +7,8 @@
 //! choice is not fitted to the frames it is judged on. A structure with one candidate is not
 //! timed. Candidates of one structure are held together and dropped before the next is tuned.
 
+pub use super::candidates::FramesTuning;
+
 use super::spec::{FramesSpec, Generator, ShadingName, SAMPLING};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
