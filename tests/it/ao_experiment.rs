@@ -10,19 +10,17 @@ use penumbra::experiment::ao::report::verdict;
 use penumbra::experiment::ao::{run_ao, AoSpec};
 use penumbra::experiment::progress::Progress;
 use penumbra::render::cpu::CpuBackend;
-use std::ffi::OsStr;
 
 #[test]
 fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ao-ci");
     let exp = common::repo("experiments/ao-ci.toml");
-    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
-    assert_eq!(code, 0, "{err}");
+    common::run_experiment(&exp, &out, &[]);
     let csv = std::fs::read_to_string(out.join("ao.csv")).unwrap();
     let mut rows = csv::Reader::from_reader(csv.as_bytes());
     let header = rows.headers().unwrap().clone();
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     let rows: Vec<csv::StringRecord> = rows.records().map(Result::unwrap).collect();
     // Per mesh: six structures with single rays, and bundled the three with bundles of their own.
     assert_eq!(rows.len(), 2 * (6 + 3), "{csv}");
@@ -92,7 +90,7 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
     // Every timed frame is committed: each row's median and interval recompute from rounds.csv.
     let mut rounds = csv::Reader::from_path(out.join("rounds.csv")).unwrap();
     let rh = rounds.headers().unwrap().clone();
-    let rc = |name: &str| rh.iter().position(|h| h == name).unwrap();
+    let rc = |name: &str| common::column(&rh, name);
     let rounds: Vec<csv::StringRecord> = rounds.records().map(Result::unwrap).collect();
     for r in &rows {
         let mine: Vec<&csv::StringRecord> = rounds
@@ -210,13 +208,12 @@ fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
 /// report names the adapter. Against the f64 CPU's images, pixel by pixel.
 #[test]
 fn the_ci_experiment_runs_on_the_gpu() {
-    if common::gpu().is_none() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
-    let (gpu, cpu) = common::on_gpu_and_cpu(dir.path(), &common::repo("experiments/ao-ci.toml"));
+    let Some((gpu, cpu)) = common::on_gpu_and_cpu(dir.path(), &common::repo("experiments/ao-ci.toml")) else {
+        return;
+    };
     let (header, rows) = common::table(&gpu.join("ao.csv"));
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 6 * 2, "meshes x structures x issues");
     for r in &rows {
         assert_eq!(&r[col("same_image_as_first")], "true", "{r:?}");

@@ -6,16 +6,13 @@
 
 use crate::common;
 
-use std::ffi::OsStr;
 use std::path::Path;
 
 /// Runs `text` as an experiment; returns frames.csv as (header, rows) and the report.
 fn run(dir: &Path, text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>, String) {
-    let exp = dir.join("exp.toml");
-    std::fs::write(&exp, text).unwrap();
+    let exp = common::write_experiment(dir, text);
     let out = dir.join("out");
-    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
-    assert_eq!(code, 0, "{err}");
+    common::run_experiment(&exp, &out, &[]);
     let (header, rows) = common::table(&out.join("frames.csv"));
     (header, rows, std::fs::read_to_string(out.join("report.md")).unwrap())
 }
@@ -65,7 +62,7 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
     let mut tuning = csv::Reader::from_path(out.join("tuning.csv")).unwrap();
     let th = tuning.headers().unwrap().clone();
     let trows: Vec<csv::StringRecord> = tuning.records().map(Result::unwrap).collect();
-    let tc = |n: &str| th.iter().position(|h| h == n).unwrap();
+    let tc = |n: &str| common::column(&th, n);
     assert_eq!(trows.len(), 4, "two candidates each for kdtree and vlf: {trows:?}");
     let builds = std::fs::read_to_string(out.join("builds.csv")).unwrap();
     let kept_line = report
@@ -111,7 +108,7 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
         "{kept_line}"
     );
     assert!(report.contains("95 % interval over independent frames"), "{report}");
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     let rays = |rows: &[csv::StringRecord]| -> Vec<String> {
         rows.iter()
             .filter(|r| &r[col("structure")] == "brute")
@@ -136,7 +133,7 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
 fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let dir = tempfile::tempdir().unwrap();
     let (header, rows, report) = run(dir.path(), &ci());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 3 * 5, "2 shadings x 3 frames x 5 structures");
     let tables = common::assert_tidy_tables(&dir.path().join("out"));
     assert_eq!(tables.len(), 3, "frames.csv, builds.csv and summary.csv: {tables:?}");
@@ -229,7 +226,7 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
 fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
     let dir = tempfile::tempdir().unwrap();
     let (header, rows, report) = run(dir.path(), &scaling());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
     assert!(rows.iter().all(|r| &r[col("differing_pixels")] == "0"));
     for file in [
@@ -251,7 +248,7 @@ fn random_scenes_at_two_sizes_give_the_scaling_plots_and_slopes() {
 fn a_moving_part_leaves_every_update_method_rendering_what_a_rebuild_renders() {
     let dir = tempfile::tempdir().unwrap();
     let (header, rows, report) = run(dir.path(), &moving());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     let methods: Vec<String> = rows
         .iter()
         .map(|r| format!("{} {}", &r[col("structure")], &r[col("update")]))
@@ -477,17 +474,16 @@ fn the_random_camera_designs_load_and_tune_both_kd_trees() {
 /// counts the GPU's work, the report and manifest name the adapter; and every strip frame is
 /// within 1e-3 W m^-2 sr^-1 (about 1e-4 of the brightest pixel's radiance) of the CPU's but on
 /// at most 1 % of its pixels, where f32 decides a ray grazing an edge the other way. Returns the
-/// GPU's frames.csv.
-fn on_the_gpu_as_on_the_cpu(text: &str) -> (csv::StringRecord, Vec<csv::StringRecord>) {
+/// GPU's frames.csv; none where there is no GPU.
+fn on_the_gpu_as_on_the_cpu(text: &str) -> Option<(csv::StringRecord, Vec<csv::StringRecord>)> {
     let dir = tempfile::tempdir().unwrap();
-    let exp = dir.path().join("exp.toml");
-    std::fs::write(&exp, text).unwrap();
-    let (gpu, cpu) = common::on_gpu_and_cpu(dir.path(), &exp);
+    let exp = common::write_experiment(dir.path(), text);
+    let (gpu, cpu) = common::on_gpu_and_cpu(dir.path(), &exp)?;
     let (header, rows) = common::table(&gpu.join("frames.csv"));
     let (cpu_header, cpu_rows) = common::table(&cpu.join("frames.csv"));
     assert_eq!(header, cpu_header);
     assert_eq!(rows.len(), cpu_rows.len());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let col = |name: &str| common::column(&header, name);
     let count = |r: &csv::StringRecord, name: &str| -> u64 { r[col(name)].parse().unwrap() };
     for (r, c) in rows.iter().zip(&cpu_rows) {
         for id in ["triangles", "structure", "update", "shading", "viewpoint", "frame"] {
@@ -514,7 +510,7 @@ fn on_the_gpu_as_on_the_cpu(text: &str) -> (csv::StringRecord, Vec<csv::StringRe
     for (file, off, pixels, worst) in common::images_against_cpu(&gpu, &cpu, 1e-3) {
         assert!(off * 100 <= pixels, "{file}: {off} of {pixels}, worst {worst}");
     }
-    (header, rows)
+    Some((header, rows))
 }
 
 /// experiments/frames-ci.toml on the GPU: the classroom's walk under both shadings, every
@@ -523,11 +519,10 @@ fn on_the_gpu_as_on_the_cpu(text: &str) -> (csv::StringRecord, Vec<csv::StringRe
 /// tracing shadow rays to the four lights and the mirrors' reflections.
 #[test]
 fn the_ci_walkthrough_runs_on_the_gpu() {
-    if common::gpu().is_none() {
+    let Some((header, rows)) = on_the_gpu_as_on_the_cpu(&ci()) else {
         return;
-    }
-    let (header, rows) = on_the_gpu_as_on_the_cpu(&ci());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    };
+    let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 3 * 5, "2 shadings x 3 frames x 5 structures");
     let mut reflections = 0;
     for r in &rows {
@@ -544,10 +539,9 @@ fn the_ci_walkthrough_runs_on_the_gpu() {
 /// The scaling variant (random triangles at two sizes, two viewpoints) on the GPU.
 #[test]
 fn random_scenes_at_two_sizes_run_on_the_gpu() {
-    if common::gpu().is_none() {
+    let Some((_, rows)) = on_the_gpu_as_on_the_cpu(&scaling()) else {
         return;
-    }
-    let (_, rows) = on_the_gpu_as_on_the_cpu(&scaling());
+    };
     assert_eq!(rows.len(), 2 * 2 * 2 * 5, "sizes x viewpoints x frames x structures");
 }
 
@@ -555,11 +549,10 @@ fn random_scenes_at_two_sizes_run_on_the_gpu() {
 /// itself) on the GPU: every update method renders what a rebuild renders.
 #[test]
 fn a_moving_part_runs_on_the_gpu() {
-    if common::gpu().is_none() {
+    let Some((header, rows)) = on_the_gpu_as_on_the_cpu(&moving()) else {
         return;
-    }
-    let (header, rows) = on_the_gpu_as_on_the_cpu(&moving());
-    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    };
+    let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 3 * 7, "2 shadings x 3 frames x 7 update methods");
     assert!(rows.iter().any(|r| &r[col("update")] == "refit"));
 }

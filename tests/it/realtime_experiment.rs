@@ -8,7 +8,6 @@ use penumbra::render::denoise::{Accumulation, Accumulator};
 use penumbra::render::{Backend, Sampling, View};
 use penumbra::sampling::{DiskScheme, Pattern};
 use penumbra::scene::{Light, Scene};
-use std::ffi::OsStr;
 
 fn sphere(rays: u32) -> Scene {
     let mut scene = Scene::load(&common::repo("experiments/scenes/sphere.toml")).unwrap();
@@ -95,8 +94,7 @@ fn read(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>
 fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::repo("experiments/realtime-ci.toml");
-    let (code, err) = common::sweep(&[exp.as_os_str(), OsStr::new("--out"), dir.path().as_os_str()]);
-    assert_eq!(code, 0, "{err}");
+    common::run_experiment(&exp, dir.path(), &[]);
     for file in [
         "runs.csv",
         "summary.csv",
@@ -192,16 +190,10 @@ fn bad_realtime_files_are_refused_at_their_key() {
             "ascending",
         ),
     ] {
-        let path = dir.path().join("bad.toml");
-        std::fs::write(&path, text.replace(edit.0, edit.1)).unwrap();
-        let out = dir.path().join("out");
-        let (code, err) = common::sweep(&[path.as_os_str(), OsStr::new("--out"), out.as_os_str()]);
-        assert_eq!(code, 2, "{edit:?}: {err}");
+        let err = common::rejected_at(dir.path(), &text.replace(edit.0, edit.1), key);
         assert!(
             err.contains(&format!("key `{key}`")) && err.contains(says),
             "{edit:?}: {err}"
         );
-        assert!(err.contains("bad.toml:"), "{edit:?}: no file and line: {err}");
-        assert!(!out.join("manifest.toml").exists());
     }
 }

@@ -7,7 +7,7 @@ use super::spec::AoSpec;
 use crate::accel::settings::ParameterColumns;
 use crate::accel::Issue;
 use crate::experiment::outputs::Outputs;
-use crate::experiment::timing::{paired_ratio, Comparison, Estimate, RULE};
+use crate::experiment::timing::{paired_ratio, Comparison, Estimate, EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::numbers::{per_triangle, thousands};
@@ -17,9 +17,10 @@ use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
 use serde::Serialize;
 
-/// A row of ao.csv: what was measured ([`Measured`]) after the mesh, the structure and its
-/// parameters, one column each ([`ParameterColumns`]).
-type CsvRow<'a> = (Named<'a>, ParameterColumns, Measured);
+/// A row of ao.csv: the mesh, the structure and its parameters, one column each
+/// ([`ParameterColumns`]), the build, the frame time with its interval ([`FRAME_S`]) and what
+/// the frame cost ([`Measured`]).
+type CsvRow<'a> = (Named<'a>, ParameterColumns, Built, EstimateColumns, Measured);
 
 /// The columns before the parameters in ao.csv.
 #[derive(Serialize)]
@@ -30,19 +31,18 @@ struct Named<'a> {
     issue: &'a str,
 }
 
-/// The columns after the parameters in ao.csv.
+/// The columns between the parameters and the frame time in ao.csv.
 #[derive(Serialize)]
-struct Measured {
+struct Built {
     #[serde(with = "float")]
     build_s: f64,
     memory_bytes: u64,
     timed_frames: usize,
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
+}
+
+/// The columns after the frame time in ao.csv.
+#[derive(Serialize)]
+struct Measured {
     primary_rays: u64,
     ao_rays: u64,
     queries: u64,
@@ -69,8 +69,8 @@ struct RoundCsv<'a> {
 }
 
 /// A row of tuning.csv: a candidate's mesh and structure, its parameters one column each, then
-/// its time and work.
-type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, Candidate);
+/// its time ([`FRAME_S`]) and work.
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, EstimateColumns, Candidate);
 
 /// The columns before the parameters in tuning.csv.
 #[derive(Serialize)]
@@ -79,15 +79,9 @@ struct Tuned<'a> {
     structure: &'a str,
 }
 
-/// The columns after the parameters in tuning.csv.
+/// The columns after the time in tuning.csv.
 #[derive(Serialize)]
 struct Candidate {
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
     nodes_visited: u64,
     primitive_tests: u64,
     chosen: bool,
@@ -230,10 +224,8 @@ pub fn write_ao(
                         structure: t.structure,
                     },
                     ParameterColumns::of(&t.settings),
+                    t.frame.columns(FRAME_S),
                     Candidate {
-                        frame_s: t.frame.median,
-                        frame_s_lo: t.frame.lo,
-                        frame_s_hi: t.frame.hi,
                         nodes_visited: t.work.nodes,
                         primitive_tests: t.work.primitives,
                         chosen: t.chosen,
@@ -251,13 +243,13 @@ pub fn write_ao(
                 issue: r.issue.name(),
             },
             ParameterColumns::of(&r.settings),
-            Measured {
+            Built {
                 build_s: r.build_seconds,
                 memory_bytes: r.memory_bytes,
                 timed_frames: r.frame_seconds.len(),
-                frame_s: r.frame.median,
-                frame_s_lo: r.frame.lo,
-                frame_s_hi: r.frame.hi,
+            },
+            r.frame.columns(FRAME_S),
+            Measured {
                 primary_rays: r.rays.0,
                 ao_rays: r.rays.1,
                 queries: r.work.queries,

@@ -2,7 +2,7 @@
 //! numbers, report.md and the page (index.html).
 
 use super::{FpsRow, FpsSpec};
-use crate::experiment::timing::RULE;
+use crate::experiment::timing::{EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::output::page::{self, Page};
 use crate::output::plots::{line_plot, Axes, Point, Reference, Series};
@@ -19,7 +19,7 @@ pub fn write_fps(
     seconds: f64,
     out: &Path,
 ) -> anyhow::Result<()> {
-    write_rows(&out.join("fps.csv"), rows.iter().map(|r| CsvRow::of(spec, r, adapter)))?;
+    write_rows(&out.join("fps.csv"), rows.iter().map(|r| csv_row(spec, r, adapter)))?;
     let mut series = Vec::new();
     let mut refs = Vec::new();
     let pixels: Vec<f64> = spec.resolutions.iter().map(|r| (r[0] * r[1]) as f64 / 1e6).collect();
@@ -117,21 +117,24 @@ pub fn write_fps(
     )
 }
 
-/// A row of fps.csv: one timed configuration, with the device.
+/// A row of fps.csv: one timed configuration, its frame time with its interval ([`FRAME_S`]), its
+/// rates and work, with the device.
+type CsvRow<'a> = (Configuration<'a>, EstimateColumns, Rates<'a>);
+
+/// The columns before the frame time in fps.csv.
 #[derive(Serialize)]
-struct CsvRow<'a> {
+struct Configuration<'a> {
     scene: &'a str,
     lights: u32,
     width: u32,
     height: u32,
     samples: u32,
     timed_frames: usize,
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
+}
+
+/// The columns after the frame time in fps.csv.
+#[derive(Serialize)]
+struct Rates<'a> {
     #[serde(with = "float")]
     frames_per_s: f64,
     #[serde(with = "float")]
@@ -149,18 +152,19 @@ struct CsvRow<'a> {
     api: &'a str,
 }
 
-impl<'a> CsvRow<'a> {
-    fn of(spec: &FpsSpec, r: &'a FpsRow, a: &'a AdapterInfo) -> CsvRow<'a> {
-        CsvRow {
+/// The row of `r`, timed on `a`.
+fn csv_row<'a>(spec: &FpsSpec, r: &'a FpsRow, a: &'a AdapterInfo) -> CsvRow<'a> {
+    (
+        Configuration {
             scene: &r.scene,
             lights: r.lights,
             width: r.width,
             height: r.height,
             samples: spec.samples,
             timed_frames: r.frame_seconds.len(),
-            frame_s: r.frame.median,
-            frame_s_lo: r.frame.lo,
-            frame_s_hi: r.frame.hi,
+        },
+        r.frame.columns(FRAME_S),
+        Rates {
             frames_per_s: r.fps().median,
             paper_frames_per_s: r.paper_fps,
             primary_rays: r.primary_rays,
@@ -173,6 +177,6 @@ impl<'a> CsvRow<'a> {
             adapter: &a.name,
             driver: &a.driver,
             api: &a.api,
-        }
-    }
+        },
+    )
 }

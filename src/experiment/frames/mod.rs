@@ -5,8 +5,13 @@
 //! frames of one scene ([`runner::Block`]), every structure timed in the same interleaved rounds
 //! on one machine, so per-frame ratios stay paired.
 
+pub mod cameras;
+pub mod candidates;
+pub mod memory;
+pub mod motion;
 pub mod report;
 pub mod runner;
+pub mod scenes;
 pub mod spec;
 pub mod tuning;
 pub mod verdict;

@@ -7,7 +7,7 @@ use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{Cameras, FramesSpec, Generator};
 use super::verdict::{label, labels, over_frames, verdict};
 use crate::accel::settings::ParameterColumns;
-use crate::experiment::timing::{coverage, median_interval, Estimate, RULE};
+use crate::experiment::timing::{coverage, median_interval, Estimate, EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
@@ -20,20 +20,24 @@ use crate::scene::procedural::random;
 use serde::Serialize;
 use std::path::Path;
 
+/// A row of frames.csv: which frame of which structure, its time with its interval over timed
+/// renders ([`FRAME_S`]), then what it cost.
+type FrameCsv<'a> = (FrameOf<'a>, EstimateColumns, FrameCost);
+
+/// The columns before the frame time in frames.csv.
 #[derive(Serialize)]
-struct FrameCsv<'a> {
+struct FrameOf<'a> {
     triangles: usize,
     structure: &'a str,
     update: &'a str,
     shading: &'a str,
     viewpoint: &'a str,
     frame: u32,
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
+}
+
+/// The columns after the frame time in frames.csv.
+#[derive(Serialize)]
+struct FrameCost {
     timed_renders: usize,
     #[serde(with = "float")]
     update_s: f64,
@@ -69,9 +73,13 @@ struct BuildCost {
     memory_bytes: u64,
 }
 
+/// The columns of a candidate's time over the tuning cameras in tuning.csv.
+const TUNING_S: [&str; 3] = ["tuning_s", "tuning_s_lo", "tuning_s_hi"];
+
 /// A row of tuning.csv: the unit that tuned, the scene size and structure, the candidate's
-/// parameters one column each, then its time over the tuning cameras and its work.
-type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, TuningCost);
+/// parameters one column each, its build, its time over the tuning cameras ([`TUNING_S`]) and
+/// its work.
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, BuildTime, EstimateColumns, TuningWork);
 
 /// The columns before the parameters in tuning.csv.
 #[derive(Serialize)]
@@ -81,17 +89,16 @@ struct Tuned<'a> {
     structure: &'a str,
 }
 
-/// The columns after the parameters in tuning.csv.
+/// The column between the parameters and the time in tuning.csv.
 #[derive(Serialize)]
-struct TuningCost {
+struct BuildTime {
     #[serde(with = "float")]
     build_s: f64,
-    #[serde(with = "float")]
-    tuning_s: f64,
-    #[serde(with = "float")]
-    tuning_s_lo: f64,
-    #[serde(with = "float")]
-    tuning_s_hi: f64,
+}
+
+/// The columns after the time in tuning.csv.
+#[derive(Serialize)]
+struct TuningWork {
     nodes_visited: u64,
     primitive_tests: u64,
     chosen: bool,
@@ -110,28 +117,36 @@ pub fn write_frames(
     let rows = &outcome.frames;
     write_rows(
         &out.join("frames.csv"),
-        rows.iter().map(|r| FrameCsv {
-            triangles: r.triangles,
-            structure: r.structure,
-            update: r.update,
-            shading: r.shading.name(),
-            viewpoint: &r.viewpoint,
-            frame: r.frame,
-            frame_s: r.seconds,
-            frame_s_lo: median_interval(&r.renders).lo,
-            frame_s_hi: median_interval(&r.renders).hi,
-            timed_renders: r.renders.len(),
-            update_s: r.update_seconds.unwrap_or(f64::NAN),
-            update_kind: r.updated.map_or("", |u| u.name()),
-            rays: r.rays.total(),
-            primary_rays: r.rays.primary,
-            shadow_rays: r.rays.shadow_total(),
-            reflection_rays: r.rays.reflection,
-            ambient_rays: r.rays.ambient,
-            queries: r.work.queries,
-            nodes_visited: r.work.nodes,
-            primitive_tests: r.work.primitives,
-            differing_pixels: r.differing_pixels,
+        rows.iter().map(|r| -> FrameCsv {
+            (
+                FrameOf {
+                    triangles: r.triangles,
+                    structure: r.structure,
+                    update: r.update,
+                    shading: r.shading.name(),
+                    viewpoint: &r.viewpoint,
+                    frame: r.frame,
+                },
+                Estimate {
+                    median: r.seconds,
+                    ..median_interval(&r.renders)
+                }
+                .columns(FRAME_S),
+                FrameCost {
+                    timed_renders: r.renders.len(),
+                    update_s: r.update_seconds.unwrap_or(f64::NAN),
+                    update_kind: r.updated.map_or("", |u| u.name()),
+                    rays: r.rays.total(),
+                    primary_rays: r.rays.primary,
+                    shadow_rays: r.rays.shadow_total(),
+                    reflection_rays: r.rays.reflection,
+                    ambient_rays: r.rays.ambient,
+                    queries: r.work.queries,
+                    nodes_visited: r.work.nodes,
+                    primitive_tests: r.work.primitives,
+                    differing_pixels: r.differing_pixels,
+                },
+            )
         }),
     )?;
     write_rows(
@@ -161,11 +176,11 @@ pub fn write_frames(
                         structure: t.structure,
                     },
                     ParameterColumns::of(&t.settings),
-                    TuningCost {
+                    BuildTime {
                         build_s: t.build_seconds,
-                        tuning_s: t.seconds.median,
-                        tuning_s_lo: t.seconds.lo,
-                        tuning_s_hi: t.seconds.hi,
+                    },
+                    t.seconds.columns(TUNING_S),
+                    TuningWork {
                         nodes_visited: t.work.nodes,
                         primitive_tests: t.work.primitives,
                         chosen: t.chosen,
@@ -175,7 +190,7 @@ pub fn write_frames(
         )?;
     }
     let summaries = summarise(spec, outcome);
-    write_rows(&out.join("summary.csv"), &summaries)?;
+    write_rows(&out.join("summary.csv"), summaries.iter().map(Summary::row))?;
     let all = labels(rows);
     let largest = outcome.builds.iter().map(|b| b.triangles).max().unwrap_or(0);
     // Each structure (and way of following motion) keeps one look in every plot.
@@ -243,7 +258,7 @@ pub fn write_frames(
                     points: summaries
                         .iter()
                         .filter(|s| s.shading == shading.name() && s.structure == *l)
-                        .map(|s| Point::between(s.triangles as f64, s.frame_s, s.frame_s_lo, s.frame_s_hi))
+                        .map(|s| Point::between(s.triangles as f64, s.frame.median, s.frame.lo, s.frame.hi))
                         .collect(),
                 })
                 .collect();
@@ -398,21 +413,36 @@ fn spread(series: &[Series]) -> f64 {
 }
 
 /// One structure (and way of following motion) at one scene size and shading, over its path:
-/// a row of summary.csv and of the report's medians.
-#[derive(Serialize)]
+/// a row of summary.csv ([`Summary::row`]) and of the report's medians.
 struct Summary {
     triangles: usize,
     shading: &'static str,
     structure: String,
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
+    frame: Estimate,
     block_frames: usize,
-    #[serde(skip)]
     update: Estimate,
+    rays: f64,
+    nodes_visited: f64,
+    primitive_tests: f64,
+    frames: usize,
+}
+
+/// A row of summary.csv: the size, shading and structure, the frame time over the path with
+/// its interval ([`FRAME_S`]), then the rest of the medians.
+type SummaryCsv<'a> = (Summarised<'a>, EstimateColumns, PathMedians);
+
+/// The columns before the frame time in summary.csv.
+#[derive(Serialize)]
+struct Summarised<'a> {
+    triangles: usize,
+    shading: &'static str,
+    structure: &'a str,
+}
+
+/// The columns after the frame time in summary.csv.
+#[derive(Serialize)]
+struct PathMedians {
+    block_frames: usize,
     #[serde(with = "float")]
     update_s: f64,
     #[serde(with = "float")]
@@ -425,12 +455,24 @@ struct Summary {
 }
 
 impl Summary {
-    fn frame(&self) -> Estimate {
-        Estimate {
-            median: self.frame_s,
-            lo: self.frame_s_lo,
-            hi: self.frame_s_hi,
-        }
+    /// Its row of summary.csv.
+    fn row(&self) -> SummaryCsv<'_> {
+        (
+            Summarised {
+                triangles: self.triangles,
+                shading: self.shading,
+                structure: &self.structure,
+            },
+            self.frame.columns(FRAME_S),
+            PathMedians {
+                block_frames: self.block_frames,
+                update_s: self.update.median,
+                rays: self.rays,
+                nodes_visited: self.nodes_visited,
+                primitive_tests: self.primitive_tests,
+                frames: self.frames,
+            },
+        )
     }
 }
 
@@ -463,12 +505,9 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     triangles: t,
                     shading: shading.name(),
                     structure: l,
-                    frame_s: frame.median,
-                    frame_s_lo: frame.lo,
-                    frame_s_hi: frame.hi,
+                    frame,
                     block_frames: block,
                     update,
-                    update_s: update.median,
                     rays: of(|r| r.rays.total()),
                     nodes_visited: of(|r| r.work.nodes),
                     primitive_tests: of(|r| r.work.primitives),
@@ -573,7 +612,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, device: &str, seconds: f64
             r.triangles,
             r.shading,
             r.structure,
-            r.frame().show(4),
+            r.frame.show(4),
             if r.update.median.is_nan() {
                 "-".into()
             } else {

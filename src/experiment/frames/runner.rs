@@ -11,6 +11,8 @@
 //! once per frame. Before each shading and viewpoint every structure renders the path's first
 //! frame `warmup` times, untimed (warm caches).
 
+pub use super::spec::SAMPLING;
+
 use super::spec::{FramesSpec, ShadingName};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
@@ -18,8 +20,7 @@ use crate::accel::{AccelSettings, UpdateMethod, Updated};
 use crate::experiment::progress::Progress;
 use crate::mesh::Triangles;
 use crate::metrics::stats::median;
-use crate::render::{Backend, Frame, RayCounts, Sampling, View};
-use crate::sampling::{DiskScheme, Pattern};
+use crate::render::{Backend, Frame, RayCounts, View};
 use crate::scene::procedural::Generated;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -27,14 +28,6 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// The frames' sampling (point lights need none; fixed for the record).
-pub const SAMPLING: Sampling = Sampling {
-    scheme: DiskScheme::Uniform,
-    pattern: Pattern::PerPixel,
-    seed: 1,
-    frame: 0,
-};
 
 /// One frame of one structure, timed.
 #[derive(Clone, Debug, Serialize, Deserialize)]

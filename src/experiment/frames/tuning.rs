@@ -7,8 +7,9 @@
 //! choice is not fitted to the frames it is judged on. A structure with one candidate is not
 //! timed. Candidates of one structure are held together and dropped before the next is tuned.
 
-use super::runner::SAMPLING;
-use super::spec::{FramesSpec, Generator, ShadingName};
+pub use super::candidates::FramesTuning;
+
+use super::spec::{FramesSpec, Generator, ShadingName, SAMPLING};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::AccelSettings;
@@ -19,46 +20,6 @@ use crate::scene::procedural::{classroom, random, Generated};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::Instant;
-
-/// How a frame-time experiment tunes (`[tuning]`; used only where a structure lists
-/// candidates).
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(deny_unknown_fields)]
-pub struct FramesTuning {
-    /// Tuning cameras drawn per viewpoint.
-    #[serde(default = "two")]
-    pub cameras: u32,
-    /// Interleaved rounds per candidate.
-    #[serde(default = "three")]
-    pub repeats: u32,
-    /// Seed of the tuning cameras' draws.
-    #[serde(default = "tuning_seed")]
-    pub seed: u32,
-}
-
-impl Default for FramesTuning {
-    fn default() -> Self {
-        FramesTuning {
-            cameras: two(),
-            repeats: three(),
-            seed: tuning_seed(),
-        }
-    }
-}
-
-fn two() -> u32 {
-    2
-}
-
-fn three() -> u32 {
-    3
-}
-
-/// The tuning cameras' seed when the file gives none: apart from any `[path] seed` a file is
-/// likely to use.
-fn tuning_seed() -> u32 {
-    0x7475_6e65
-}
 
 /// One candidate of the tuning sweep, timed: a row of tuning.csv.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -1,31 +1,16 @@
-//! Shared test fixtures: the GPU backend (opened once per test binary), scene paths, and the
-//! seeded ray generators of the visibility-field tests ([`rays`]).
+//! Shared test fixtures: the GPU backend (opened once per test binary) and a kind's experiment
+//! run on it beside the CPU ([`on_gpu`]), scene paths, results tables, and the seeded ray
+//! generators of the visibility-field tests ([`rays`]).
 #![allow(dead_code)]
 
-use penumbra::render::gpu::GpuBackend;
 use std::path::PathBuf;
-use std::sync::{Mutex, OnceLock};
 
 pub mod browser;
+pub mod on_gpu;
 pub mod rays;
 pub mod updates;
 
-/// The GPU backend, or `None` with a note when no adapter exists. Where the environment sets
-/// `PENUMBRA_REQUIRE_GPU=1` (CI installs lavapipe and does), a missing adapter fails the test.
-pub fn gpu() -> Option<std::sync::MutexGuard<'static, GpuBackend>> {
-    static GPU: OnceLock<Option<Mutex<GpuBackend>>> = OnceLock::new();
-    let slot = GPU.get_or_init(|| match GpuBackend::new() {
-        Ok(g) => Some(Mutex::new(g)),
-        Err(e) => {
-            if std::env::var("PENUMBRA_REQUIRE_GPU").as_deref() == Ok("1") {
-                panic!("PENUMBRA_REQUIRE_GPU=1 but: {e}");
-            }
-            eprintln!("skipping GPU checks: {e}");
-            None
-        }
-    });
-    slot.as_ref().map(|m| m.lock().unwrap_or_else(|p| p.into_inner()))
-}
+pub use on_gpu::{gpu, images_against_cpu, on_gpu_and_cpu};
 
 /// A shipped OFF mesh's triangles as loaded (file units, assets/meshes), degenerate ones
 /// dropped; every triangle of object 0.
@@ -129,8 +114,8 @@ repeats = 0
 }
 
 /// Runs experiment `text` (written to DIR/bad.toml) and checks it is refused as bad input at
-/// `key`: exit status 2, the file and key named, nothing written.
-pub fn rejected_at(dir: &std::path::Path, text: &str, key: &str) {
+/// `key`: exit status 2, the file and key named, nothing written. Returns what it said.
+pub fn rejected_at(dir: &std::path::Path, text: &str, key: &str) -> String {
     let path = dir.join("bad.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
@@ -138,6 +123,16 @@ pub fn rejected_at(dir: &std::path::Path, text: &str, key: &str) {
     assert_eq!(code, 2, "{key}: {err}");
     assert!(err.contains("bad.toml:") && err.contains(key), "{key}: {err}");
     assert!(!out.exists(), "{key}: wrote {}", out.display());
+    err
+}
+
+/// Runs experiment file `exp` with its results in `out` and the further arguments `args`
+/// (`--backend gpu`), and checks that it succeeds.
+pub fn run_experiment(exp: &std::path::Path, out: &std::path::Path, args: &[&str]) {
+    let mut all = vec![exp.as_os_str(), std::ffi::OsStr::new("--out"), out.as_os_str()];
+    all.extend(args.iter().map(std::ffi::OsStr::new));
+    let (code, err) = sweep(&all);
+    assert_eq!(code, 0, "{} {args:?}: {err}", exp.display());
 }
 
 /// Runs the `sweep` binary; returns (exit code, stderr).
@@ -286,23 +281,19 @@ pub fn without_clock(path: &std::path::Path) -> Vec<Vec<String>> {
     rows
 }
 
-/// Runs experiment file `exp` (an ao or frames kind, whose default backend is the f64 CPU)
-/// twice: with `--backend gpu` into `dir/gpu`, then as written into `dir/cpu`; returns both
-/// folders.
-pub fn on_gpu_and_cpu(dir: &std::path::Path, exp: &std::path::Path) -> (PathBuf, PathBuf) {
-    let (gpu, cpu) = (dir.join("gpu"), dir.join("cpu"));
-    let gpu_args = [
-        exp.as_os_str(),
-        "--backend".as_ref(),
-        "gpu".as_ref(),
-        "--out".as_ref(),
-        gpu.as_os_str(),
-    ];
-    let (code, err) = sweep(&gpu_args);
-    assert_eq!(code, 0, "on the GPU: {err}");
-    let (code, err) = sweep(&[exp.as_os_str(), "--out".as_ref(), cpu.as_os_str()]);
-    assert_eq!(code, 0, "on the CPU: {err}");
-    (gpu, cpu)
+/// Writes experiment `text` to `dir/exp.toml`; returns its path.
+pub fn write_experiment(dir: &std::path::Path, text: &str) -> PathBuf {
+    let exp = dir.join("exp.toml");
+    std::fs::write(&exp, text).unwrap();
+    exp
+}
+
+/// The index of column `name` in a table's `header` ([`table`]).
+pub fn column(header: &csv::StringRecord, name: &str) -> usize {
+    header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column `{name}` in {header:?}"))
 }
 
 /// A results table: its header and rows.
@@ -310,34 +301,4 @@ pub fn table(path: &std::path::Path) -> (csv::StringRecord, Vec<csv::StringRecor
     let mut reader = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let header = reader.headers().unwrap().clone();
     (header, reader.records().map(Result::unwrap).collect())
-}
-
-/// Every image the GPU's run wrote (`gpu/images/*.exr`) against the CPU's of the same name:
-/// (file, pixels differing by more than `step`, pixels, largest difference). f32 against f64
-/// decides a grazing ray the other way now and then, which moves a pixel by about one ray's
-/// weight.
-pub fn images_against_cpu(gpu: &std::path::Path, cpu: &std::path::Path, step: f32) -> Vec<(String, usize, usize, f32)> {
-    let mut files: Vec<String> = std::fs::read_dir(gpu.join("images"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|f| f.ends_with(".exr"))
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "{}: no images", gpu.display());
-    files
-        .into_iter()
-        .map(|file| {
-            let (g, _) = browser::exr(&gpu.join("images").join(&file)).unwrap();
-            let (c, _) = browser::exr(&cpu.join("images").join(&file)).unwrap();
-            assert_eq!(g.len(), c.len(), "{file}");
-            let diff: Vec<f32> = g.iter().zip(&c).map(|(a, b)| (a - b).abs()).collect();
-            let worst = diff.iter().cloned().fold(0.0, f32::max);
-            let off = diff.iter().filter(|&&d| d > step).count();
-            eprintln!(
-                "{file}: {off} of {} pixels differ from the CPU's by more than {step}, worst {worst}",
-                diff.len()
-            );
-            (file, off, diff.len(), worst)
-        })
-        .collect()
 }
