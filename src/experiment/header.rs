@@ -1,12 +1,12 @@
 //! The keys every experiment file shares, read and validated once by the driver before the
 //! kind reads the rest: `kind`, `name` (the results folder's name: a plain name, never a path),
-//! `backend` and the `[timing]` table ([`super::timing::Schedule`]).
+//! `backend` and the `[timing]` table ([`crate::timing::Schedule`]).
 
 use super::kind::Kind;
-use super::timing::{Schedule, DEFAULT_SEED};
 use crate::config::{ConfigError, Source};
 use crate::key_path;
 use crate::render::BackendChoice;
+use crate::timing::{Schedule, DEFAULT_SEED};
 use serde::Deserialize;
 
 /// Longest experiment, mesh or scene name that becomes a file name.

@@ -9,7 +9,7 @@
 //! The driver owns what every kind shares: the header (`kind`, `name`, `backend`, `[timing]`,
 //! [`header`]) validated once, the command line's refusals, the output folder and its atomic
 //! replacement ([`outputs`]), the manifest ([`manifest`]), logging and progress ([`progress`]),
-//! and the timing method ([`timing`]). A kind is its spec, its runner and its report. This
+//! and the timing method ([`crate::timing`]). A kind is its spec, its runner and its report. This
 //! module only declares the parts and hands on the contract's names and [`load`].
 
 pub mod ao;
@@ -30,8 +30,6 @@ pub mod progress;
 pub mod realtime;
 pub mod shadow;
 pub mod sweep;
-pub mod timing;
 
-pub(crate) use contract::scene_gpu_gap;
 pub use contract::{Accepts, Experiment, Finished, RunContext};
 pub use kinds::load;

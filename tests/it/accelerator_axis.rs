@@ -4,7 +4,7 @@
 use crate::common;
 
 use penumbra::experiment::sweep::pictures::render_pictures;
-use penumbra::experiment::sweep::runner::sweep_plan;
+
 use penumbra::experiment::sweep::spec::Spec;
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Frame, Sampling, Timing, View};
@@ -81,7 +81,7 @@ fn pictures_use_the_runs_structure() {
 fn dry_run_plan_names_a_swept_structure() {
     let dir = tempfile::tempdir().unwrap();
     let spec = meshed(dir.path(), "\"brute\"", false);
-    let plan = sweep_plan(&spec).unwrap().to_string();
+    let plan = spec.plan().unwrap().to_string();
     assert!(
         plan.contains("mesh (BRUTE)"),
         "only brute is swept, yet the plan says:\n{plan}"

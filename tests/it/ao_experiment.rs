@@ -106,7 +106,7 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         // One frame per round, rounds numbered from 0 in the order they ran.
         let numbers: Vec<usize> = mine.iter().map(|x| x[rc("round")].parse().unwrap()).collect();
         assert_eq!(numbers, (0..times.len()).collect::<Vec<_>>(), "{r:?}");
-        let e = penumbra::experiment::timing::median_interval(&times);
+        let e = penumbra::timing::median_interval(&times);
         for (name, v) in [("frame_s", e.median), ("frame_s_lo", e.lo), ("frame_s_hi", e.hi)] {
             let committed: f64 = r[col(name)].parse().unwrap();
             assert!(

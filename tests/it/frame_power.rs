@@ -13,9 +13,9 @@ use crate::common;
 use penumbra::experiment::frames::spec::Cameras;
 use penumbra::experiment::frames::verdict::Speedup;
 use penumbra::experiment::frames::FramesSpec;
-use penumbra::experiment::timing::Comparison;
 use penumbra::metrics::stats::median;
 use penumbra::sampling::Stream;
+use penumbra::timing::Comparison;
 use std::collections::BTreeMap;
 
 /// Trials per cell and pair.

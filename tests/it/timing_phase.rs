@@ -8,11 +8,11 @@ use crate::common;
 use penumbra::experiment::progress::Progress;
 use penumbra::experiment::sweep::timing::{compare, NOISE_VISITS};
 use penumbra::experiment::sweep::{run_sweep, Spec};
-use penumbra::experiment::timing::Comparison;
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::{AdapterInfo, Backend, Clock, Frame, Sampling, Timing, View};
 use penumbra::sampling::DiskScheme;
 use penumbra::scene::Scene;
+use penumbra::timing::Comparison;
 
 /// Renders on the CPU; `time` returns 10 ms plus a drift of 0.1 ms per call, and logs its calls.
 struct Drifting {

@@ -51,18 +51,9 @@ impl Declaration for AoSpec {
 
     fn axes(&self) -> Vec<Axis<AoAxis>> {
         vec![
-            Axis {
-                key: AoAxis::Mesh,
-                values: self.meshes.iter().map(|m| m.name.clone()).collect(),
-            },
-            Axis {
-                key: AoAxis::Structure,
-                values: self.structures.iter().map(|(s, _)| s.to_string()).collect(),
-            },
-            Axis {
-                key: AoAxis::Issue,
-                values: self.issues.iter().map(|i| i.name().to_string()).collect(),
-            },
+            Axis::of(AoAxis::Mesh, self.meshes.iter().map(|m| m.name.clone())),
+            Axis::of(AoAxis::Structure, self.structures.iter().map(|(s, _)| s.to_string())),
+            Axis::of(AoAxis::Issue, self.issues.iter().map(|i| i.name().to_string())),
         ]
     }
 

@@ -7,7 +7,6 @@ use super::spec::AoSpec;
 use crate::accel::settings::ParameterColumns;
 use crate::accel::Issue;
 use crate::experiment::outputs::Outputs;
-use crate::experiment::timing::{paired_ratio, Comparison, Estimate, EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::numbers::{per_triangle, thousands};
@@ -15,6 +14,7 @@ use crate::output::page::{self, write_shots, Gallery, Page, Shot, Tone};
 use crate::output::plots::{grouped_bars, Bar, Group};
 use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
+use crate::timing::{paired_ratio, Comparison, Estimate, EstimateColumns, FRAME_S, RULE};
 use serde::Serialize;
 
 /// A row of ao.csv: the mesh, the structure and its parameters, one column each

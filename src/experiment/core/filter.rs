@@ -44,6 +44,14 @@ pub struct Axis<K> {
 }
 
 impl<K: AxisKey> Axis<K> {
+    /// The axis `key` with `values`, written as filters and folder names write them.
+    pub fn of(key: K, values: impl IntoIterator<Item = impl ToString>) -> Axis<K> {
+        Axis {
+            key,
+            values: values.into_iter().map(|v| v.to_string()).collect(),
+        }
+    }
+
     /// Its column and filter name.
     pub fn name(&self) -> &'static str {
         self.key.name()

@@ -2,7 +2,7 @@
 //! and read back before the report sees it, so a killed run resumes unit by unit and a resumed,
 //! merged or uninterrupted run reports from the same bytes.
 
-use super::declared::{unit_key, Declaration, Unit};
+use super::declaration::{unit_key, Declaration, Unit};
 use crate::experiment::cli::BadInput;
 use crate::experiment::progress::Progress;
 use crate::fingerprint::fnv1a;

@@ -3,11 +3,11 @@
 //! it lists, unchanged; anything missing, duplicated or foreign is refused (exit status 4) with
 //! the command that reruns the shard.
 
-use super::declared::{context, dealt, identity, unit_key, Declaration};
+use super::declaration::{context, dealt, identity, unit_key, Declaration};
 use super::journal::{Measured, UnitFile, UnitJournal};
 use super::shard::{Shard, MAX_SHARDS};
 use crate::experiment::cli::{BadInput, Cli};
-use crate::experiment::RunContext;
+use crate::experiment::contract::RunContext;
 use crate::fingerprint::fnv1a;
 use clap::ValueEnum;
 use serde::de::DeserializeOwned;
@@ -26,7 +26,7 @@ pub struct ShardManifest {
     pub experiment: String,
     /// Hash of every unit key of the whole (filtered) experiment.
     pub identity: String,
-    /// The keys' context ([`super::declared::context`]): inputs, axes, device and build.
+    /// The keys' context ([`super::declaration::context`]): inputs, axes, device and build.
     pub context: String,
     /// The machine it ran on (times from shards on unlike machines are not comparable).
     pub machine: String,

@@ -74,18 +74,12 @@ impl Declaration for FpsSpec {
 
     fn axes(&self) -> Vec<Axis<FpsAxis>> {
         vec![
-            Axis {
-                key: FpsAxis::Scene,
-                values: self.scenes.iter().map(|s| s.name.clone()).collect(),
-            },
-            Axis {
-                key: FpsAxis::Lights,
-                values: self.light_counts().iter().map(u32::to_string).collect(),
-            },
-            Axis {
-                key: FpsAxis::Resolution,
-                values: self.resolutions.iter().map(|[w, h]| format!("{w}x{h}")).collect(),
-            },
+            Axis::of(FpsAxis::Scene, self.scenes.iter().map(|s| s.name.clone())),
+            Axis::of(FpsAxis::Lights, self.light_counts().iter().map(u32::to_string)),
+            Axis::of(
+                FpsAxis::Resolution,
+                self.resolutions.iter().map(|[w, h]| format!("{w}x{h}")),
+            ),
         ]
     }
 

@@ -2,12 +2,12 @@
 //! numbers, report.md and the page (index.html).
 
 use super::{FpsRow, FpsSpec};
-use crate::experiment::timing::{EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::output::page::{self, Page};
 use crate::output::plots::{line_plot, Axes, Point, Reference, Series};
 use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
+use crate::timing::{EstimateColumns, FRAME_S, RULE};
 use serde::Serialize;
 use std::path::Path;
 

@@ -4,9 +4,9 @@
 use super::spec::{timed_scene, FpsSpec};
 use crate::accel::work::Work;
 use crate::experiment::progress::Progress;
-use crate::experiment::timing::{median_interval, Estimate};
 use crate::render::{Backend, Clock, RenderPlan, View};
 use crate::scene::Scene;
+use crate::timing::{median_interval, Estimate};
 use anyhow::Context;
 
 /// One timed configuration: a row of fps.csv.

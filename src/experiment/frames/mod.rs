@@ -73,18 +73,12 @@ impl Declaration for FramesSpec {
 
     fn axes(&self) -> Vec<Axis<FramesAxis>> {
         vec![
-            Axis {
-                key: FramesAxis::Scene,
-                values: self.scene_names(),
-            },
-            Axis {
-                key: FramesAxis::Shading,
-                values: self.shadings.iter().map(|(n, _)| n.name().to_string()).collect(),
-            },
-            Axis {
-                key: FramesAxis::Viewpoint,
-                values: self.viewpoints.clone(),
-            },
+            Axis::of(FramesAxis::Scene, self.scene_names()),
+            Axis::of(
+                FramesAxis::Shading,
+                self.shadings.iter().map(|(n, _)| n.name().to_string()),
+            ),
+            Axis::of(FramesAxis::Viewpoint, self.viewpoints.clone()),
         ]
     }
 

@@ -7,7 +7,6 @@ use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{Cameras, FramesSpec, Generator};
 use super::verdict::{label, labels, over_frames, verdict};
 use crate::accel::settings::ParameterColumns;
-use crate::experiment::timing::{coverage, median_interval, Estimate, EstimateColumns, FRAME_S, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
@@ -17,6 +16,7 @@ use crate::output::plots::{image_grid, line_plot, Axes, Point, Series, Tile};
 use crate::output::table::{float, write_rows};
 use crate::render::AdapterInfo;
 use crate::scene::procedural::random;
+use crate::timing::{coverage, median_interval, Estimate, EstimateColumns, FRAME_S, RULE};
 use serde::Serialize;
 use std::path::Path;
 

@@ -455,10 +455,10 @@ pub fn run_block(
 /// frame's scene, shading, viewpoint (by name: a filtered run keeps the whole run's orders) and
 /// number, so every frame's rounds visit the structures in their own orders.
 fn frame_rounds(
-    schedule: &crate::experiment::timing::Schedule,
+    schedule: &crate::timing::Schedule,
     (scene, shading, viewpoint, frame): (&str, &str, &str, u32),
-) -> crate::experiment::timing::Schedule {
+) -> crate::timing::Schedule {
     let at = crate::fingerprint::fnv1a(format!("{scene}|{shading}|{viewpoint}|{frame}").as_bytes());
     let seed = crate::sampling::rng::pcg(schedule.seed ^ crate::sampling::rng::pcg(at as u32 ^ (at >> 32) as u32));
-    crate::experiment::timing::Schedule { seed, ..*schedule }
+    crate::timing::Schedule { seed, ..*schedule }
 }

@@ -6,8 +6,8 @@
 
 use super::runner::{FrameRow, FramesOutcome};
 use super::spec::{Cameras, FramesSpec, Generator, ShadingName};
-use crate::experiment::timing::{median_interval, series_median, Comparison, Estimate};
 use crate::metrics::stats::median;
+use crate::timing::{median_interval, series_median, Comparison, Estimate};
 
 /// A structure and the way it follows motion, as rows and plots label it.
 pub fn label(r: &FrameRow) -> String {

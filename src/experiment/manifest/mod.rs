@@ -21,8 +21,8 @@ pub use run::{peak_rss, utc, RunInfo};
 pub use staleness::{staleness, Problem};
 
 use super::kind::Kind;
-use super::timing::Schedule;
 use crate::render::AdapterInfo;
+use crate::timing::Schedule;
 use serde::{Deserialize, Serialize};
 
 /// Version of the manifest and of the tables beside it; raised when a column or key changes

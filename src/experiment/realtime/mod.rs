@@ -94,34 +94,16 @@ impl Declaration for Realtime {
     fn axes(&self) -> Vec<Axis<RealtimeAxis>> {
         let s = &self.spec;
         vec![
-            Axis {
-                key: RealtimeAxis::Variant,
-                values: s.variants.iter().map(|v| v.name().to_string()).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Scheme,
-                values: s.schemes.iter().map(|v| v.name().to_string()).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Rays,
-                values: s.rays.iter().map(u32::to_string).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Frames,
-                values: s.frames.iter().map(u32::to_string).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Accumulation,
-                values: s.accumulations.iter().map(|a| a.name().to_string()).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Filter,
-                values: s.filters.iter().map(|f| f.name().to_string()).collect(),
-            },
-            Axis {
-                key: RealtimeAxis::Seed,
-                values: s.seeds.iter().map(u32::to_string).collect(),
-            },
+            Axis::of(RealtimeAxis::Variant, s.variants.iter().map(|v| v.name().to_string())),
+            Axis::of(RealtimeAxis::Scheme, s.schemes.iter().map(|v| v.name().to_string())),
+            Axis::of(RealtimeAxis::Rays, s.rays.iter().map(u32::to_string)),
+            Axis::of(RealtimeAxis::Frames, s.frames.iter().map(u32::to_string)),
+            Axis::of(
+                RealtimeAxis::Accumulation,
+                s.accumulations.iter().map(|a| a.name().to_string()),
+            ),
+            Axis::of(RealtimeAxis::Filter, s.filters.iter().map(|f| f.name().to_string())),
+            Axis::of(RealtimeAxis::Seed, s.seeds.iter().map(u32::to_string)),
         ]
     }
 

@@ -8,13 +8,13 @@ use super::runner::{Outcome, Picture, Row, Run, Series, Timed};
 use super::spec::{RealtimeSpec, Variant};
 use crate::experiment::contract::RunContext;
 use crate::experiment::shadow::has_exact_answer;
-use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate, MARGIN, RULE};
 use crate::files::write_atomic;
 use crate::metrics::stats::mean_ci;
 use crate::output::page::{self, Gallery, Page, Shot, Tone};
 use crate::output::plots::{line_panels, scheme_look, Axes, Panel, Point, Series as PlotSeries};
 use crate::output::table::{cells, write_rows};
 use crate::sampling::DiskScheme;
+use crate::timing::{median_interval, paired_ratio, Comparison, Estimate, FRAME_S, MARGIN, RULE};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -77,12 +77,9 @@ pub struct Stats {
     pub taps_per_pixel: f64,
 }
 
-/// A timed slot's columns of timings.csv after the slot's own.
+/// A timed slot's columns of timings.csv after its frame time.
 #[derive(Serialize)]
 struct TimingColumns<'a> {
-    frame_s: f64,
-    frame_s_lo: f64,
-    frame_s_hi: f64,
     timed_frames: usize,
     work: u64,
     work_unit: &'a str,
@@ -393,14 +390,11 @@ pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> a
         &dir.join("timings.csv"),
         m.slots.iter().map(|s| {
             let columns = TimingColumns {
-                frame_s: s.time.median,
-                frame_s_lo: s.time.lo,
-                frame_s_hi: s.time.hi,
                 timed_frames: s.seconds.len(),
                 work: s.work,
                 work_unit: &s.work_unit,
             };
-            (&s.slot, columns)
+            (&s.slot, s.time.columns(FRAME_S), columns)
         }),
     )?;
     plot(spec, &summary, dir)?;

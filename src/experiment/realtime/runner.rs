@@ -8,7 +8,6 @@ use super::reference::{RefFrame, References};
 use super::spec::{RealtimeSpec, Variant};
 use crate::experiment::progress::Progress;
 use crate::experiment::shadow::shadow_image;
-use crate::experiment::timing::{median_interval, Estimate};
 use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
 use crate::metrics::{penumbra_coverage, ErrorMetrics};
 use crate::output::images::grey;
@@ -18,6 +17,7 @@ use crate::render::shading::Receiver;
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern, Site};
 use crate::scene::{Light, Scene};
+use crate::timing::{median_interval, Estimate};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 

@@ -14,14 +14,14 @@
 use super::axes::Axis;
 use super::reference::Reference;
 use super::run::{context_key, expand, Group};
-use super::runner::{assemble, figure_samples, measure_group, sweep_plan, time_all, verdict_radius};
+use super::runner::UnitOutcome;
+use super::runner::{assemble, measure_group, time_all, Outcome};
 use super::spec::Spec;
-use super::units::UnitOutcome;
+use crate::experiment::contract::RunContext;
 use crate::experiment::core::filter;
-use crate::experiment::core::{Cost, Declaration, Unit};
+use crate::experiment::core::{measure_whole, Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
-use crate::experiment::RunContext;
 use crate::fingerprint::fnv1a;
 use crate::render::{AdapterInfo, Backend, RenderPlan, View};
 use crate::sampling::DiskScheme;
@@ -139,7 +139,7 @@ impl Declaration for Sweep {
 
     fn gpu_gap(&self) -> Option<String> {
         let s = &self.spec;
-        if let Some(gap) = crate::experiment::scene_gpu_gap(&s.scene_path, &s.scene) {
+        if let Some(gap) = crate::experiment::contract::scene_gpu_gap(&s.scene_path, &s.scene) {
             return Some(gap);
         }
         s.axes.accelerators.iter().enumerate().find_map(|(i, name)| {
@@ -218,7 +218,7 @@ impl Declaration for Sweep {
             s.name,
             groups * seeds.len(),
             seeds.join(", "),
-            sweep_plan(s)?
+            s.plan()?
         ))
     }
 
@@ -232,7 +232,7 @@ impl Declaration for Sweep {
         };
         let group = &expand(&self.spec)[i];
         // Whether it keeps a figure follows the swept ray counts, not the group alone.
-        let figure = group.head().samples == figure_samples(&self.spec);
+        let figure = group.head().samples == self.spec.figure_samples();
         Some(format!(
             "{};figure={figure}",
             group.key(&context_key(&self.spec, adapter))
@@ -258,7 +258,7 @@ impl Declaration for Sweep {
                 Ok(UnitOutcome::Group(measure_group(s, backend, group, &reference)))
             }
             (_, PICTURES) => {
-                let pictures = super::pictures::render_pictures(s, backend, verdict_radius(s))
+                let pictures = super::pictures::render_pictures(s, backend, s.verdict_radius())
                     .context("rendering the figures' pictures")?;
                 Ok(UnitOutcome::Pictures(pictures))
             }
@@ -274,7 +274,8 @@ impl Declaration for Sweep {
     }
 
     fn report(&self, outcomes: Vec<UnitOutcome>, run: &mut RunContext) -> anyhow::Result<toml::Table> {
-        let outcome = assemble(self, run.backend, outcomes)?;
+        let adapter = run.backend.adapter().clone();
+        let outcome = assemble(&self.spec, &adapter, |l, r| self.reference(run.backend, l, r), outcomes)?;
         tracing::info!("render plan of a run:\n{}", outcome.plan);
         let adapter = run.backend.adapter().clone();
         let results = super::report::Results {
@@ -286,6 +287,22 @@ impl Declaration for Sweep {
         };
         super::report::write_all(&results, run.out)?;
         tracing::info!("{} runs ({} failed)", outcome.records.len(), outcome.failures);
-        Ok(super::report::manifest::details(&results))
+        Ok(super::report::details(&results))
     }
+}
+
+/// Runs the whole sweep in this process with the core's unit journal and the ground-truth cache
+/// under `home` (`fresh` discards the journal first), and puts its outcomes together.
+pub fn run_sweep(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    home: &Path,
+    fresh: bool,
+    progress: &Progress,
+) -> anyhow::Result<Outcome> {
+    let mut sweep = Sweep::new(spec.clone());
+    sweep.keep_state_in(home);
+    let measured = measure_whole(&sweep, home, fresh, backend, progress)?;
+    let adapter = backend.adapter().clone();
+    assemble(spec, &adapter, |l, r| sweep.reference(backend, l, r), measured.outcomes)
 }

@@ -1,7 +1,7 @@
 //! The sweep: the file ([`spec`]) and its axes ([`axes`]), their expansion into runs ([`run`]),
 //! the per-radius references ([`reference`]), a run measured ([`measure`]) into its record
 //! ([`record`]), the kind's units on the experiment core ([`experiment`]) and what they yield
-//! ([`units`], [`runner`]), the timing design ([`timing`]), and the outputs ([`report`]).
+//! ([`runner`]), the timing design ([`timing`]), and the outputs ([`report`]).
 
 pub mod axes;
 pub mod experiment;
@@ -14,10 +14,9 @@ pub mod run;
 pub mod runner;
 pub mod spec;
 pub mod timing;
-pub mod units;
 
 pub use axes::{Config, Run};
-pub use experiment::Sweep;
+pub use experiment::{run_sweep, Sweep};
 pub use record::Record;
-pub use runner::{run_sweep, Outcome};
+pub use runner::Outcome;
 pub use spec::Spec;

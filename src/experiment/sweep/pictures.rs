@@ -3,7 +3,6 @@
 //! the first seed's and measures each against the ground truth perceptually (FLIP).
 
 use super::run::{expand, Run};
-use super::runner::figure_samples;
 use super::spec::Spec;
 use crate::output::table::f32_hex;
 use crate::render::{Backend, Sampling, View};
@@ -71,7 +70,7 @@ pub fn render_pictures(spec: &Spec, backend: &mut dyn Backend, light_radius: f64
         super::reference::GROUND_TRUTH_SEED,
         spec.scene.accel_settings.name,
     )?;
-    let n = figure_samples(spec);
+    let n = spec.figure_samples();
     let mut runs = Vec::new();
     for group in expand(spec) {
         for run in group.runs {

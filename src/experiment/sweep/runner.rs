@@ -1,25 +1,79 @@
-//! The sweep's units measured, and their outcomes put together for the report: a group renders
+//! The sweep's units measured, what each yields ([`UnitOutcome`], journaled by the experiment
+//! core), and their outcomes put together for the report: a group renders
 //! every seed of one configuration against its (lights on, light radius) reference; the timing
 //! unit times every configuration in interleaved rounds ([`super::timing`]); the outcomes, in
 //! canonical order, become the [`Outcome`] the report reads, records listed reference by
 //! reference.
 
 use super::axes::Config;
-use super::experiment::Sweep;
 use super::measure::{failed_record, measure_run};
+use super::pictures::Pictures;
 use super::record::{FrameTime, Record, Status};
 use super::reference::Reference;
 use super::run::{context_key, expand, Group, GroupStats};
 use super::spec::Spec;
-use super::timing::{self, Timings};
-use super::units::{Figure, GroupOutcome, TimingOutcome, UnitOutcome};
-use crate::experiment::core::measure_whole;
+use super::timing::{self, ConfigTiming, Timings};
 use crate::experiment::progress::Progress;
 use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
-use crate::render::{Backend, RenderPlan, View};
+use crate::output::table::{csv_text, f32_hex};
+use crate::render::{AdapterInfo, Backend, RenderPlan};
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
-use std::path::Path;
+use std::sync::Arc;
+
+/// One unit's outcome.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum UnitOutcome {
+    /// A configuration measured over its seeds.
+    Group(GroupOutcome),
+    /// The Fig. 2 pictures (none without `[figures]`).
+    Pictures(Option<Pictures>),
+    /// The timing phase.
+    Timing(TimingOutcome),
+}
+
+/// A configuration measured over every seed: its runs.csv rows, the per-pixel bias/variance
+/// split of its images, and what the figures keep of it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct GroupOutcome {
+    /// One record per seed, in seed order; failed runs included.
+    #[serde(with = "csv_text")]
+    pub records: Vec<Record>,
+    /// Squared bias and variance over the seeds that rendered.
+    pub split: BiasVariance,
+    /// At the figures' ray count, when any seed rendered.
+    pub figure: Option<Figure>,
+}
+
+impl GroupOutcome {
+    /// Runs that failed.
+    pub fn failed(&self) -> usize {
+        self.records.iter().filter(|r| r.status != Status::Ok).count()
+    }
+}
+
+/// What the report's figures take from a group at the figures' ray count: the measuring image
+/// of its first rendered seed and, on on-axis scenes, the bin means of its seed-averaged radial
+/// profile (the rest of a profile follows from the image and the receivers).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Figure {
+    /// Measuring-view visibility of the first rendered seed.
+    #[serde(with = "f32_hex")]
+    pub image: Vec<f32>,
+    /// [`crate::metrics::RadialProfile::mean`] over the group's seeds, on on-axis scenes.
+    pub profile_means: Option<Vec<f64>>,
+}
+
+/// Every configuration timed in one interleaved phase, in the sweep's canonical order, and the
+/// A/A control: the configuration (an index into that order) timed a second time per round.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct TimingOutcome {
+    /// Per configuration, in canonical order.
+    pub configs: Vec<ConfigTiming>,
+    /// The A/A control's configuration index and its second series of frames.
+    pub noise: Option<(usize, ConfigTiming)>,
+}
 
 /// What a finished sweep hands to the report.
 pub struct Outcome {
@@ -40,64 +94,9 @@ pub struct Outcome {
     /// Frame times per configuration (empty when the experiment times nothing).
     pub timings: Timings,
     /// The Fig. 2 pictures, when the experiment has `[figures]`.
-    pub pictures: Option<super::pictures::Pictures>,
+    pub pictures: Option<Pictures>,
     /// Runs that failed.
     pub failures: usize,
-}
-
-/// Shadow-ray count whose images and profiles are kept for figures (the paper's 16, or the
-/// nearest swept count).
-pub fn figure_samples(spec: &Spec) -> u32 {
-    let want = spec.figures.as_ref().map_or(16, |f| f.samples);
-    *spec
-        .axes
-        .samples
-        .iter()
-        .min_by_key(|&&n| (n as i64 - want as i64).abs())
-        .expect("validated non-empty")
-}
-
-/// The render plan of the sweep's fullest run (most lights, first radius, the figures' ray
-/// count, first swept structure): logged with every sweep and printed by `--dry-run`.
-pub fn sweep_plan(spec: &Spec) -> anyhow::Result<RenderPlan> {
-    let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
-    let s = spec.scene_with(
-        lights,
-        spec.axes.light_radii[0],
-        figure_samples(spec),
-        &spec.axes.accelerators[0],
-    );
-    let view = View {
-        camera: &s.cameras[&spec.measure.camera],
-        width: spec.measure.width,
-        height: spec.measure.height,
-    };
-    RenderPlan::new(&s, view)
-}
-
-/// The light radius the verdict is read at: the paper's 2 cm if swept, else the nearest.
-pub fn verdict_radius(spec: &Spec) -> f64 {
-    *spec
-        .axes
-        .light_radii
-        .iter()
-        .min_by(|a, b| (*a - 0.02).abs().total_cmp(&(*b - 0.02).abs()))
-        .expect("validated non-empty")
-}
-
-/// Runs the whole sweep in this process with the core's unit journal and the ground-truth cache
-/// under `home` (`fresh` discards the journal first), and puts its outcomes together.
-pub fn run_sweep(
-    spec: &Spec,
-    backend: &mut dyn Backend,
-    home: &Path,
-    fresh: bool,
-    progress: &Progress,
-) -> anyhow::Result<Outcome> {
-    let mut sweep = Sweep::new(spec.clone());
-    crate::experiment::core::Declaration::keep_state_in(&mut sweep, home);
-    let measured = measure_whole(&sweep, home, fresh, backend, progress)?;
-    assemble(&sweep, backend, measured.outcomes)
 }
 
 /// Renders and measures every seed of `group` against `reference`; a failed render becomes a
@@ -118,7 +117,7 @@ pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, refe
             }
         }
     }
-    let figure = (group.head().samples == figure_samples(spec))
+    let figure = (group.head().samples == spec.figure_samples())
         .then(|| figure_of(reference, &images))
         .flatten();
     GroupOutcome {
@@ -135,7 +134,7 @@ pub fn time_all(spec: &Spec, backend: &mut dyn Backend, progress: &Progress) -> 
         return Ok(TimingOutcome::default());
     }
     let groups = expand(spec);
-    let probe = timing::noise_probe(&groups, figure_samples(spec), verdict_radius(spec));
+    let probe = timing::noise_probe(&groups, spec.figure_samples(), spec.verdict_radius());
     let visits = (groups.len() as u64 + probe.map_or(0, |_| timing::NOISE_VISITS as u64)) * spec.timing.repeats as u64;
     let bar = progress.bar("timed frames", visits);
     bar.message(format!("{} warm-up each, interleaved rounds", spec.timing.warmup));
@@ -149,17 +148,21 @@ pub fn time_all(spec: &Spec, backend: &mut dyn Backend, progress: &Progress) -> 
 
 /// Puts the units' outcomes (canonical order: groups, pictures, timing) together for the
 /// report: each reference built again, from the ground-truth cache where a unit left it.
-pub fn assemble(sweep: &Sweep, backend: &mut dyn Backend, outcomes: Vec<UnitOutcome>) -> anyhow::Result<Outcome> {
-    let spec = &sweep.spec;
+pub fn assemble(
+    spec: &Spec,
+    adapter: &AdapterInfo,
+    mut reference_for: impl FnMut(u32, f64) -> anyhow::Result<Arc<Reference>>,
+    outcomes: Vec<UnitOutcome>,
+) -> anyhow::Result<Outcome> {
     let groups = expand(spec);
-    let context = context_key(spec, backend.adapter());
+    let context = context_key(spec, adapter);
     let mut out = Outcome {
         records: Vec::new(),
         groups: Vec::new(),
         references: Vec::new(),
         profiles: Vec::new(),
         keep: Vec::new(),
-        plan: sweep_plan(spec)?,
+        plan: spec.plan()?,
         timings: Timings {
             seed: spec.timing.seed,
             ..Timings::default()
@@ -183,7 +186,7 @@ pub fn assemble(sweep: &Sweep, backend: &mut dyn Backend, outcomes: Vec<UnitOutc
         groups.len()
     );
     for ((lights, radius), share) in by_reference(&groups) {
-        let reference = sweep.reference(backend, lights, radius)?;
+        let reference = reference_for(lights, radius)?;
         for (i, g) in share {
             let o = measured[i].take().expect("each group once");
             if let Some(f) = o.figure {

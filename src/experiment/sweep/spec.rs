@@ -5,13 +5,13 @@ pub use super::axes::Axes;
 use crate::accel::Accelerator;
 use crate::config::{ConfigError, Source};
 use crate::experiment::header::Header;
-use crate::experiment::timing::Schedule;
 use crate::key_path;
-use crate::render::BackendChoice;
-use crate::sampling::points::{Domain, Layout, PointSet, PointsId, Settings, MAX_TILE};
+use crate::render::{BackendChoice, RenderPlan, View};
+use crate::sampling::points;
 use crate::sampling::DiskScheme;
 use crate::scene::camera::Projection;
 use crate::scene::{Light, Scene, MAX_SAMPLES};
+use crate::timing::Schedule;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,28 +26,9 @@ crate::experiment_file! {
         ground_truth: GroundTruth,
         figures: Option<Figures>,
         #[serde(default)]
-        points: BTreeMap<String, PointsTable>,
+        points: BTreeMap<String, points::Table>,
         verdict: Option<VerdictPair>,
     }
-}
-
-/// A `[points.NAME]` table: the file (relative to the experiment) a `points:NAME` scheme reads
-/// and how ([`crate::sampling::points`]).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct PointsTable {
-    /// The points file.
-    pub path: PathBuf,
-    /// `square` (default; mapped to the disk by the concentric map) or `disk`.
-    #[serde(default)]
-    pub domain: Option<String>,
-    /// `shared` (default), `tile` or `mask`.
-    #[serde(default)]
-    pub layout: Option<String>,
-    /// The tile's side in pixels (`tile` and `mask` layouts).
-    pub tile: Option<u32>,
-    /// The mask file (`mask` layout), relative to the experiment.
-    pub mask: Option<PathBuf>,
 }
 
 /// `[verdict]`: the two schemes the verdict compares (default: the paper's pattern against
@@ -369,7 +350,7 @@ impl Spec {
             .copied()
             .max()
             .unwrap_or(1);
-        load_points(source, &mut axes.schemes, &f.points, needed)?;
+        points::load_all(source, &mut axes.schemes, &f.points, needed)?;
         let verdict = match &f.verdict {
             None => (DiskScheme::Paper, DiskScheme::Uniform),
             Some(v) => {
@@ -406,6 +387,46 @@ impl Spec {
             ground_truth: f.ground_truth,
             figures: f.figures,
         })
+    }
+
+    /// Shadow-ray count whose images and profiles are kept for figures (the paper's 16, or the
+    /// nearest swept count).
+    pub fn figure_samples(&self) -> u32 {
+        let want = self.figures.as_ref().map_or(16, |f| f.samples);
+        *self
+            .axes
+            .samples
+            .iter()
+            .min_by_key(|&&n| (n as i64 - want as i64).abs())
+            .expect("validated non-empty")
+    }
+
+    /// The render plan of the sweep's fullest run (most lights, first radius, the figures' ray
+    /// count, first swept structure): logged with every sweep and printed by `--dry-run`.
+    pub fn plan(&self) -> anyhow::Result<RenderPlan> {
+        let lights = *self.axes.light_counts.iter().max().expect("validated non-empty");
+        let s = self.scene_with(
+            lights,
+            self.axes.light_radii[0],
+            self.figure_samples(),
+            &self.axes.accelerators[0],
+        );
+        let view = View {
+            camera: &s.cameras[&self.measure.camera],
+            width: self.measure.width,
+            height: self.measure.height,
+        };
+        RenderPlan::new(&s, view)
+    }
+
+    /// The light radius the verdict is read at: the paper's 2 cm if swept, else the nearest.
+    pub fn verdict_radius(&self) -> f64 {
+        *self
+            .axes
+            .light_radii
+            .iter()
+            .min_by(|a, b| (*a - 0.02).abs().total_cmp(&(*b - 0.02).abs()))
+            .expect("validated non-empty")
     }
 
     /// Every points file the sweep reads, for the manifest.
@@ -448,81 +469,4 @@ fn read_as_sweep(mut e: ConfigError, header: &Header) -> ConfigError {
             " (a file without `kind` is read as kind = \"sweep\"; a frame-rate experiment says kind = \"fps\")";
     }
     e
-}
-
-/// Loads the set of every `points:NAME` in `schemes` from its `[points.NAME]` table (paths
-/// relative to the experiment), checking it holds `needed` samples per pixel; a table no scheme
-/// names is an error too (a misspelt name would otherwise be silently unused).
-fn load_points(
-    source: &Source,
-    schemes: &mut [DiskScheme],
-    tables: &BTreeMap<String, PointsTable>,
-    needed: u32,
-) -> Result<(), ConfigError> {
-    let dir = source.path.parent().unwrap_or(Path::new("."));
-    for name in tables.keys() {
-        let listed = schemes.iter().any(|s| s.to_string() == format!("points:{name}"));
-        if !listed {
-            return Err(source.error(
-                &key_path!["points", name.as_str()],
-                format!("no `points:{name}` in sweep.schemes uses this table"),
-            ));
-        }
-    }
-    for (i, scheme) in schemes.iter_mut().enumerate() {
-        let DiskScheme::Points(_) = scheme else { continue };
-        let label = scheme.to_string();
-        let name = &label["points:".len()..];
-        let Some(t) = tables.get(name) else {
-            return Err(source.error(
-                &key_path!["sweep", "schemes", i],
-                format!("`{label}` needs a [points.{name}] table with the file's `path`"),
-            ));
-        };
-        let at = |key: &str| key_path!["points", name, key];
-        let domain = match t.domain.as_deref() {
-            None | Some("square") => Domain::Square,
-            Some("disk") => Domain::Disk,
-            Some(other) => {
-                return Err(source.error(&at("domain"), format!("`{other}`: expected \"square\" or \"disk\"")))
-            }
-        };
-        let side = |what: &str| match t.tile {
-            Some(side) if (1..=MAX_TILE).contains(&side) => Ok(side),
-            Some(side) => Err(source.error(&at("tile"), format!("tile side must be in 1..={MAX_TILE}, got {side}"))),
-            None => Err(source.error(
-                &at("layout"),
-                format!("the {what} layout needs `tile`, the tile's side in pixels"),
-            )),
-        };
-        let layout = match t.layout.as_deref() {
-            None | Some("shared") => Layout::Shared,
-            Some("tile") => Layout::Tile(side("tile")?),
-            Some("mask") => Layout::Mask(side("mask")?),
-            Some(other) => {
-                return Err(source.error(
-                    &at("layout"),
-                    format!("`{other}`: expected \"shared\", \"tile\" or \"mask\""),
-                ))
-            }
-        };
-        if matches!(layout, Layout::Mask(_)) != t.mask.is_some() {
-            return Err(source.error(
-                &at("mask"),
-                "a mask file goes with layout = \"mask\", and only with it".to_string(),
-            ));
-        }
-        if matches!(layout, Layout::Shared) && t.tile.is_some() {
-            return Err(source.error(&at("tile"), "a shared set has no tile".to_string()));
-        }
-        let settings = Settings {
-            path: dir.join(&t.path),
-            domain,
-            layout,
-            mask: t.mask.as_ref().map(|m| dir.join(m)),
-        };
-        let set = PointSet::load(name, &settings, needed)?;
-        *scheme = DiskScheme::Points(PointsId::install(set).map_err(|e| source.error(&at("path"), e))?);
-    }
-    Ok(())
 }

@@ -1,4 +1,4 @@
-//! Frame times you can rank by, timed the one way every kind times ([`crate::experiment::timing`]).
+//! Frame times you can rank by, timed the one way every kind times ([`crate::timing`]).
 //! Every configuration of a sweep (all axes but the seed) is timed with its first seed's sampling,
 //! once per interleaved round; each visit renders `warmup` untimed frames, then one timed frame
 //! over resources already resident on the device. An A/A control, one configuration visited a
@@ -8,8 +8,8 @@
 use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::Spec;
-use crate::experiment::timing::{median_interval, paired_ratio, Comparison, Estimate};
 use crate::render::{Backend, Sampling, View};
+use crate::timing::{median_interval, paired_ratio, Comparison, Estimate};
 use std::collections::BTreeMap;
 
 /// Extra visits of the A/A control per round.

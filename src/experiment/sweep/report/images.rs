@@ -1,15 +1,21 @@
 //! The sweep's images: every scheme x pattern of the measuring view at the figure ray count with
 //! the ground truth and the exact image, and the Fig. 2 pictures, each as EXR (the values) and
 //! PNG (what the page shows), gathered into the page's galleries; plus the grids
-//! fig2_measure.png (with error maps and their colour bars) and fig2_picture.png.
+//! fig2_measure.png (with error maps and their colour bars) and fig2_picture.png. The Fig. 2
+//! pictures are shown as a person sees them: tone-mapped with the ground-truth picture's exposure,
+//! and each measured against the ground-truth picture with FLIP (Andersson et al. 2020), the
+//! perceptual stand-in for the paper's "equal quality".
 
-use super::pictures::{shown, write_fig2_picture};
 use super::results::Results;
-use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
-use crate::output::images::{diverging, exposure, grey, Rgb};
+use super::summary::PictureFlip;
+use crate::experiment::sweep::pictures::{Picture, Pictures};
+use crate::experiment::sweep::Spec;
+use crate::metrics::flip::{flip_mean, PIXELS_PER_DEGREE};
+use crate::output::images::{diverging, exposure, grey, tonemap_with, Rgb};
 use crate::output::page::{write_shots, Gallery, Shot, Tone};
 use crate::output::plots::{image_grid, ColourBar, Tile};
 use crate::output::table::cells;
+use crate::sampling::{DiskScheme, Pattern};
 use std::path::Path;
 
 /// The difference a run's error map shows at full colour.
@@ -45,8 +51,8 @@ pub fn write_images(r: &Results, dir: &Path) -> anyhow::Result<Vec<Gallery>> {
 /// exact image.
 fn measuring_view(r: &Results) -> anyhow::Result<Option<Gallery>> {
     let spec = r.spec;
-    let radius = verdict_radius(spec);
-    let n = figure_samples(spec);
+    let radius = spec.verdict_radius();
+    let n = spec.figure_samples();
     let lights = *spec.axes.light_counts.iter().max().expect("validated non-empty");
     let Some(reference) = r
         .outcome
@@ -110,7 +116,7 @@ fn measuring_view(r: &Results) -> anyhow::Result<Option<Gallery>> {
 /// their signed errors underneath, each with its colour bar.
 fn write_measure_grid(r: &Results, g: &Gallery, path: &Path) -> anyhow::Result<()> {
     let (w, h) = (g.width, g.height);
-    let n = figure_samples(r.spec);
+    let n = r.spec.figure_samples();
     let gt = &g.shots[g.reference.expect("the measuring view has a reference")];
     let mut tiles: Vec<(String, Rgb)> = Vec::new();
     let mut errors: Vec<(String, Rgb, f64)> = Vec::new();
@@ -192,4 +198,77 @@ fn pictures_gallery(r: &Results, p: &crate::experiment::sweep::pictures::Picture
         against: None,
         shots,
     })
+}
+
+fn display(p: &Picture, p99: f64) -> Rgb {
+    tonemap_with(&p.radiance, p.width, p.height, p99)
+}
+
+/// Mean FLIP of every picture against the ground-truth picture, per configuration, one value per
+/// seed in seed order.
+pub fn picture_flip(pictures: &Pictures) -> anyhow::Result<PictureFlip> {
+    let gt = &pictures.ground_truth;
+    let p99 = exposure(&gt.radiance);
+    let reference = display(gt, p99);
+    let mut out = PictureFlip::new();
+    for (run, p) in &pictures.runs {
+        let test = display(p, p99);
+        let e = flip_mean(
+            &reference.data,
+            &test.data,
+            reference.width,
+            reference.height,
+            PIXELS_PER_DEGREE,
+        )?;
+        let config = run.config();
+        match out.iter_mut().find(|(c, _)| *c == config) {
+            Some((_, seeds)) => seeds.push(e),
+            None => out.push((config, vec![e])),
+        }
+    }
+    Ok(out)
+}
+
+/// The (scheme, pattern) pairs the Fig. 2 images show, in order: the verdict's subject
+/// (per-pixel, then shared), its baseline, then every other swept scheme per-pixel; only what
+/// was swept.
+pub fn shown(spec: &Spec) -> Vec<(DiskScheme, Pattern)> {
+    let (subject, baseline) = spec.verdict;
+    let mut out = vec![
+        (subject, Pattern::PerPixel),
+        (subject, Pattern::Shared),
+        (baseline, Pattern::PerPixel),
+    ];
+    out.extend(
+        spec.axes
+            .schemes
+            .iter()
+            .filter(|&&s| s != subject && s != baseline)
+            .map(|&s| (s, Pattern::PerPixel)),
+    );
+    out.retain(|(s, p)| spec.axes.schemes.contains(s) && spec.axes.patterns.contains(p));
+    out
+}
+
+/// fig2_picture.png: the [`shown`] schemes at the first seed, and the ground truth, all at the
+/// ground truth's exposure.
+pub fn write_fig2_picture(spec: &Spec, pictures: &Pictures, seed: u32, path: &Path) -> anyhow::Result<()> {
+    let gt = &pictures.ground_truth;
+    let p99 = exposure(&gt.radiance);
+    let mut tiles: Vec<(String, Rgb)> = Vec::new();
+    for (scheme, pattern) in shown(spec) {
+        let found = pictures
+            .runs
+            .iter()
+            .find(|(r, _)| r.scheme == scheme && r.pattern == pattern && r.seed == seed);
+        if let Some((_, p)) = found {
+            tiles.push((format!("{scheme} ({pattern}), {} rays", p.samples), display(p, p99)));
+        }
+    }
+    tiles.push((
+        format!("jittered (ground truth), {} rays", gt.samples),
+        display(gt, p99),
+    ));
+    let refs: Vec<Tile> = tiles.iter().map(|(l, i)| Tile::new(l.clone(), i)).collect();
+    image_grid(path, &refs, 2)
 }

@@ -4,13 +4,13 @@
 use super::summary::{find, swept_schemes, Summary};
 use super::verdict::Verdict;
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
-use crate::experiment::sweep::runner::{figure_samples, verdict_radius, Outcome};
+use crate::experiment::sweep::runner::Outcome;
 use crate::experiment::sweep::timing::{compare, ConfigTiming};
 use crate::experiment::sweep::Spec;
-use crate::experiment::timing::{Comparison, Estimate, RULE};
 use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
+use crate::timing::{Comparison, RULE};
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
     or_na(x.unwrap_or(f64::NAN), f)
@@ -18,8 +18,8 @@ fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
 
 /// The report's markdown.
 pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &AdapterInfo, seconds: f64) -> String {
-    let n = figure_samples(spec);
-    let radius = verdict_radius(spec);
+    let n = spec.figure_samples();
+    let radius = spec.verdict_radius();
     let mut s = format!("# {}: soft-shadow sampling sweep\n\n", spec.name);
     s += &format!(
         "Experiment `{}`, scene `{}`; {} runs ({} failed) on **{}** ({}, {}, {}) in {:.0} s.\n\n",
@@ -114,15 +114,6 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
     s += "- `ground_truth.csv`: per light configuration, the reference's checks above.\n- `plots/`: width vs samples (exact drawn), RMSE vs samples, RMSE vs frame time, radial profiles, width vs light radius (on-axis scenes); RMSE vs samples and vs frame time, the error's spectrum per scheme at the figure ray count (any scene). A plot over both patterns has one panel per pattern on shared axes; one file per value of each other swept axis, named `_AXIS-VALUE` (`rmse_vs_time_lights-1_accelerator-bvh.png`).\n";
     s += "- `images/`: every scheme and pattern of the measuring view at the figure ray count, the ground truth and the exact image, and the Fig. 2 pictures, each as `.exr` (the values) and `.png`; the grids `fig2_measure.png` and `fig2_picture.png`.\n- `index.html`: the comparison page (open it in a browser; no server needed).\n- `manifest.toml`: commit, adapter, experiment, seeds.\n";
     s
-}
-
-/// "12.3 ms [11.9, 12.8]": a median frame time (seconds) and its 95 % interval, in ms.
-pub(super) fn ms_ci(frame: &Estimate) -> String {
-    if frame.median.is_finite() {
-        format!("{} ms", frame.scaled(1e3).show(2))
-    } else {
-        "n/a".into()
-    }
 }
 
 /// How times were taken, the rule that turns them into words, and the A/A control that checks
@@ -255,7 +246,7 @@ fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> St
                 "not reached".to_string(),
                 |x| {
                     let rank = time_rank(x.timing.as_ref(), u.timing.as_ref());
-                    format!("{} rays, {}, {rank}", x.config.samples, ms_ci(&x.frame))
+                    format!("{} rays, {}, {rank}", x.config.samples, x.frame.show_ms())
                 },
             ),
         };
@@ -266,7 +257,7 @@ fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> St
             or_na(at.metrics.rmse.mean, |x| format!("{x:.4}")),
             or_na(at.flip.mean, |x| format!("{x:.4}")),
             or_na(at.metrics.penumbra_lost_share.mean, |x| format!("{x:.3}")),
-            ms_ci(&at.frame),
+            at.frame.show_ms(),
             count(at.rays),
             count(at.work.map(|w| w.nodes)),
             count(at.work.map(|w| w.primitives)),
@@ -297,6 +288,5 @@ mod tests {
         assert!(time_rank(Some(&b), Some(&a)).ends_with(": slower"));
         assert!(time_rank(Some(&a), Some(&noisy)).ends_with(": equal within noise"));
         assert_eq!(time_rank(None, Some(&b)), "untimed");
-        assert_eq!(ms_ci(&Estimate::NAN), "n/a");
     }
 }

@@ -1,11 +1,9 @@
-//! The sweep's outputs: CSV tables, plots, images, the markdown report with its verdict, the
-//! comparison page (index.html), and the regression thresholds checked against them, written into the run's staging folder (the
-//! driver adds the manifest and swaps the set in).
+//! The sweep's outputs, written into the run's staging folder (the driver adds the manifest and
+//! swaps the set in): CSV tables, plots, images, the markdown report with its verdict, the
+//! comparison page (index.html), and the regression thresholds checked against them.
 
 pub mod images;
-pub mod manifest;
 pub mod markdown;
-pub mod pictures;
 pub mod plots;
 pub mod results;
 pub mod schemes;
@@ -18,9 +16,9 @@ pub mod verdict;
 use crate::experiment::outputs::Outputs;
 use crate::files::write_atomic;
 use crate::output::page::{self, Page};
+use images::picture_flip;
 use markdown::report;
-use pictures::picture_flip;
-pub use results::Results;
+pub use results::{details, Results};
 
 /// Writes every output into `outputs`.
 pub fn write_all(r: &Results, outputs: &Outputs) -> anyhow::Result<()> {

@@ -8,7 +8,6 @@ use super::results::Results;
 use super::summary::{swept_schemes, Summary};
 use crate::experiment::sweep::axes::{slices, Axis, Config, Slice};
 use crate::experiment::sweep::record::{Aggregated, Status};
-use crate::experiment::sweep::runner::{figure_samples, verdict_radius};
 use crate::metrics::spectrum::BIN;
 use crate::metrics::stats::{mean_ci, MeanCi};
 pub use crate::output::plots::scheme_look;
@@ -108,8 +107,8 @@ pub fn write_plots(r: &Results, summaries: &[Summary], dir: &Path) -> anyhow::Re
 
 fn plots_for(r: &Results, summaries: &[Summary], dir: &Path, slice: &Slice, suffix: &str) -> anyhow::Result<()> {
     let spec = r.spec;
-    let radius = verdict_radius(spec);
-    let n = figure_samples(spec);
+    let radius = spec.verdict_radius();
+    let n = spec.figure_samples();
     let lights = slice.config.lights;
     let schemes = &spec.axes.schemes;
     let at_radius = Filter {

@@ -7,14 +7,13 @@
 //! 95 % interval over seeds lies below every other scheme's, and otherwise the schemes whose
 //! intervals overlap its are named with it.
 
-use super::markdown::ms_ci;
 use super::summary::{find, swept_schemes, Summary};
 use crate::experiment::sweep::axes::{Axis, Config, Slice};
 use crate::experiment::sweep::timing::compare;
-use crate::experiment::timing::Comparison;
 use crate::metrics::stats::MeanCi;
 use crate::output::numbers::{or_na, with_ci};
 use crate::sampling::{DiskScheme, Pattern};
+use crate::timing::Comparison;
 
 /// A metric the schemes are ranked by (lower is better).
 struct Metric {
@@ -211,7 +210,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
             with_ci(x.flip.mean, x.flip.ci95, four),
             with_ci(m.rmse_blurred.mean, m.rmse_blurred.ci95, four),
             with_ci(m.lowfreq_share.mean, m.lowfreq_share.ci95, |v| format!("{v:.3}")),
-            ms_ci(&x.frame),
+            x.frame.show_ms(),
         );
     }
     let Some(budget) = find(summaries, &config(slice, DiskScheme::Uniform, n, radius)) else {
@@ -226,7 +225,7 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
     }
     s += &format!(
         "\n### At equal time\n\nEach scheme at the most swept rays whose frame time is not clearly longer than uniform@{n}'s ({}) by the timing rule; FLIP only where that is {n} rays (the pictures are rendered there).\n\n",
-        ms_ci(&budget.frame)
+        budget.frame.show_ms()
     );
     s += &rank_sentences(&equal, subject);
     s += "\n| scheme | rays | time vs uniform | RMSE | blurred RMSE | low-freq share |\n|---|---|---|---|---|---|\n";

@@ -56,13 +56,13 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
                 let (r, w) = compare(a, b);
                 (r, w.word())
             }
-            _ => (crate::experiment::timing::Estimate::NAN, "untimed"),
+            _ => (crate::timing::Estimate::NAN, "untimed"),
         };
         if ratio.median.is_finite() {
             ratios.push(ratio.median);
         }
         let c = &other.config;
-        let ms = |e: &crate::experiment::timing::Estimate| or_na(e.median, |_| e.scaled(1e3).show(2));
+        let ms = |e: &crate::timing::Estimate| or_na(e.median, |_| e.scaled(1e3).show(2));
         let count = |w: Option<crate::accel::work::Work>, f: fn(crate::accel::work::Work) -> u64| {
             w.map_or("n/a".to_string(), |w| format!("{:.3e}", f(w) as f64))
         };

@@ -7,10 +7,10 @@ use crate::experiment::sweep::record::{Aggregated, Metrics, Record, Status};
 use crate::experiment::sweep::run::GroupStats;
 use crate::experiment::sweep::runner::Outcome;
 use crate::experiment::sweep::timing::ConfigTiming;
-use crate::experiment::timing::Estimate;
 use crate::metrics::stats::{mean_ci, MeanCi};
 use crate::output::table::float;
 use crate::sampling::DiskScheme;
+use crate::timing::{Estimate, FRAME_S};
 use serde::{Serialize, Serializer};
 
 /// FLIP of each seed's picture, per configuration that has pictures.
@@ -128,15 +128,9 @@ struct Head {
     exact_width_10_90: f64,
 }
 
-/// The columns after the aggregated metrics.
+/// The columns after the frame time.
 #[derive(Serialize)]
 struct Tail {
-    #[serde(with = "float")]
-    frame_s: f64,
-    #[serde(with = "float")]
-    frame_s_lo: f64,
-    #[serde(with = "float")]
-    frame_s_hi: f64,
     timed_frames: Option<usize>,
     queries: Option<u64>,
     nodes_visited: Option<u64>,
@@ -169,13 +163,9 @@ impl Serialize for Summary {
             exact_extent_width: self.exact_extent_width,
             exact_width_10_90: self.exact_width_10_90,
         };
-        let frame = self.frame;
         let split = &self.stats.split;
         let [rays_per_s, primary_rays_per_s, shadow_rays_per_s] = self.rays_per_s;
         let tail = Tail {
-            frame_s: frame.median,
-            frame_s_lo: frame.lo,
-            frame_s_hi: frame.hi,
             timed_frames: self.timing.as_ref().map(|t| t.frame_seconds.len()),
             queries: self.work.map(|w| w.queries),
             nodes_visited: self.work.map(|w| w.nodes),
@@ -190,6 +180,6 @@ impl Serialize for Summary {
             flip_mean: self.flip.mean,
             flip_ci95: self.flip.ci95,
         };
-        (&self.config, head, &self.metrics, tail).serialize(s)
+        (&self.config, head, &self.metrics, self.frame.columns(FRAME_S), tail).serialize(s)
     }
 }

@@ -72,8 +72,8 @@ pub fn paired_ratio(a: &[f64], b: &[f64]) -> Estimate {
 mod tests {
     use super::super::draws;
     use super::*;
-    use crate::experiment::timing::rule::Comparison;
-    use crate::experiment::timing::schedule::Schedule;
+    use crate::timing::rule::Comparison;
+    use crate::timing::schedule::Schedule;
 
     /// The ranks and coverages of the order-statistic interval: known values of the binomial
     /// (n = 5: [min, max], 1 - 2/32; n = 9: the second smallest and largest, 1 - 2 x 10/512),

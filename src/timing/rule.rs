@@ -117,8 +117,8 @@ impl Comparison {
 mod tests {
     use super::super::draws;
     use super::*;
-    use crate::experiment::timing::interval::{coverage, paired_ratio};
     use crate::sampling::Stream;
+    use crate::timing::interval::{coverage, paired_ratio};
 
     /// Two modes at random, as lavapipe's frames: 15 or 29 ms, each half the time, with 2 %
     /// jitter.

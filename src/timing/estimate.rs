@@ -49,6 +49,15 @@ impl Estimate {
         EstimateColumns { names, estimate: self }
     }
 
+    /// `12.34 [11.90, 12.80] ms`: a time in seconds, shown in milliseconds; `n/a` when untimed.
+    pub fn show_ms(&self) -> String {
+        if self.median.is_finite() {
+            format!("{} ms", self.scaled(1e3).show(2))
+        } else {
+            "n/a".into()
+        }
+    }
+
     /// `1.23 [1.10, 1.41]` with `digits` decimals.
     pub fn show(&self, digits: usize) -> String {
         if self.median.is_nan() {
@@ -113,6 +122,17 @@ mod tests {
 
     /// The group writes the columns its three fields wrote, byte for byte, as a part of a row; a
     /// struct in a field or a flattened one would be refused.
+    #[test]
+    fn a_time_shows_in_milliseconds_or_as_not_available() {
+        assert_eq!(Estimate::NAN.show_ms(), "n/a");
+        let e = Estimate {
+            median: 0.0123,
+            lo: 0.0119,
+            hi: 0.0128,
+        };
+        assert_eq!(e.show_ms(), "12.30 [11.90, 12.80] ms");
+    }
+
     #[test]
     fn an_estimate_writes_the_columns_its_fields_wrote() {
         #[derive(Serialize)]

@@ -22,6 +22,10 @@
 //! numbers: square coordinates as 24-bit fractions (the built-ins' resolution), disk coordinates
 //! as multiples of 2^-23.
 
+mod table;
+
+pub use table::{load_all, Table};
+
 use super::bluenoise::{cp_shift, tile_index_in};
 use crate::config::ConfigError;
 use crate::fingerprint::fnv1a;

@@ -71,7 +71,7 @@ fn block_length(values: &[f64]) -> usize {
 mod tests {
     use super::super::draws;
     use super::*;
-    use crate::experiment::timing::rule::Comparison;
+    use crate::timing::rule::Comparison;
 
     /// An AR(1) series: x_i = rho x_(i-1) + noise, around `mean`.
     fn ar1(stream: u32, n: usize, mean: f64, rho: f64, rel: f64) -> Vec<f64> {
