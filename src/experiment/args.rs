@@ -41,7 +41,8 @@ impl std::fmt::Display for Filter {
 /// `--filter`'s help.
 pub const FILTER_HELP: &str = "Run only the work whose AXIS has VALUE (each kind's axes are listed by \
 --dry-run: a sweep's scheme, pattern, samples, light_radius, lights, accelerator, seed; ao's mesh, \
-structure, issue; frames' scene, shading, viewpoint; fps' scene, lights, resolution); repeat to keep \
+structure, issue; frames' scene, shading, viewpoint; fps' scene, lights, resolution; realtime's variant, scheme, \
+rays, frames, accumulation, filter, seed); repeat to keep \
 several values or restrict several axes";
 
 /// Most shards an experiment splits into.

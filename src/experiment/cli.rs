@@ -48,16 +48,16 @@ pub struct Cli {
     /// Override the experiment's backend.
     #[arg(long, value_enum)]
     pub backend: Option<BackendChoice>,
-    /// Print the expanded runs and the render plan, then exit without rendering.
+    /// Print the axes, the units of work and the render plan, then exit without rendering.
     #[arg(long)]
     pub dry_run: bool,
-    /// Run only the K-th of N deterministic shares of the runs (balanced by expected rays) into
-    /// RESULTS/shards/K-of-N/, from which a killed shard resumes; no final outputs.
+    /// Run only the K-th of N deterministic shares of the experiment's units (dealt by expected
+    /// work) into RESULTS/shards/K-of-N/, from which a killed shard resumes; no final outputs.
     #[arg(long, value_name = "K/N", conflicts_with = "merge")]
     pub shard: Option<Shard>,
-    /// Merge finished shards into the results, checking that every run is present exactly once:
-    /// N merges RESULTS/shards/1-of-N .. N-of-N, or name shard folders; times the configurations
-    /// and draws the figures here.
+    /// Merge finished shards into the results, checking that every unit is present exactly once:
+    /// N merges RESULTS/shards/1-of-N .. N-of-N, or name shard folders. Nothing is measured
+    /// again: times and pictures were taken inside the shards' units.
     #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
     pub merge: Vec<PathBuf>,
     /// Subset filters; the help text names the axes from the axis list.
@@ -94,7 +94,7 @@ impl Cli {
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-/// Some runs failed: exit status 3.
+/// Some runs failed: exit status 3. The text says where their errors are.
 #[derive(Debug, thiserror::Error)]
-#[error("{0} runs failed; see the `error` column of {1}")]
+#[error("{0} runs failed; {1}")]
 pub struct RunsFailed(pub usize, pub String);

@@ -40,7 +40,7 @@ pub struct RunContext<'a> {
 /// How a run ended.
 pub enum Finished {
     /// The outputs are written; `details` is the kind's table in the manifest; `failed` names
-    /// runs that failed and the table saying why (exit status 3).
+    /// runs that failed and where their errors are (exit status 3).
     Results {
         /// The kind's part of the manifest.
         details: toml::Table,

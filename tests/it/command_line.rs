@@ -45,8 +45,12 @@ fn a_dry_run_lists_every_run_and_the_plan_and_renders_nothing() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     let s = text(&o.stdout);
     // 2 schemes x 2 patterns x 2 ray counts, 2 seeds each.
-    assert!(s.contains("tiny: 16 runs in 8 configurations"), "{s}");
-    assert_eq!(s.lines().filter(|l| l.contains("seeds=[1, 2]")).count(), 8, "{s}");
+    assert!(
+        s.contains("tiny: 16 runs in 8 configurations, each over seeds [1, 2]"),
+        "{s}"
+    );
+    assert!(s.contains("8 units:"), "{s}");
+    assert_eq!(s.lines().filter(|l| l.starts_with("  scheme=")).count(), 8, "{s}");
     assert!(
         s.contains("scheme=paper pattern=shared samples=16 light_radius=0.02 lights=1"),
         "{s}"

@@ -107,7 +107,7 @@ fn the_deal_covers_every_group_once_is_deterministic_and_balanced() {
         assert!(load.iter().all(|&l| l > 0.0), "n={n}: an idle share: {load:?}");
     }
     // Shares follow the groups' keys, not their order in the file: the same experiment with its
-    // seeds listed in another order is dealt alike, group by group.
+    // ray counts listed in another order is dealt alike, group by group.
     let (a, b) = (
         common::tiny_experiment(&dir.path().join("a"), |t| {
             t.replace("samples = [4, 16]", "samples = [4, 16, 64]")

@@ -1,6 +1,7 @@
 //! Nothing lost: identical inputs give byte-identical runs.csv, an interrupted sweep resumes
 //! from its journal to the same bytes, `--fresh` redoes everything, and a failing run is
-//! recorded as failed while the sweep goes on.
+//! recorded as failed while the sweep goes on (and measured again on resume), and a
+//! configuration the device cannot time is left untimed while the others are timed.
 
 use crate::common;
 use penumbra::experiment::progress::Progress;
@@ -8,6 +9,7 @@ use penumbra::experiment::progress::Progress;
 use penumbra::experiment::sweep::record::Status;
 use penumbra::experiment::sweep::{run_sweep, Spec};
 use penumbra::render::cpu::CpuBackend;
+use penumbra::sampling::DiskScheme;
 use std::ffi::OsStr;
 use std::path::Path;
 
@@ -88,7 +90,64 @@ fn failed_runs_are_recorded_and_the_sweep_goes_on() {
         assert_eq!(r.error.contains("simulated device loss"), failed);
         assert_eq!(r.metrics.rmse.is_nan(), failed);
     }
-    // Groups with a failure are not journaled: a later sweep retries them.
-    let journaled = std::fs::read_to_string(dir.path().join("j/groups.csv")).unwrap_or_default();
-    assert!(journaled.lines().count() <= 1, "{journaled}");
+    // A unit with a failed run is measured again on resume: on a working device nothing fails.
+    let mut good = CpuBackend::default();
+    let again = run_sweep(&spec, &mut good, dir.path(), false, &Progress::default()).unwrap();
+    assert_eq!(again.failures, 0);
+    assert!(again.records.iter().all(|r| r.status == Status::Ok));
+    // Units measured whole are taken from the journal: the flaky device renders nothing again.
+    let resumed = run_sweep(&spec, &mut backend, dir.path(), false, &Progress::default()).unwrap();
+    assert_eq!(resumed.failures, 0, "a journaled unit was measured again");
+    let images = |o: &penumbra::experiment::sweep::Outcome| -> Vec<String> {
+        o.records.iter().map(|r| r.image_fnv1a.clone()).collect()
+    };
+    assert_eq!(images(&resumed), images(&again));
+}
+
+/// A device that cannot render the paper's scheme at all, neither measured nor timed.
+struct NoPaper(CpuBackend);
+
+impl penumbra::render::Backend for NoPaper {
+    fn adapter(&self) -> &penumbra::render::AdapterInfo {
+        self.0.adapter()
+    }
+    fn dispatches(&self) -> u64 {
+        self.0.dispatches()
+    }
+    fn render(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+    ) -> anyhow::Result<penumbra::render::Frame> {
+        anyhow::ensure!(s.scheme != DiskScheme::Paper, "paper too big for this device");
+        self.0.render(scene, view, s)
+    }
+    fn time(
+        &mut self,
+        scene: &penumbra::scene::Scene,
+        view: penumbra::render::View,
+        s: penumbra::render::Sampling,
+        warmup: u32,
+        repeats: u32,
+    ) -> anyhow::Result<penumbra::render::Timing> {
+        anyhow::ensure!(s.scheme != DiskScheme::Paper, "paper too big for this device");
+        self.0.time(scene, view, s, warmup, repeats)
+    }
+}
+
+#[test]
+fn a_configuration_that_cannot_be_timed_is_left_untimed_and_the_rest_are_timed() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 6"));
+    let spec = Spec::load(&exp).unwrap();
+    assert_eq!(spec.timing.repeats, 6, "the tiny experiment's timing was not edited");
+    let mut backend = NoPaper(CpuBackend::default());
+    let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
+    assert_eq!(out.failures, 8, "every paper run fails, every uniform run renders");
+    for r in &out.records {
+        let paper = r.run.scheme == DiskScheme::Paper;
+        assert_eq!(r.status == Status::Ok, !paper);
+        assert_eq!(r.time.frame_s.is_nan(), paper, "{:?}", r.run);
+    }
 }

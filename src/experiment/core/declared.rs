@@ -110,7 +110,10 @@ impl<D: Declaration> Declared<D> {
             manifest.seconds,
             dir.display()
         );
-        let journal = dir.join(".journal").display().to_string();
+        let journal = format!(
+            "their errors reach the `error` column of {} at --merge; rerunning this shard measures them again",
+            D::FAILURES
+        );
         Ok(Finished::Shard {
             failed: Some((measured.failed, journal)),
         })
@@ -193,7 +196,7 @@ impl<D: Declaration> Experiment for Declared<D> {
         // manifest says how many, so a rerun that measured nothing is not read as fresh timing.
         details.insert("units".into(), toml::Value::Integer(units as i64));
         details.insert("units_from_journal".into(), toml::Value::Integer(resumed as i64));
-        let table = run.home.join(D::FAILURES).display().to_string();
+        let table = format!("see the `error` column of {}", run.home.join(D::FAILURES).display());
         Ok(Finished::Results {
             details,
             failed: Some((failed, table)),

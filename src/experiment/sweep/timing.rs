@@ -93,7 +93,9 @@ pub fn noise_probe(groups: &[Group], samples: u32, radius: f64) -> Option<usize>
 }
 
 /// Times `groups` (each by its first run) and, if `noise` is given, the A/A control, in the
-/// schedule's interleaved rounds.
+/// schedule's interleaved rounds. A configuration whose frame fails to render is logged, left
+/// untimed (the report reads "n/a") and not visited again: its runs' rows say why it failed, and
+/// one configuration the device cannot render never keeps the others from being timed.
 pub fn time_groups(
     spec: &Spec,
     backend: &mut dyn Backend,
@@ -107,8 +109,13 @@ pub fn time_groups(
         entries.extend((0..NOISE_VISITS).map(|_| (groups.len(), g.head())));
     }
     let mut out = vec![ConfigTiming::empty(); groups.len() + 1];
+    let mut failed = vec![false; groups.len() + 1];
     t.run(entries.len(), |k| -> anyhow::Result<f64> {
         let (slot, run) = entries[k];
+        if failed[slot] {
+            on_frame();
+            return Ok(f64::NAN);
+        }
         let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
         let view = View {
             camera: &scene.cameras[&spec.measure.camera],
@@ -121,7 +128,16 @@ pub fn time_groups(
             seed: run.seed,
             frame: 0,
         };
-        let timing = backend.time(&scene, view, sampling, t.warmup, 1)?;
+        let timing = match backend.time(&scene, view, sampling, t.warmup, 1) {
+            Ok(timing) => timing,
+            Err(e) => {
+                tracing::error!("timing {} failed; left untimed: {e:#}", run.config());
+                failed[slot] = true;
+                out[slot] = ConfigTiming::empty();
+                on_frame();
+                return Ok(f64::NAN);
+            }
+        };
         let c = &mut out[slot];
         c.frame_seconds.extend(&timing.seconds);
         c.primary_seconds.extend(&timing.primary_seconds);
