@@ -80,7 +80,7 @@ fn identical_inputs_give_identical_runs_csv_and_resume_reproduces_it() {
 fn failed_runs_are_recorded_and_the_sweep_goes_on() {
     let dir = tempfile::tempdir().unwrap();
     let spec = Spec::load(&common::tiny_experiment(dir.path(), |t| t)).unwrap();
-    let mut backend = common::Flaky(CpuBackend::default());
+    let mut backend = common::Refusing::seed_2();
     let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     assert_eq!(out.records.len(), 16);
     assert_eq!(out.failures, 8);
@@ -104,45 +104,17 @@ fn failed_runs_are_recorded_and_the_sweep_goes_on() {
     assert_eq!(images(&resumed), images(&again));
 }
 
-/// A device that cannot render the paper's scheme at all, neither measured nor timed.
-struct NoPaper(CpuBackend);
-
-impl penumbra::render::Backend for NoPaper {
-    fn adapter(&self) -> &penumbra::render::AdapterInfo {
-        self.0.adapter()
-    }
-    fn dispatches(&self) -> u64 {
-        self.0.dispatches()
-    }
-    fn render(
-        &mut self,
-        scene: &penumbra::scene::Scene,
-        view: penumbra::render::View,
-        s: penumbra::render::Sampling,
-    ) -> anyhow::Result<penumbra::render::Frame> {
-        anyhow::ensure!(s.scheme != DiskScheme::Paper, "paper too big for this device");
-        self.0.render(scene, view, s)
-    }
-    fn time(
-        &mut self,
-        scene: &penumbra::scene::Scene,
-        view: penumbra::render::View,
-        s: penumbra::render::Sampling,
-        warmup: u32,
-        repeats: u32,
-    ) -> anyhow::Result<penumbra::render::Timing> {
-        anyhow::ensure!(s.scheme != DiskScheme::Paper, "paper too big for this device");
-        self.0.time(scene, view, s, warmup, repeats)
-    }
-}
-
 #[test]
 fn a_configuration_that_cannot_be_timed_is_left_untimed_and_the_rest_are_timed() {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::tiny_experiment(dir.path(), |t| t.replace("repeats = 0", "repeats = 6"));
     let spec = Spec::load(&exp).unwrap();
     assert_eq!(spec.timing.repeats, 6, "the tiny experiment's timing was not edited");
-    let mut backend = NoPaper(CpuBackend::default());
+    let mut backend = common::Refusing {
+        cpu: CpuBackend::default(),
+        refuses: |s| s.scheme == DiskScheme::Paper,
+        timing_too: true,
+    };
     let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     assert_eq!(out.failures, 8, "every paper run fails, every uniform run renders");
     for r in &out.records {

@@ -208,16 +208,34 @@ pub fn triangles_scene(triangles: &penumbra::mesh::Triangles, name: &'static str
     )
 }
 
-/// A CPU backend that fails every render with seed 2: the runner's failure path, in sweeps and
-/// through shards.
-pub struct Flaky(pub penumbra::render::cpu::CpuBackend);
+/// A CPU backend that refuses what `refuses` picks: the runner's failure paths. `timing_too`
+/// refuses timing the same frames (a device that cannot render a configuration at all).
+pub struct Refusing {
+    /// The working device underneath.
+    pub cpu: penumbra::render::cpu::CpuBackend,
+    /// Which frames fail.
+    pub refuses: fn(&penumbra::render::Sampling) -> bool,
+    /// Whether timing them fails too.
+    pub timing_too: bool,
+}
 
-impl penumbra::render::Backend for Flaky {
+impl Refusing {
+    /// Fails every render with seed 2 (timing, by the first seed, works): a flaky device.
+    pub fn seed_2() -> Refusing {
+        Refusing {
+            cpu: Default::default(),
+            refuses: |s| s.seed == 2,
+            timing_too: false,
+        }
+    }
+}
+
+impl penumbra::render::Backend for Refusing {
     fn adapter(&self) -> &penumbra::render::AdapterInfo {
-        self.0.adapter()
+        self.cpu.adapter()
     }
     fn dispatches(&self) -> u64 {
-        self.0.dispatches()
+        self.cpu.dispatches()
     }
     fn render(
         &mut self,
@@ -225,8 +243,8 @@ impl penumbra::render::Backend for Flaky {
         view: penumbra::render::View,
         s: penumbra::render::Sampling,
     ) -> anyhow::Result<penumbra::render::Frame> {
-        anyhow::ensure!(s.seed != 2, "simulated device loss");
-        self.0.render(scene, view, s)
+        anyhow::ensure!(!(self.refuses)(&s), "simulated device loss");
+        self.cpu.render(scene, view, s)
     }
     fn time(
         &mut self,
@@ -236,7 +254,8 @@ impl penumbra::render::Backend for Flaky {
         warmup: u32,
         repeats: u32,
     ) -> anyhow::Result<penumbra::render::Timing> {
-        self.0.time(scene, view, s, warmup, repeats)
+        anyhow::ensure!(!(self.timing_too && (self.refuses)(&s)), "simulated device loss");
+        self.cpu.time(scene, view, s, warmup, repeats)
     }
 }
 
