@@ -50,17 +50,13 @@ impl Motion {
     ) -> Result<(), ConfigError> {
         let m = self;
         let travel = m.step * frames as f64;
+        let too_far = |why: String| {
+            let moved = format!("over {frames} frames `{}` travels {:?} m", m.part, travel.to_array());
+            Err(source.error(&key_path!["motion", "step"], format!("{moved}{why}: shorten the step")))
+        };
         let far = travel.abs().max_element();
         if far.is_nan() || far > MAX_EXTENT {
-            return Err(source.error(
-                &key_path!["motion", "step"],
-                format!(
-                    "over {} frames `{}` would travel {:?} m, beyond the +-{MAX_EXTENT:e} m any coordinate may reach: shorten the step",
-                    frames,
-                    m.part,
-                    travel.to_array()
-                ),
-            ));
+            return too_far(format!(", beyond the +-{MAX_EXTENT:e} m any coordinate may reach"));
         }
         let bounded: Vec<_> = structures
             .iter()
@@ -83,16 +79,8 @@ impl Motion {
                     .map(|p| (*p + travel).distance(centre))
                     .fold(0.0, f64::max);
                 if out > radius {
-                    return Err(source.error(
-                        &key_path!["motion", "step"],
-                        format!(
-                            "over {} frames `{}` travels {:?} m and leaves the ball `{name}` is built in ({:.3} m from its centre, radius {:.3} m), where it cannot follow: shorten the step",
-                            frames,
-                            m.part,
-                            travel.to_array(),
-                            out,
-                            radius
-                        ),
+                    return too_far(format!(
+                        " and leaves the ball `{name}` is built in ({out:.3} m from its centre, radius {radius:.3} m), where it cannot follow"
                     ));
                 }
             }
