@@ -19,28 +19,34 @@
 //! units (consecutive frames of a camera path) takes its interval from the medians of blocks of
 //! frames longer than the series' correlation ([`series_median`]).
 //!
-//! **Words.** [`Comparison::of`] reads the 95 % interval of a time ratio A / B: *faster* when the
-//! whole interval lies below 1 - [`MARGIN`], *slower* when it lies above 1 + [`MARGIN`], *equal
-//! within noise* otherwise; a claim "A is faster than B" is answered *yes*, *no* or *not
-//! clearly* by the same interval. The margin keeps a word from turning on a few percent: a
-//! device whose frames fall in two modes (lavapipe's take 15 or 29 ms at random) puts all the
-//! ratios of a few rounds on one side of 1 now and then, but rarely all beyond 5 %. [`RULE`]
-//! says so in every report.
-//!
-//! Files: [`schedule`] (the visiting order), [`estimate`] (a median with its interval),
+//! **Words.** [`Comparison::of`] reads the 95 % interval of a ratio A / B (of times, or of
+//! errors) against an equivalence band of [`MARGIN`] = 5 % ([`band`]): *faster* (*better*)
+//! when the whole interval lies below the band, *slower* (*worse*) when above it, *equivalent*
+//! when it lies wholly inside it (two one-sided tests), *undecided* otherwise; a claim "A is
+//! faster than B" is answered *yes*, *no* or *undecided* by the same words. An interval wholly
+//! on one side of 1 that reaches into the band is undecided, never equal: a direction needs a
+//! difference the interval places beyond 5 %, which a device whose frames fall in two modes
+//! (lavapipe's take 15 or 29 ms at random) rarely fakes. [`RULE`] says so in every report.
+
+//! Files: [`schedule`] (the visiting order), [`sequential`] (blocked rounds that stop when
+//! every stated comparison is decided), [`curve`] (equal time from error-vs-time curves, with
+//! bootstrap intervals over seeds and rounds), [`estimate`] (a median with its interval),
 //! [`interval`] (order-statistic intervals, paired ratios), [`series`] (a correlated series'
 //! interval from block medians), [`rule`] (the words and how the numbers behind them print).
 
+pub mod curve;
 pub mod estimate;
 pub mod interval;
 pub mod rule;
 pub mod schedule;
+pub mod sequential;
 pub mod series;
 
 pub use estimate::{Estimate, EstimateColumns, FRAME_S};
 pub use interval::{coverage, interval_rank, median_interval, paired_ratio};
-pub use rule::{Comparison, MARGIN, MAX_DIGITS, NEAR_THRESHOLD, RULE};
+pub use rule::{band, Comparison, MARGIN, MAX_DIGITS, NEAR_THRESHOLD, RULE};
 pub use schedule::{Schedule, DEFAULT_SEED};
+pub use sequential::{decide, Decided, Looks, Pair, RoundDone, SequentialTimes};
 pub use series::{series_median, MIN_BLOCKS};
 
 /// Roughly normal draws (sum of four uniforms) of mean `mean` and relative spread `rel`.

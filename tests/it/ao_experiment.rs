@@ -189,14 +189,14 @@ fn the_verdict_reports_differing_images_and_speed_ups_from_the_rows() {
     rows[1].frame_seconds = vec![1.0, 1.1, 0.9, 1.0, 1.0];
     let v = verdict(&small, &rows);
     assert!(
-        v.contains("faster on 1 of 1 meshes, slower on 0, equal within noise on 0") && v.contains("cow 2.00 ["),
+        v.contains("faster on 1 of 1 meshes, slower on 0, equivalent on 0, undecided on 0") && v.contains("cow 2.00 ["),
         "{v}"
     );
     rows[1].frame_seconds = vec![1.9, 2.2, 1.8, 2.1, 2.0];
     let v = verdict(&small, &rows);
     assert!(
-        v.contains("faster on 0 of 1 meshes, slower on 0, equal within noise on 1")
-            && v.contains("(equal within noise)"),
+        v.contains("faster on 0 of 1 meshes, slower on 0, equivalent on 0, undecided on 1")
+            && v.contains("(undecided)"),
         "{v}"
     );
 }

@@ -205,3 +205,20 @@ fn a_file_without_kind_is_a_sweep() {
     assert_located(&e, "fps.toml", line, &format!("key `{key}`"));
     assert!(e.contains("a file without `kind` is read as kind = \"sweep\""), "{e}");
 }
+
+/// `[timed] samples` names swept counts only, each once, and at least one; the error points at
+/// the entry (line 24 of the tiny file holds the list).
+#[test]
+fn a_timing_grid_names_swept_counts() {
+    let with = |list: &'static str| move |t: String| format!("{t}\n[timed]\nsamples = {list}\n");
+    let e = rejects(with("[4, 8]"));
+    assert_located(&e, "tiny.toml", 24, "key `timed.samples[1]`");
+    assert!(e.contains("8 is not in sweep.samples [4, 16]"), "{e}");
+    let e = rejects(with("[16, 16]"));
+    assert!(
+        e.contains("key `timed.samples[1]`") && e.contains("listed twice"),
+        "{e}"
+    );
+    let e = rejects(with("[]"));
+    assert!(e.contains("key `timed.samples`") && e.contains("at least one"), "{e}");
+}

@@ -344,7 +344,7 @@ fn bad_input_is_located_and_writes_nothing() {
 }
 
 /// The verdict is computed from the rows: a structure whose frames differ fails exactness by
-/// name, and "is `vlf` faster" reads yes, no or not clearly from the interval of the median of
+/// name, and "is `vlf` faster" reads yes, no or undecided from the interval of the median of
 /// per-frame ratios.
 #[test]
 fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
@@ -392,11 +392,11 @@ fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
     );
     assert!(v.contains("faster on 36 of 36 frames"), "{v}");
     assert!(
-        v.contains("Is `vlf` faster than `bvh`, opengl shading?** **not clearly**"),
+        v.contains("Is `vlf` faster than `bvh`, opengl shading?** **undecided**"),
         "{v}"
     );
     assert!(v.contains("faster on 18 of 36 frames"), "{v}");
-    // Three frames, all 2x faster, give no interval: not clearly.
+    // Three frames, all 2x faster, give no interval: undecided.
     let few = FramesOutcome {
         frames: (0..3)
             .flat_map(|f| [row("kdtree", f, 2.0, 0), row("vlf", f, 1.0, 0)])
@@ -405,7 +405,7 @@ fn the_verdict_names_differing_structures_and_answers_from_the_ratios() {
     };
     let v = verdict(&spec, &few);
     assert!(
-        v.contains("(the paper's baseline), opengl shading?** **not clearly**"),
+        v.contains("(the paper's baseline), opengl shading?** **undecided**"),
         "{v}"
     );
     frames_all_slower(&spec);

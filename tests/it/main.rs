@@ -37,6 +37,7 @@ mod render_plan;
 mod reproduction;
 mod results_fresh;
 mod rim_samples;
+mod round_times;
 mod sampling_properties;
 mod shape_order;
 mod shards;

@@ -102,7 +102,7 @@ fn find_issued<'a>(rows: &'a [AoRow], mesh: &str, structure: &str, issue: Issue)
 /// per-round ratios with its interval), and the rule's word for `subject`.
 fn speedup(subject: &AoRow, other: &AoRow) -> (Estimate, Comparison) {
     if subject.frame_seconds.len() != other.frame_seconds.len() || subject.frame_seconds.is_empty() {
-        return (Estimate::NAN, Comparison::Equal);
+        return (Estimate::NAN, Comparison::Undecided);
     }
     let ratio = paired_ratio(&subject.frame_seconds, &other.frame_seconds);
     (ratio.recip(), Comparison::of(&ratio))
@@ -156,11 +156,12 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
             String::new()
         };
         out += &format!(
-            "- **`{subject}` vs `{other}`**{claim}: faster on {} of {} meshes, slower on {}, equal within noise on {}; speed-up (`{other}`'s time / `{subject}`'s, 95 % interval): {}; median over meshes {:.2}x.\n",
+            "- **`{subject}` vs `{other}`**{claim}: faster on {} of {} meshes, slower on {}, equivalent on {}, undecided on {}; speed-up (`{other}`'s time / `{subject}`'s, 95 % interval): {}; median over meshes {:.2}x.\n",
             count(Comparison::Faster),
             per_mesh.len(),
             count(Comparison::Slower),
-            count(Comparison::Equal),
+            count(Comparison::Equivalent),
+            count(Comparison::Undecided),
             listed.join(", "),
             median(&per_mesh.iter().map(|m| m.1.median).collect::<Vec<_>>()),
         );

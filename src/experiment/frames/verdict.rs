@@ -1,7 +1,7 @@
 //! The verdict of a frame-time experiment, computed from its rows: the paper's claim, whether
 //! every structure rendered the same frames, speed-ups as the median of per-frame ratios with a
 //! 95 % moving-block interval over frames (consecutive frames are correlated) and the one rule's
-//! yes / no / not clearly, the work behind each time, log-log scaling slopes, what updates cost,
+//! yes / no / undecided, the work behind each time, log-log scaling slopes, what updates cost,
 //! and the memory and build time paid.
 
 use super::runner::{FrameRow, FramesOutcome};
@@ -123,12 +123,12 @@ impl Speedup {
     }
 }
 
-/// A claim answered in each scene size and viewpoint apart: "**yes** in 8 and **not clearly** in
+/// A claim answered in each scene size and viewpoint apart: "**yes** in 8 and **undecided** in
 /// 2 of 10 sizes and viewpoints ...: 1K outside **no** 0.81x [0.75, 0.88] (2 of 12 frames
 /// faster); ...".
 fn by_cell(per: &[(Cell, Speedup)]) -> String {
     let count = |c: Comparison| per.iter().filter(|(_, s)| s.comparison() == c).count();
-    let mut tally: Vec<String> = [Comparison::Faster, Comparison::Slower, Comparison::Equal]
+    let mut tally: Vec<String> = Comparison::ALL
         .into_iter()
         .filter(|&c| count(c) > 0)
         .map(|c| format!("**{}** in {}", c.answer(), count(c)))

@@ -127,22 +127,40 @@ pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, refe
     }
 }
 
-/// The timing unit: every configuration of the sweep, and the A/A control, timed in the
-/// schedule's interleaved rounds (nothing when the experiment times nothing).
+/// The timing unit: every configuration of the sweep at a timed ray count (`[timed]`), and the
+/// A/A control, timed in the schedule's blocked sequential rounds (nothing when the experiment
+/// times nothing); configurations off the timing grid get no frames.
 pub fn time_all(spec: &Spec, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<TimingOutcome> {
     if spec.timing.repeats == 0 {
         return Ok(TimingOutcome::default());
     }
     let groups = expand(spec);
-    let probe = timing::noise_probe(&groups, spec.figure_samples(), spec.verdict_radius());
-    let visits = (groups.len() as u64 + probe.map_or(0, |_| timing::NOISE_VISITS as u64)) * spec.timing.repeats as u64;
-    let bar = progress.bar("timed frames", visits);
-    bar.message(format!("{} warm-up each, interleaved rounds", spec.timing.warmup));
-    let (configs, noise) = timing::time_groups(spec, backend, &groups, probe.map(|i| &groups[i]), &|| bar.inc(1))?;
+    let timed: Vec<usize> = (0..groups.len())
+        .filter(|&i| spec.timed_samples.contains(&groups[i].head().samples))
+        .collect();
+    let subset: Vec<Group> = timed.iter().map(|&i| groups[i].clone()).collect();
+    let probe = timing::noise_probe(&subset, spec.figure_samples(), spec.verdict_radius());
+    let bar = progress.bar("timing rounds (at most)", spec.timing.repeats as u64);
+    bar.message(format!(
+        "{} configurations, {} warm-up frame(s) before each timed one",
+        subset.len() + probe.map_or(0, |_| timing::NOISE_VISITS as usize),
+        spec.timing.warmup
+    ));
+    let (configs, noise) = timing::time_groups(spec, backend, &subset, probe, &|r| {
+        bar.message(format!(
+            "{} comparisons undecided, {} configurations still timed",
+            r.open, r.units
+        ));
+        bar.inc(1);
+    })?;
     bar.finish();
+    let mut all = vec![ConfigTiming::empty(); groups.len()];
+    for (&i, c) in timed.iter().zip(configs) {
+        all[i] = c;
+    }
     Ok(TimingOutcome {
-        configs,
-        noise: probe.zip(noise),
+        configs: all,
+        noise: probe.map(|p| timed[p]).zip(noise),
     })
 }
 
@@ -165,6 +183,7 @@ pub fn assemble(
         plan: spec.plan()?,
         timings: Timings {
             seed: spec.timing.seed,
+            looks: crate::timing::Looks::up_to(spec.timing.repeats),
             ..Timings::default()
         },
         pictures: None,
@@ -204,7 +223,9 @@ pub fn assemble(
     }
     if !timing.configs.is_empty() {
         for (g, t) in groups.iter().zip(timing.configs) {
-            out.timings.configs.insert(g.head().key(&context), t);
+            if !t.frame_seconds.is_empty() {
+                out.timings.configs.insert(g.head().key(&context), t);
+            }
         }
         out.timings.noise = timing.noise.map(|(i, t)| (groups[i].config(), t));
         fill_timing_columns(&mut out, &groups, &context);

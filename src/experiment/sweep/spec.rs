@@ -28,7 +28,19 @@ crate::experiment_file! {
         #[serde(default)]
         points: BTreeMap<String, points::Table>,
         verdict: Option<VerdictPair>,
+        timed: Option<Timed>,
     }
+}
+
+/// `[timed]`: which swept ray counts are timed (default: all). The equal-time curves
+/// interpolate between timed counts only, so leaving out the costliest count (half of all the
+/// frames at 128 rays of a 1-128 sweep) halves the timing and narrows only the budgets that
+/// would need it.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Timed {
+    /// Shadow-ray counts timed, each one of `sweep.samples`.
+    pub samples: Vec<u32>,
 }
 
 /// `[verdict]`: the two schemes the verdict compares (default: the paper's pattern against
@@ -121,6 +133,8 @@ pub struct Spec {
     pub figures: Option<Figures>,
     /// The verdict's (subject, baseline).
     pub verdict: (DiskScheme, DiskScheme),
+    /// The ray counts timed (`[timed]`; default every swept count).
+    pub timed_samples: Vec<u32>,
 }
 
 impl Spec {
@@ -371,7 +385,31 @@ impl Spec {
                 (v.subject, v.baseline)
             }
         };
+        let timed_samples = match &f.timed {
+            None => axes.samples.clone(),
+            Some(t) => {
+                if t.samples.is_empty() {
+                    return Err(err(
+                        &key_path!["timed", "samples"],
+                        "name at least one swept ray count to time (or leave [timed] out to time every count)".into(),
+                    ));
+                }
+                for (i, n) in t.samples.iter().enumerate() {
+                    if !axes.samples.contains(n) {
+                        return Err(err(
+                            &key_path!["timed", "samples", i],
+                            format!("{n} is not in sweep.samples {:?}", axes.samples),
+                        ));
+                    }
+                    if t.samples[..i].contains(n) {
+                        return Err(err(&key_path!["timed", "samples", i], format!("{n} is listed twice")));
+                    }
+                }
+                t.samples.clone()
+            }
+        };
         Ok(Spec {
+            timed_samples,
             verdict,
             name: header.name.clone(),
             path: path.to_path_buf(),

@@ -1,15 +1,20 @@
-//! Frame times you can rank by, timed the one way every kind times ([`crate::timing`]).
-//! Every configuration of a sweep (all axes but the seed) is timed with its first seed's sampling,
-//! once per interleaved round; each visit renders `warmup` untimed frames, then one timed frame
-//! over resources already resident on the device. An A/A control, one configuration visited a
-//! second time per round as if it were another, checks the rule on this machine: the two must
-//! read "equal within noise".
+//! Frame times you can rank by, timed the one way every kind times ([`crate::timing`]), and
+//! sequentially ([`crate::timing::sequential`]).
+//! Every configuration of a sweep (all axes but the seed) is timed with its first seed's
+//! sampling; each visit renders `warmup` untimed frames, then one timed frame over resources
+//! already resident on the device. The configurations a report compares share a block, visited
+//! back to back: those of one pattern, ray count, light radius and light count, so each scheme
+//! is timed beside uniform sampling and each structure beside the first. Rounds go on while a
+//! comparison (scheme / uniform, structure / the first, the A/A control) is undecided, up to
+//! the file's `repeats`. An A/A control, one configuration visited a second time per round as
+//! if it were another, checks the rule on this machine: the two must never read faster or
+//! slower.
 
 use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::Spec;
 use crate::render::{Backend, Sampling, View};
-use crate::timing::{median_interval, paired_ratio, Comparison, Estimate};
+use crate::timing::{decide, median_interval, Comparison, Decided, Estimate, Looks, Pair, RoundDone};
 use std::collections::BTreeMap;
 
 /// Extra visits of the A/A control per round.
@@ -58,14 +63,17 @@ impl ConfigTiming {
 }
 
 /// The time ratio `a / b` of two configurations timed in the same rounds (paired by round) with
-/// its interval, and the word the rule gives it; NaN and "equal" where either is untimed or
-/// they were not timed in the same rounds.
-pub fn compare(a: &ConfigTiming, b: &ConfigTiming) -> (Estimate, Comparison) {
-    if a.frame_seconds.is_empty() || a.frame_seconds.len() != b.frame_seconds.len() {
-        return (Estimate::NAN, Comparison::Equal);
+/// its interval, the word the stopping rule gave it and the rounds it took (replayed on the
+/// series, [`decide`]); NaN, "undecided" and no rounds where either is untimed.
+pub fn compare(a: &ConfigTiming, b: &ConfigTiming, looks: Looks) -> Decided {
+    if a.frame_seconds.is_empty() || b.frame_seconds.is_empty() {
+        return Decided {
+            ratio: Estimate::NAN,
+            word: Comparison::Undecided,
+            rounds: 0,
+        };
     }
-    let ratio = paired_ratio(&a.frame_seconds, &b.frame_seconds);
-    (ratio, Comparison::of(&ratio))
+    decide(&a.frame_seconds, &b.frame_seconds, looks)
 }
 
 /// The timing phase's result.
@@ -77,6 +85,8 @@ pub struct Timings {
     pub noise: Option<(Config, ConfigTiming)>,
     /// Seed of the visiting order and of every bootstrap interval.
     pub seed: u32,
+    /// When the rounds were looked at and the most of them.
+    pub looks: Looks,
 }
 
 /// The configuration timed twice as the A/A control: uniform sampling, per-pixel, at the figure
@@ -92,60 +102,117 @@ pub fn noise_probe(groups: &[Group], samples: u32, radius: f64) -> Option<usize>
     probe.or((!groups.is_empty()).then_some(0))
 }
 
+/// The blocks of units visited back to back (units: `groups`, then the A/A control's second
+/// visit of group `noise` if given) and the comparisons the report states: each scheme against
+/// uniform sampling, each structure against the first swept, the control against its group.
+pub fn blocks_and_pairs(groups: &[Group], noise: Option<usize>) -> (Vec<Vec<usize>>, Vec<Pair>) {
+    let configs: Vec<Config> = groups.iter().map(Group::config).collect();
+    let block_of = |c: &Config| (c.pattern, c.samples, c.light_radius.to_bits(), c.lights);
+    let mut keys = Vec::new();
+    let mut blocks: Vec<Vec<usize>> = Vec::new();
+    for (i, c) in configs.iter().enumerate() {
+        match keys.iter().position(|k| *k == block_of(c)) {
+            Some(b) => blocks[b].push(i),
+            None => {
+                keys.push(block_of(c));
+                blocks.push(vec![i]);
+            }
+        }
+    }
+    let first_structure = configs.first().map(|c| c.accelerator.clone());
+    let mut pairs = Vec::new();
+    for (a, c) in configs.iter().enumerate() {
+        let against = |other: &Config| configs.iter().position(|x| x == other);
+        if c.scheme != crate::sampling::DiskScheme::Uniform {
+            let uniform = Config {
+                scheme: crate::sampling::DiskScheme::Uniform,
+                ..c.clone()
+            };
+            pairs.extend(against(&uniform).map(|b| Pair { a, b }));
+        }
+        if let Some(first) = first_structure.as_ref().filter(|f| **f != c.accelerator) {
+            let base = Config {
+                accelerator: first.clone(),
+                ..c.clone()
+            };
+            pairs.extend(against(&base).map(|b| Pair { a, b }));
+        }
+    }
+    if let Some(g) = noise {
+        let twin = groups.len();
+        let b = blocks
+            .iter()
+            .position(|b| b.contains(&g))
+            .expect("every group in a block");
+        blocks[b].push(twin);
+        pairs.push(Pair { a: twin, b: g });
+    }
+    (blocks, pairs)
+}
+
 /// Times `groups` (each by its first run) and, if `noise` is given, the A/A control, in the
-/// schedule's interleaved rounds. A configuration whose frame fails to render is logged, left
-/// untimed (the report reads "n/a") and not visited again: its runs' rows say why it failed, and
-/// one configuration the device cannot render never keeps the others from being timed.
+/// schedule's blocked rounds until every comparison of [`blocks_and_pairs`] is decided or the
+/// file's `repeats` are run ([`crate::timing::Schedule::run_sequential`]). A configuration
+/// whose frame fails to render is logged, left untimed (the report reads "n/a") and not visited
+/// again: its runs' rows say why it failed, and one configuration the device cannot render
+/// never keeps the others from being timed.
 pub fn time_groups(
     spec: &Spec,
     backend: &mut dyn Backend,
     groups: &[Group],
-    noise: Option<&Group>,
-    on_frame: &dyn Fn(),
+    noise: Option<usize>,
+    on_round: &dyn Fn(RoundDone),
 ) -> anyhow::Result<(Vec<ConfigTiming>, Option<ConfigTiming>)> {
     let t = &spec.timing;
-    let mut entries: Vec<(usize, &Run)> = groups.iter().enumerate().map(|(i, g)| (i, g.head())).collect();
-    if let Some(g) = noise {
-        entries.extend((0..NOISE_VISITS).map(|_| (groups.len(), g.head())));
-    }
-    let mut out = vec![ConfigTiming::empty(); groups.len() + 1];
-    let mut failed = vec![false; groups.len() + 1];
-    t.run(entries.len(), |k| -> anyhow::Result<f64> {
-        let (slot, run) = entries[k];
-        if failed[slot] {
-            on_frame();
-            return Ok(f64::NAN);
-        }
-        let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
-        let view = View {
-            camera: &scene.cameras[&spec.measure.camera],
-            width: spec.measure.width,
-            height: spec.measure.height,
-        };
-        let sampling = Sampling {
-            scheme: run.scheme,
-            pattern: run.pattern,
-            seed: run.seed,
-            frame: 0,
-        };
-        let timing = match backend.time(&scene, view, sampling, t.warmup, 1) {
-            Ok(timing) => timing,
-            Err(e) => {
-                tracing::error!("timing {} failed; left untimed: {e:#}", run.config());
-                failed[slot] = true;
-                out[slot] = ConfigTiming::empty();
-                on_frame();
+    let (blocks, pairs) = blocks_and_pairs(groups, noise);
+    let mut entries: Vec<&Run> = groups.iter().map(Group::head).collect();
+    entries.extend(noise.map(|g| groups[g].head()));
+    let mut out = vec![ConfigTiming::empty(); entries.len()];
+    let mut failed = vec![false; entries.len()];
+    let times = t.run_sequential(
+        Looks::up_to(t.repeats),
+        &blocks,
+        &pairs,
+        |slot| -> anyhow::Result<f64> {
+            let run = entries[slot];
+            if failed[slot] {
                 return Ok(f64::NAN);
             }
-        };
-        let c = &mut out[slot];
-        c.frame_seconds.extend(&timing.seconds);
-        c.primary_seconds.extend(&timing.primary_seconds);
-        c.clock = timing.clock.name().to_string();
-        on_frame();
-        Ok(timing.seconds.first().copied().unwrap_or(f64::NAN))
-    })?;
-    let noise_timing = out.pop().filter(|_| noise.is_some());
+            let scene = spec.scene_with(run.lights, run.light_radius, run.samples, &run.accelerator);
+            let view = View {
+                camera: &scene.cameras[&spec.measure.camera],
+                width: spec.measure.width,
+                height: spec.measure.height,
+            };
+            let sampling = Sampling {
+                scheme: run.scheme,
+                pattern: run.pattern,
+                seed: run.seed,
+                frame: 0,
+            };
+            match backend.time(&scene, view, sampling, t.warmup, 1) {
+                Ok(timing) => {
+                    let c = &mut out[slot];
+                    c.primary_seconds.extend(&timing.primary_seconds);
+                    c.clock = timing.clock.name().to_string();
+                    Ok(timing.seconds.first().copied().unwrap_or(f64::NAN))
+                }
+                Err(e) => {
+                    tracing::error!("timing {} failed; left untimed: {e:#}", run.config());
+                    failed[slot] = true;
+                    Ok(f64::NAN)
+                }
+            }
+        },
+        on_round,
+    )?;
+    for ((c, seconds), failed) in out.iter_mut().zip(times.seconds).zip(failed) {
+        c.frame_seconds = if failed { vec![] } else { seconds };
+        if failed {
+            c.primary_seconds.clear();
+        }
+    }
+    let noise_timing = noise.and_then(|_| out.pop());
     Ok((out, noise_timing))
 }
 
@@ -161,15 +228,17 @@ mod tests {
     fn comparisons_pair_by_round_and_follow_the_rule() {
         let a = timing(&[10.0, 11.0, 12.0, 13.0, 14.0]);
         let b = timing(&[15.0, 16.0, 17.0, 18.0, 19.0]);
-        assert_eq!(compare(&a, &b).1, Comparison::Faster);
-        assert_eq!(compare(&b, &a).1, Comparison::Slower);
+        let looks = Looks::up_to(6);
+        assert_eq!(compare(&a, &b, looks).word, Comparison::Faster);
+        assert_eq!(compare(&b, &a, looks).word, Comparison::Slower);
         let drifting = timing(&[10.0, 20.0, 12.0, 13.0, 14.0]);
         let same = timing(&[10.5, 19.0, 12.5, 12.5, 14.5]);
-        assert_eq!(compare(&drifting, &same).1, Comparison::Equal);
-        assert_eq!(compare(&a, &timing(&[])).1, Comparison::Equal);
+        assert_eq!(compare(&drifting, &same, looks).word, Comparison::Undecided);
+        assert_eq!(compare(&a, &timing(&[]), looks).word, Comparison::Undecided);
+        let r = compare(&a, &timing(&[20.0, 22.0]), looks).ratio;
         assert!(
-            compare(&a, &timing(&[1.0, 2.0])).0.median.is_nan(),
-            "not timed in the same rounds"
+            (r.median - 0.5).abs() < 1e-12,
+            "paired over the rounds both were timed in: {r:?}"
         );
         let f = a.frame();
         assert!((f.median - 0.012).abs() < 1e-12 && f.lo <= f.median && f.hi >= f.median);

@@ -10,7 +10,8 @@ use crate::experiment::sweep::Spec;
 use crate::output::numbers::or_na;
 use crate::render::AdapterInfo;
 use crate::sampling::{DiskScheme, Pattern};
-use crate::timing::{Comparison, RULE};
+use crate::timing::Decided;
+use crate::timing::{Comparison, Looks, RULE};
 
 fn opt(x: Option<f64>, f: impl Fn(f64) -> String) -> String {
     or_na(x.unwrap_or(f64::NAN), f)
@@ -103,11 +104,12 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
         }
     }
     if !outcome.timings.configs.is_empty() {
-        s += &timing_section(outcome);
+        s += &timing_section(outcome, spec.timing.warmup);
     }
     for slice in slices(summaries.iter().map(|x| &x.config), &COST_NAMES) {
         s += &super::schemes::scheme_section(summaries, &slice, n, radius, spec.verdict.0);
-        s += &cost_section(summaries, &slice, n, radius);
+        s += &super::equal_time::section(outcome, summaries, &slice, n, radius);
+        s += &cost_section(summaries, &slice, n, radius, outcome.timings.looks);
     }
     s += &super::structures::structure_section(spec, outcome, summaries);
     s += "\n## Outputs\n\n- `runs.csv`: one row per run, with the error's radial power spectrum (`error_power_NN`: rings of 1/32 cycles per pixel); `summary.csv`: means and 95 % CIs over seeds, with the per-pixel bias/variance split.\n";
@@ -118,19 +120,24 @@ pub fn report(spec: &Spec, outcome: &Outcome, summaries: &[Summary], adapter: &A
 
 /// How times were taken, the rule that turns them into words, and the A/A control that checks
 /// the rule on this machine: stated once per report.
-fn timing_section(outcome: &Outcome) -> String {
+fn timing_section(outcome: &Outcome, warmup: u32) -> String {
     let t = &outcome.timings;
     let some = t.configs.values().next();
     let mut s = format!(
         "
 ## Timing
 
-Every configuration timed with its first seed, once per round, in {} interleaved rounds (order seed {}, warm-up frames before each timed frame; clock: {}). {RULE}
+Every configuration on the timing grid timed with its first seed, once per round, sequentially: the configurations a comparison holds (each scheme and uniform sampling, each structure and the first, at one pattern, ray count, light radius and light count) are visited back to back in seeded ABBA order, and after {first} rounds and every {every} after, up to {cap}, every open comparison is read by the rule; a decided one stops, and a configuration stops being timed when all of its have ({min}-{max} rounds here; `timings.csv` holds every round, and replaying these looks on it gives every word below). Order seed {seed}; {warmup} warm-up frame(s) before each timed frame; clock: {clock}. {RULE}
 
 ",
-        some.map_or(0, |c| c.frame_seconds.len()),
-        t.seed,
-        some.map_or("n/a", |c| c.clock.as_str()),
+        first = t.looks.first_look,
+        every = t.looks.every,
+        cap = t.looks.cap,
+        min = t.configs.values().map(|c| c.frame_seconds.len()).min().unwrap_or(0),
+        max = t.configs.values().map(|c| c.frame_seconds.len()).max().unwrap_or(0),
+        seed = t.seed,
+        warmup = warmup,
+        clock = some.map_or("n/a", |c| c.clock.as_str()),
     );
     if let Some((config, twin)) = &t.noise {
         if let Some(first) = outcome
@@ -139,9 +146,9 @@ Every configuration timed with its first seed, once per round, in {} interleaved
             .find(|g| g.config == *config)
             .and_then(|g| t.configs.get(&g.key))
         {
-            let (ratio, word) = compare(twin, first);
+            let Decided { ratio, word, rounds } = compare(twin, first, t.looks);
             s += &format!(
-                "A/A control: one configuration ({} {}, {} rays, light radius {} m) visited twice per round as if it were two; the time ratio of its two series is {}: **{}**{}
+                "A/A control: one configuration ({} {}, {} rays, light radius {} m) visited twice per round, as if it were two, while its comparison was open; the time ratio of its two series is {}: **{}** after {rounds} rounds{}
 
 ",
                 config.scheme,
@@ -150,10 +157,10 @@ Every configuration timed with its first seed, once per round, in {} interleaved
                 config.light_radius,
                 ratio.show_ratio(3),
                 word.word(),
-                if word == Comparison::Equal {
-                    ", as it must be."
-                } else {
-                    ". The rule called an unchanged workload different on this machine: read every time comparison below with that in mind."
+                match word {
+                    Comparison::Equivalent => ", as it must be.",
+                    Comparison::Undecided => ": the rounds could not show an unchanged workload equivalent on this machine (no direction either).",
+                    _ => ". The rule called an unchanged workload different on this machine: read every time comparison below with that in mind.",
                 }
             );
         }
@@ -163,11 +170,16 @@ Every configuration timed with its first seed, once per round, in {} interleaved
 
 /// How a configuration's frame time compares with uniform sampling's (time ratio with its
 /// interval and the rule's word).
-fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>) -> String {
+fn time_rank(x: Option<&ConfigTiming>, uniform: Option<&ConfigTiming>, looks: Looks) -> String {
     match (x, uniform) {
         (Some(a), Some(b)) => {
-            let (ratio, word) = compare(a, b);
-            format!("{}x uniform's time: {}", ratio.show_ratio(2), word.word())
+            let d = compare(a, b, looks);
+            format!(
+                "{}x uniform's time: {} ({} rounds)",
+                d.ratio.show_ratio(2),
+                d.word.word(),
+                d.rounds
+            )
         }
         _ => "untimed".into(),
     }
@@ -205,19 +217,18 @@ fn verdicts(summaries: &[Summary], n: u32, radius: f64, pair: (DiskScheme, DiskS
 /// The axes a cost section names; it is written once per value of the others.
 const COST_NAMES: [Axis; 4] = [Axis::Scheme, Axis::Pattern, Axis::Samples, Axis::LightRadius];
 
-/// What accuracy costs: error, frame time and work per scheme at the verdict's count, and for
-/// each scheme the fewest rays (and time) that reach uniform sampling's RMSE at that count,
-/// compared with uniform's time by the rule.
-fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> String {
+/// What accuracy costs: error, frame time and work per scheme at the verdict's count, and each
+/// scheme's frame time against uniform's at that count by the rule (with the rounds it took).
+fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64, looks: Looks) -> String {
     let lights = slice.config.lights;
     let more = match slice.label(&[Axis::Lights]) {
         l if l.is_empty() => l,
         l => format!(", {l}"),
     };
     let mut s = format!(
-        "\n## What accuracy costs ({lights} light(s){more})\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [95 % interval] of the timed frames; rays, nodes visited and primitive tests of one frame (deterministic; nodes and tests where the backend counts them). `to match uniform@{n}`: the fewest swept rays at which the scheme's mean RMSE is at or below uniform's at {n} rays, that configuration's frame time, and its time against uniform@{n}'s by the rule above.\n\n"
+        "\n## What accuracy costs ({lights} light(s){more})\n\nPer-pixel pattern, light radius {radius} m. RMSE against the ground truth over its penumbra (mean over seeds); FLIP of the Fig. 2 picture where rendered; `lost`: share of the true penumbra shown fully lit or fully dark; frame time: median [95 % interval] of the timed frames; rays, nodes visited and primitive tests of one frame (deterministic; nodes and tests where the backend counts them). `vs uniform@{n}`: the frame time against uniform's at the same count by the rule (see Timing; timed beside it, with the rounds it took). The time each scheme needs to reach uniform@{n}'s RMSE is read off its curve above.\n\n"
     );
-    s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays @{n} | nodes @{n} | tests @{n} | to match uniform@{n} |\n|---|---|---|---|---|---|---|---|---|\n");
+    s += &format!("| scheme | RMSE @{n} | FLIP @{n} | lost @{n} | frame time @{n} | rays @{n} | nodes @{n} | tests @{n} | vs uniform@{n} |\n|---|---|---|---|---|---|---|---|---|\n");
     let base = Config {
         pattern: Pattern::PerPixel,
         samples: n,
@@ -235,20 +246,9 @@ fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64) -> St
         let Some(at) = find(summaries, &Config { scheme, ..base.clone() }) else {
             continue;
         };
-        let mut rows: Vec<&Summary> = summaries
-            .iter()
-            .filter(|x| x.config.agrees_except(&at.config, &[Axis::Samples]))
-            .collect();
-        rows.sort_by_key(|x| x.config.samples);
-        let matched = match uniform.filter(|u| u.metrics.rmse.mean.is_finite()) {
+        let matched = match uniform {
             None => "n/a".to_string(),
-            Some(u) => rows.iter().find(|x| x.metrics.rmse.mean <= u.metrics.rmse.mean).map_or(
-                "not reached".to_string(),
-                |x| {
-                    let rank = time_rank(x.timing.as_ref(), u.timing.as_ref());
-                    format!("{} rays, {}, {rank}", x.config.samples, x.frame.show_ms())
-                },
-            ),
+            Some(u) => time_rank(at.timing.as_ref(), u.timing.as_ref(), looks),
         };
         let count = |v: Option<u64>| v.map_or("n/a".to_string(), |v| format!("{v:.3e}", v = v as f64));
         s += &format!(
@@ -275,18 +275,24 @@ mod tests {
         ConfigTiming::wall_clock_ms(ms)
     }
 
+    const L: Looks = Looks {
+        first_look: 6,
+        every: 3,
+        cap: 6,
+    };
+
     #[test]
     fn times_are_compared_by_the_rule() {
         let a = timing(&[99.0, 99.5, 100.0, 100.5, 101.0]);
         let b = timing(&[113.0, 113.5, 114.0, 114.5, 115.0]);
         let noisy = timing(&[80.0, 120.0, 100.0, 90.0, 110.0]);
         assert!(
-            time_rank(Some(&a), Some(&b)).ends_with(": faster"),
+            time_rank(Some(&a), Some(&b), L).ends_with(": faster (5 rounds)"),
             "{}",
-            time_rank(Some(&a), Some(&b))
+            time_rank(Some(&a), Some(&b), L)
         );
-        assert!(time_rank(Some(&b), Some(&a)).ends_with(": slower"));
-        assert!(time_rank(Some(&a), Some(&noisy)).ends_with(": equal within noise"));
-        assert_eq!(time_rank(None, Some(&b)), "untimed");
+        assert!(time_rank(Some(&b), Some(&a), L).ends_with(": slower (5 rounds)"));
+        assert!(time_rank(Some(&a), Some(&noisy), L).ends_with(": undecided (5 rounds)"));
+        assert_eq!(time_rank(None, Some(&b), L), "untimed");
     }
 }

@@ -2,6 +2,7 @@
 //! swaps the set in): CSV tables, plots, images, the markdown report with its verdict, the
 //! comparison page (index.html), and the regression thresholds checked against them.
 
+pub mod equal_time;
 pub mod images;
 pub mod markdown;
 pub mod plots;

@@ -1,5 +1,4 @@
-//! Which scheme to use at few rays: every swept scheme ranked, at the figure ray count and at
-//! equal time, by the error a viewer sees (FLIP), the error a simple denoiser leaves (blurred
+//! Which scheme to use at few rays: every swept scheme ranked at the figure ray count by the error a viewer sees (FLIP), the error a simple denoiser leaves (blurred
 //! RMSE), where the error sits in frequency (low-frequency share) and plain RMSE, with each
 //! scheme's penumbra width against the exact one.
 //!
@@ -8,12 +7,10 @@
 //! intervals overlap its are named with it.
 
 use super::summary::{find, swept_schemes, Summary};
-use crate::experiment::sweep::axes::{Axis, Config, Slice};
-use crate::experiment::sweep::timing::compare;
+use crate::experiment::sweep::axes::{Config, Slice};
 use crate::metrics::stats::MeanCi;
-use crate::output::numbers::{or_na, with_ci};
+use crate::output::numbers::with_ci;
 use crate::sampling::{DiskScheme, Pattern};
-use crate::timing::Comparison;
 
 /// A metric the schemes are ranked by (lower is better).
 struct Metric {
@@ -146,31 +143,7 @@ fn config(slice: &Slice, scheme: DiskScheme, samples: u32, radius: f64) -> Confi
     }
 }
 
-/// The most rays at which `scheme` does not take clearly longer than `budget` (uniform sampling
-/// at the figure count) by the timing rule, with that configuration.
-fn within_time<'a>(
-    summaries: &'a [Summary],
-    slice: &Slice,
-    scheme: DiskScheme,
-    radius: f64,
-    budget: &Summary,
-) -> Option<&'a Summary> {
-    let budget_timing = budget.timing.as_ref()?;
-    summaries
-        .iter()
-        .filter(|x| {
-            x.config
-                .agrees_except(&config(slice, scheme, 1, radius), &[Axis::Samples])
-        })
-        .filter(|x| {
-            x.timing
-                .as_ref()
-                .is_some_and(|t| compare(t, budget_timing).1 != Comparison::Slower)
-        })
-        .max_by_key(|x| x.config.samples)
-}
-
-/// The section: at `n` rays, then at uniform@n's frame time.
+/// The section: every scheme at `n` rays (equal time is [`super::equal_time`]'s).
 pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64, subject: DiskScheme) -> String {
     let at_n: Vec<(DiskScheme, &Summary)> = swept_schemes(summaries)
         .iter()
@@ -211,39 +184,6 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
             with_ci(m.rmse_blurred.mean, m.rmse_blurred.ci95, four),
             with_ci(m.lowfreq_share.mean, m.lowfreq_share.ci95, |v| format!("{v:.3}")),
             x.frame.show_ms(),
-        );
-    }
-    let Some(budget) = find(summaries, &config(slice, DiskScheme::Uniform, n, radius)) else {
-        return s;
-    };
-    let equal: Vec<(DiskScheme, &Summary)> = swept_schemes(summaries)
-        .iter()
-        .filter_map(|&sc| within_time(summaries, slice, sc, radius, budget).map(|x| (sc, x)))
-        .collect();
-    if equal.len() < 2 {
-        return s;
-    }
-    s += &format!(
-        "\n### At equal time\n\nEach scheme at the most swept rays whose frame time is not clearly longer than uniform@{n}'s ({}) by the timing rule; FLIP only where that is {n} rays (the pictures are rendered there).\n\n",
-        budget.frame.show_ms()
-    );
-    s += &rank_sentences(&equal, subject);
-    s += "\n| scheme | rays | time vs uniform | RMSE | blurred RMSE | low-freq share |\n|---|---|---|---|---|---|\n";
-    for (scheme, x) in &equal {
-        let ratio = match (&x.timing, &budget.timing) {
-            (Some(a), Some(b)) => {
-                let (r, word) = compare(a, b);
-                format!("{}x: {}", r.show_ratio(2), word.word())
-            }
-            _ => "untimed".into(),
-        };
-        let m = &x.metrics;
-        s += &format!(
-            "| {scheme} | {} | {ratio} | {} | {} | {} |\n",
-            x.config.samples,
-            or_na(m.rmse.mean, |v| format!("{v:.4}")),
-            or_na(m.rmse_blurred.mean, |v| format!("{v:.4}")),
-            or_na(m.lowfreq_share.mean, |v| format!("{v:.3}")),
         );
     }
     s

@@ -53,8 +53,8 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
         compared += both;
         let (ratio, word) = match (&other.timing, &first.timing) {
             (Some(a), Some(b)) => {
-                let (r, w) = compare(a, b);
-                (r, w.word())
+                let d = compare(a, b, outcome.timings.looks);
+                (d.ratio, d.word.word())
             }
             _ => (crate::timing::Estimate::NAN, "untimed"),
         };
