@@ -5,8 +5,10 @@
 //! log-log between measured counts (error ~ rays^-b is close to straight there); time by the
 //! least-squares fit of a fixed cost plus a cost per ray, `t = a + c rays`, to the measured
 //! medians (relative residuals minimised; the largest is reported as the fit's check), which is
-//! increasing wherever `c > 0`, so a budget maps to one ray count and a 5 % change in a measured
-//! time moves an answer by a few per cent, never by a jump to another count. Two questions are
+//! increasing wherever `c > 0`, so a budget maps to one ray count and a small change in a
+//! measured time moves an answer continuously, never by a jump to another count (how far: rays
+//! in a budget are (t - a) / c, so a 5 % change in time moves them by 5 % / (1 - a / t), much more
+//! where the fixed cost dominates the budget, as at a few rays on lavapipe). Two questions are
 //! answered: the error each scheme reaches in a given time (the budget), and the time each needs
 //! to reach a given error. Nothing is extrapolated: a budget outside a scheme's timed range, or
 //! an error outside its measured range, has no answer.
@@ -229,7 +231,7 @@ impl Draw {
                 Some((stream, base)) => median(
                     &(0..n as u32)
                         .map(|i| {
-                            let u = stream.unit(base + 64 * k as u32 + i);
+                            let u = stream.unit(base + stride(n) * k as u32 + i);
                             seconds[((u * n as f64) as usize).min(n - 1)]
                         })
                         .collect::<Vec<_>>(),
@@ -243,10 +245,22 @@ impl Draw {
             .map(|(k, p)| (p.rays, time(k, &p.seconds)))
             .collect();
         Drawn {
-            errors: points.iter().map(|p| (p.rays, mean(&p.errors))).collect(),
+            // A count whose every seed failed has no error and is left out of the curve, so
+            // both directions (error at rays, rays at error) see the same gap.
+            errors: points
+                .iter()
+                .map(|p| (p.rays, mean(&p.errors)))
+                .filter(|p| p.1.is_finite())
+                .collect(),
             time: TimeModel::fit(&timed),
         }
     }
+}
+
+/// Spacing of the uniforms one replicate draws per seed list or per count: 64, or more where a
+/// list is longer, so that no two draws share a uniform.
+fn stride(n: usize) -> u32 {
+    n.max(64) as u32
 }
 
 /// Least share of replicates that must answer for an interval to be given.
@@ -283,7 +297,7 @@ pub fn bootstrap(
     let mut values = Vec::with_capacity(replicates as usize);
     for r in 0..replicates {
         let seeds_drawn: Vec<usize> = (0..seeds)
-            .map(|i| ((stream.unit(r * 64 + i as u32) * seeds as f64) as usize).min(seeds - 1))
+            .map(|i| ((stream.unit(r * stride(seeds) + i as u32) * seeds as f64) as usize).min(seeds - 1))
             .collect();
         // Seeds pair across curves; each curve's counts draw their rounds from its own stream.
         let drawn: Vec<Drawn> = (0..curves.len())

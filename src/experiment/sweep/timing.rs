@@ -1,7 +1,7 @@
 //! Frame times you can rank by, timed the one way every kind times ([`crate::timing`]), and
 //! sequentially ([`crate::timing::sequential`]).
-//! Every configuration of a sweep (all axes but the seed) is timed with its first seed's
-//! sampling; each visit renders `warmup` untimed frames, then one timed frame over resources
+//! Every configuration of a sweep (all axes but the seed) at a timed ray count (`[timed]`) is
+//! timed with its first seed's sampling; each visit renders `warmup` untimed frames, then one timed frame over resources
 //! already resident on the device. The configurations a report compares share a block, visited
 //! back to back: those of one pattern, ray count, light radius and light count, so each scheme
 //! is timed beside uniform sampling and each structure beside the first. Rounds go on while a
@@ -191,11 +191,16 @@ pub fn time_groups(
                 frame: 0,
             };
             match backend.time(&scene, view, sampling, t.warmup, 1) {
-                Ok(timing) => {
+                Ok(timing) if timing.seconds.first().is_some_and(|s| s.is_finite()) => {
                     let c = &mut out[slot];
                     c.primary_seconds.extend(&timing.primary_seconds);
                     c.clock = timing.clock.name().to_string();
-                    Ok(timing.seconds.first().copied().unwrap_or(f64::NAN))
+                    Ok(timing.seconds[0])
+                }
+                Ok(_) => {
+                    tracing::error!("timing {} gave no finite time; left untimed", run.config());
+                    failed[slot] = true;
+                    Ok(f64::NAN)
                 }
                 Err(e) => {
                     tracing::error!("timing {} failed; left untimed: {e:#}", run.config());

@@ -1,8 +1,9 @@
 //! What each scheme achieves at equal time and what it costs at equal error, read from its
-//! error-vs-time curve ([`crate::timing::curve`]): error per seed and time per round at every
-//! swept count, interpolated in log-log, with intervals from resampling seeds and rounds
-//! together. A scheme a few per cent slower per frame reaches a few per cent fewer rays in the
-//! budget, not half as many: the answer follows the schemes, not a snap to the next count.
+//! error-vs-time curve ([`crate::timing::curve`]): error per seed at every swept count,
+//! interpolated in log-log, and time per round at every timed count, fitted as a fixed cost plus
+//! a cost per ray, with intervals from resampling seeds and rounds together. A scheme a little
+//! slower per ray reaches a little fewer rays in the budget (how many fewer grows with the fixed
+//! cost's share of it), never the next swept count down: the answer follows the schemes.
 
 use super::summary::{swept_schemes, Summary};
 use crate::experiment::sweep::axes::{Axis, Config, Slice};
