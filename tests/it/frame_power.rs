@@ -33,9 +33,13 @@ const AA_EQUAL: f64 = 0.95;
 /// that changes it fails here until someone looks again; a listed cell that reaches [`POWER`],
 /// and any unlisted cell below it, fail too.
 ///
-/// None in the committed frames: the one cell an earlier regeneration left short (scaling, 4K
-/// inside, against the median kd-tree, 85.9 %) reaches it with these.
-const SHORTFALLS: &[(&str, f64)] = &[];
+/// Three in the committed frames: inside the scene at 4K against obvhs' BVH2 and CWBVH and at
+/// 16K against the SAH kd-tree, where the per-frame speed-ups spread widely (MAD 0.12-0.23).
+const SHORTFALLS: &[(&str, f64)] = &[
+    ("scaling opengl 4000 inside bvh", 0.865),
+    ("scaling opengl 4000 inside cwbvh", 0.730),
+    ("scaling opengl 16000 inside kdtree-sah", 0.885),
+];
 
 /// Per (shading, triangles, viewpoint), per structure, frame -> seconds.
 type Frames = BTreeMap<(String, usize, String), BTreeMap<String, BTreeMap<u32, f64>>>;
