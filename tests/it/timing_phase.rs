@@ -25,6 +25,16 @@ struct Drifting {
     paper_cost: f64,
 }
 
+impl Drifting {
+    fn new(paper_cost: f64) -> Drifting {
+        Drifting {
+            cpu: CpuBackend::default(),
+            calls: vec![],
+            paper_cost,
+        }
+    }
+}
+
 impl Backend for Drifting {
     fn adapter(&self) -> &AdapterInfo {
         self.cpu.adapter()
@@ -62,11 +72,7 @@ fn configurations_are_timed_once_in_interleaved_rounds() {
         t.replace("warmup = 0\nrepeats = 0", "warmup = 2\nrepeats = 6")
     });
     let spec = Spec::load(&exp).unwrap();
-    let mut backend = Drifting {
-        cpu: CpuBackend::default(),
-        calls: vec![],
-        paper_cost: 1.0,
-    };
+    let mut backend = Drifting::new(1.0);
     let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     // 2 schemes x 2 patterns x 2 ray counts = 8 configurations (each with 2 seeds), 6 rounds,
     // plus the A/A control's visits.
@@ -153,11 +159,7 @@ fn rounds_stop_when_every_comparison_is_decided() {
         t.replace("warmup = 0\nrepeats = 0", "warmup = 0\nrepeats = 12")
     });
     let spec = Spec::load(&exp).unwrap();
-    let mut backend = Drifting {
-        cpu: CpuBackend::default(),
-        calls: vec![],
-        paper_cost: 2.0,
-    };
+    let mut backend = Drifting::new(2.0);
     let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     assert_eq!(backend.calls.len(), 6 * (8 + NOISE_VISITS as usize));
     let looks = out.timings.looks;
@@ -214,11 +216,7 @@ fn frame_rates_are_timed_in_interleaved_rounds() {
     let path = dir.path().join("fps.toml");
     std::fs::write(&path, text).unwrap();
     let spec = FpsSpec::load(&path).unwrap();
-    let mut backend = Drifting {
-        cpu: CpuBackend::default(),
-        calls: vec![],
-        paper_cost: 1.0,
-    };
+    let mut backend = Drifting::new(1.0);
     let rows = run_fps(&spec, &mut backend, &Progress::default()).unwrap();
     assert_eq!(rows.len(), 4, "two scenes, one and two lights, one resolution");
     assert_eq!(
@@ -261,11 +259,7 @@ fn only_the_timing_grid_is_timed() {
         )
     });
     let spec = Spec::load(&exp).unwrap();
-    let mut backend = Drifting {
-        cpu: CpuBackend::default(),
-        calls: vec![],
-        paper_cost: 1.0,
-    };
+    let mut backend = Drifting::new(1.0);
     let out = run_sweep(&spec, &mut backend, dir.path(), true, &Progress::default()).unwrap();
     assert!(backend.calls.iter().all(|c| c.1 == 16), "only 16 rays timed");
     assert_eq!(backend.calls.len(), 6 * (4 + NOISE_VISITS as usize));

@@ -123,9 +123,10 @@ pub fn section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, 
             _ => "none".into(),
         }
     );
+    let uniform_measured = as_measured(&u_rmse);
     for &b in &budgets {
         let budget_of = |d: &Drawn| d.time_at_rays(b as f64);
-        let budget = as_measured(&u_rmse).time_at_rays(b as f64).unwrap_or(f64::NAN);
+        let budget = uniform_measured.time_at_rays(b as f64).unwrap_or(f64::NAN);
         let _ = write!(
             s,
             "\n**Budget: uniform@{b}'s frame time ({:.3} ms).**\n\n| scheme | rays in the budget | RMSE | RMSE / uniform's | blurred RMSE / uniform's |\n|---|---|---|---|---|\n",
@@ -160,8 +161,8 @@ pub fn section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, 
         s,
         "\n**Time to reach uniform@{n}'s RMSE** (the equal-quality question): rays each scheme needs for it on its curve, and that time against uniform@{n}'s.\n\n| scheme | rays needed | time / uniform@{n}'s |\n|---|---|---|\n"
     );
+    let target = uniform_measured.error_at_rays(n as f64);
     for (scheme, c) in &rmse {
-        let target = as_measured(&u_rmse).error_at_rays(n as f64);
         let rays = target.and_then(|e| as_measured(c).rays_at_error(e));
         let ratio = bootstrap(&[c, &u_rmse], REPLICATES, seed, |d| {
             let target = d[1].error_at_rays(n as f64)?;
