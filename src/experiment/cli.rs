@@ -60,6 +60,12 @@ pub struct Cli {
     /// again: times and pictures were taken inside the shards' units.
     #[arg(long, value_name = "N|SHARD_DIR", num_args = 1..)]
     pub merge: Vec<PathBuf>,
+    /// Build each structure an ao or frames experiment tunes at the setting an earlier run kept
+    /// (its results folder's tuning.csv) instead of timing the candidates again, so that shards,
+    /// reruns and other hosts count the same work; give it to every shard and to the merge.
+    /// Structures the file keeps nothing for are tuned as usual.
+    #[arg(long, value_name = "TUNING_CSV")]
+    pub tuning: Option<PathBuf>,
     /// Subset filters; the help text names the axes from the axis list.
     #[arg(long, value_name = "AXIS=VALUE", help = FILTER_HELP)]
     pub filter: Vec<Filter>,
@@ -82,6 +88,7 @@ impl Cli {
             dry_run: false,
             shard: None,
             merge: Vec::new(),
+            tuning: None,
             filter: Vec::new(),
             verbose: 0,
             quiet: 0,

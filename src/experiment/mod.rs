@@ -4,7 +4,7 @@
 //! truth), [`fps`] (the paper's frame rates), [`ao`] (the visibility-field paper's
 //! ambient-occlusion table), [`frames`] (its frame-time figures: scaling, walkthrough, dynamic
 //! scenes) and [`realtime`] (few-ray pipelines accumulated and filtered). No kind imports
-//! another: what two kinds share sits below them ([`shadow`], [`core`]).
+//! another: what two kinds share sits below them ([`shadow`], [`core`], [`tuning`]).
 //!
 //! The driver owns what every kind shares: the header (`kind`, `name`, `backend`, `[timing]`,
 //! [`header`]) validated once, the command line's refusals, the output folder and its atomic
@@ -30,6 +30,7 @@ pub mod progress;
 pub mod realtime;
 pub mod shadow;
 pub mod sweep;
+pub mod tuning;
 
 pub use contract::{Accepts, Experiment, Finished, RunContext};
 pub use kinds::load;

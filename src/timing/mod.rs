@@ -32,7 +32,8 @@
 //! every stated comparison is decided), [`curve`] (equal time from error-vs-time curves, with
 //! bootstrap intervals over seeds and rounds), [`estimate`] (a median with its interval),
 //! [`interval`] (order-statistic intervals, paired ratios), [`series`] (a correlated series'
-//! interval from block medians), [`rule`] (the words and how the numbers behind them print).
+//! interval from block medians), [`rule`] (the words and how the numbers behind them print),
+//! [`tuning`] (which candidate setting a structure keeps: the default unless another is faster).
 
 pub mod curve;
 pub mod estimate;
@@ -41,6 +42,7 @@ pub mod rule;
 pub mod schedule;
 pub mod sequential;
 pub mod series;
+pub mod tuning;
 
 pub use estimate::{Estimate, EstimateColumns, FRAME_S};
 pub use interval::{coverage, interval_rank, median_interval, paired_ratio};

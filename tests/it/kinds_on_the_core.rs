@@ -249,3 +249,59 @@ fn a_filter_keeps_its_value_after_another_axis_thins_the_list() {
         OsStr::new("lights=2"),
     ]);
 }
+
+/// `--tuning` takes the settings a whole run kept: shards given the whole run's tuning.csv, and
+/// their merge, build the same structures, so every column but the clock's equals the whole
+/// run's (the real ao-ci file, whose kd-trees and field have candidates timed against each
+/// other); the reused settings carry the word `reused`. A kind that tunes nothing, a file kept
+/// for another candidate grid and a missing file are refused as bad input.
+#[test]
+fn shards_given_the_whole_runs_tuning_build_and_count_what_it_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = variant(dir.path(), "experiments/ao-ci.toml", |t| {
+        t.replace("name = \"ao-ci\"", "name = \"ao-ci-tuned\"")
+    });
+    let exp = exp.as_os_str();
+    let (full, sharded) = (dir.path().join("full"), dir.path().join("sharded"));
+    let out = |p: &Path| -> [OsString; 2] { ["--out".into(), p.into()] };
+    let [o, f] = out(&full);
+    run_ok(&[exp, &o, &f]);
+    let tuning = full.join("tuning.csv");
+    let rounds = std::fs::read_to_string(full.join("tuning_rounds.csv")).unwrap();
+    assert!(rounds.lines().count() > 1, "no tuning rounds:\n{rounds}");
+    let [o, s] = out(&sharded);
+    let with_tuning = |extra: &[&OsStr]| {
+        let mut args: Vec<&OsStr> = vec![exp, &o, &s, OsStr::new("--tuning"), tuning.as_os_str()];
+        args.extend_from_slice(extra);
+        run_ok(&args);
+    };
+    with_tuning(&[OsStr::new("--shard"), OsStr::new("1/2")]);
+    with_tuning(&[OsStr::new("--shard"), OsStr::new("2/2")]);
+    with_tuning(&[OsStr::new("--merge"), OsStr::new("2")]);
+    assert!(
+        common::without_clock(&full.join("ao.csv")) == common::without_clock(&sharded.join("ao.csv")),
+        "ao.csv of the shards given the whole run's tuning differs from the whole run's"
+    );
+    let kept = std::fs::read_to_string(sharded.join("tuning.csv")).unwrap();
+    let whole_kept = std::fs::read_to_string(&tuning).unwrap();
+    let chosen = |text: &str| text.lines().filter(|l| l.ends_with(",true")).count();
+    assert_eq!(chosen(&kept), chosen(&whole_kept), "{kept}");
+    assert!(kept.lines().skip(1).all(|l| l.contains(",reused,")), "{kept}");
+
+    // Refusals: exit 2, before anything is measured.
+    let [o, b] = out(&dir.path().join("bad"));
+    let fps = common::repo("experiments/fps-ci.toml");
+    let (code, err) = run(&[fps.as_os_str(), &o, &b, OsStr::new("--tuning"), tuning.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("tune no structure"), "{err}");
+    let regrid = variant(dir.path(), "experiments/ao-ci.toml", |t| {
+        t.replace("depth = [2, 4]", "depth = [1, 3]")
+    });
+    let (code, err) = run(&[regrid.as_os_str(), &o, &b, OsStr::new("--tuning"), tuning.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not among the experiment's candidates"), "{err}");
+    let missing = dir.path().join("none.csv");
+    let (code, err) = run(&[exp, &o, &b, OsStr::new("--tuning"), missing.as_os_str()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("none.csv") && err.contains("cannot read"), "{err}");
+}

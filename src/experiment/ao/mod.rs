@@ -18,8 +18,9 @@ use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
+use crate::experiment::tuning::KeptTuning;
 use crate::render::Backend;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 crate::axis_keys! {
     /// The ambient-occlusion table's axes.
@@ -43,8 +44,18 @@ impl Declaration for AoSpec {
     fn inputs(&self) -> Vec<PathBuf> {
         let mut v = vec![self.path.clone()];
         v.extend(self.meshes.iter().map(|m| m.path.clone()));
+        v.extend(self.reused.iter().map(|k| k.path.clone()));
         v.dedup();
         v
+    }
+
+    fn reuse_tuning(&mut self, path: &Path) -> Result<(), String> {
+        let kept = KeptTuning::read(path, "mesh")?;
+        for mesh in &self.meshes {
+            kept.check(self.structures.iter().map(|(_, c)| (mesh.name.as_str(), c.as_slice())))?;
+        }
+        self.reused = Some(kept);
+        Ok(())
     }
 
     type Axis = AoAxis;

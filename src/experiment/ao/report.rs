@@ -7,6 +7,7 @@ use super::spec::AoSpec;
 use crate::accel::settings::ParameterColumns;
 use crate::accel::Issue;
 use crate::experiment::outputs::Outputs;
+use crate::experiment::tuning::{round_rows, REUSED};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::numbers::{per_triangle, thousands};
@@ -70,7 +71,7 @@ struct RoundCsv<'a> {
 
 /// A row of tuning.csv: a candidate's mesh and structure, its parameters one column each, then
 /// its time ([`FRAME_S`]) and work.
-type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, EstimateColumns, Candidate);
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, EstimateColumns, Candidate<'a>);
 
 /// The columns before the parameters in tuning.csv.
 #[derive(Serialize)]
@@ -79,11 +80,15 @@ struct Tuned<'a> {
     structure: &'a str,
 }
 
-/// The columns after the time in tuning.csv.
+/// The columns after the time in tuning.csv: its work, and how it was judged
+/// ([`crate::experiment::tuning::Verdict`]).
 #[derive(Serialize)]
-struct Candidate {
+struct Candidate<'a> {
     nodes_visited: u64,
     primitive_tests: u64,
+    candidate: usize,
+    against: usize,
+    word: &'a str,
     chosen: bool,
 }
 
@@ -229,10 +234,17 @@ pub fn write_ao(
                     Candidate {
                         nodes_visited: t.work.nodes,
                         primitive_tests: t.work.primitives,
+                        candidate: t.verdict.candidate,
+                        against: t.verdict.against,
+                        word: &t.verdict.word,
                         chosen: t.chosen,
                     },
                 )
             }),
+        )?;
+        write_rows(
+            &out("tuning_rounds.csv")?,
+            tuning.iter().flat_map(|t| round_rows(&t.mesh, t.structure, &t.verdict)),
         )?;
     }
     let csv = rows.iter().map(|r| -> CsvRow {
@@ -399,7 +411,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], adapter: &AdapterInfo, seconds: f64) ->
         spec.name
     );
     md += &format!(
-        "Experiment `{}`, {:.0} s on {device}. Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each structure is first tuned per mesh, as the paper tuned both methods ({}; each candidate timed in {} interleaved rounds at {}x{}, the fastest median kept, `tuning.csv`); then the kept settings render one untimed frame, which gives the image and the work counts, and every structure of a mesh is timed in {} interleaved rounds (order seed {}). Rays/s count camera and AO rays. {RULE}\n\n",
+        "Experiment `{}`, {:.0} s on {device}. Each mesh is scaled into the unit ball and seen at {}x{} by one camera; every camera hit casts {} AO rays along the visibility field's grid lines (each oriented into the normal's hemisphere, `{}` weighting, length {}). Each structure is first tuned per mesh, as the paper tuned both methods ({}; each candidate timed in {} interleaved rounds at {}x{}, the first listed kept unless a later one is *faster* than the one kept so far by the rule below, `tuning.csv`, its rounds in `tuning_rounds.csv`{}); then the kept settings render one untimed frame, which gives the image and the work counts, and every structure of a mesh is timed in {} interleaved rounds (order seed {}). Rays/s count camera and AO rays. {RULE}\n\n",
         spec.path.display(),
         seconds,
         spec.width,
@@ -411,6 +423,10 @@ fn report(spec: &AoSpec, rows: &[AoRow], adapter: &AdapterInfo, seconds: f64) ->
         spec.tuning.repeats,
         spec.tuning.width,
         spec.tuning.height,
+        spec.reused.as_ref().map_or(String::new(), |k| format!(
+            "; settings the file `{}` keeps taken as kept there (`--tuning`, word `{REUSED}`)",
+            k.path.display()
+        )),
         schedule.repeats,
         schedule.seed,
     );
@@ -463,7 +479,7 @@ fn report(spec: &AoSpec, rows: &[AoRow], adapter: &AdapterInfo, seconds: f64) ->
             None => md += &format!("| {} | not in the paper | | | {ours} |\n", m.name),
         }
     }
-    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `rounds.csv` (every timed frame, in round order: the per-round ratios recompute from it), `tuning.csv` (every candidate of the tuning sweep, where a structure had more than one), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
+    md += "\nOutputs: `ao.csv` (one row per mesh, structure and way of issuing rays), `rounds.csv` (every timed frame, in round order: the per-round ratios recompute from it), `tuning.csv` (every candidate of the tuning sweep, where a structure had more than one, with the word that kept or passed it) and `tuning_rounds.csv` (its per-round times), `images/MESH_STRUCTURE.exr` and `.png` (each structure's AO image), `index.html` (the comparison page), `plots/frame_time.png`.\n";
     md
 }
 

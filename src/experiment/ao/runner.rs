@@ -1,21 +1,24 @@
 //! Runs an ambient-occlusion experiment on the f64 CPU backend, where every structure answers
 //! exactly, or on the GPU where asked (`backend = "gpu"`: every structure's f32 walk runs the same
 //! triangle test, its direction-major issue one dispatch per direction): per mesh, each structure
-//! is tuned over its candidates (timed at a small size in interleaved rounds), built at the
-//! settings kept, and renders the AO image once (untimed; its rays and work counted; every
-//! structure's image must equal the first's bit for bit); then the mesh's structures are timed
-//! in the experiment's interleaved rounds.
+//! is tuned over its candidates (timed at a small size in interleaved rounds; the first listed
+//! kept unless another is decidedly faster), built at the settings kept, and renders the AO
+//! image once (untimed; its rays and work counted; every structure's image must equal the
+//! first's bit for bit); then the mesh's structures are timed in the experiment's interleaved
+//! rounds.
 
 use super::spec::{AoMesh, AoSpec};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, Issue};
 use crate::experiment::progress::Progress;
+use crate::experiment::tuning::{verdicts, Verdict, REUSED};
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::ambient::AmbientOcclusion;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Mesh, Scene};
+use crate::timing::tuning::keep;
 use crate::timing::{median_interval, Estimate, Schedule};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -93,14 +96,15 @@ pub struct TuningRow {
     pub structure: RegistryName,
     /// Its parameters.
     pub settings: AccelSettings,
-    /// Median frame seconds at the tuning size, with its interval.
+    /// Median frame seconds at the tuning size, with its interval (NaN where reused).
     pub frame: Estimate,
-    /// What a frame at the tuning size cost.
+    /// What a frame at the tuning size cost (zero where reused).
     pub work: Work,
+    /// How it was judged, and its per-round times.
+    pub verdict: Verdict,
     /// Whether this candidate was kept.
     pub chosen: bool,
 }
-
 /// The AO frames' sampling (the grid needs none; fixed for the record).
 const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
@@ -147,9 +151,9 @@ fn time_scenes(
     })
 }
 
-/// The fastest of `structure`'s candidates on `mesh` at the tuning size (by median, all
-/// candidates timed in interleaved rounds), and every candidate's row; a single candidate is
-/// not timed.
+/// The candidate of `structure` kept on `mesh` ([`keep`]: the first listed unless another is
+/// decidedly faster, all timed at the tuning size in interleaved rounds), and every candidate's
+/// row; a single candidate is not timed, and one kept by `--tuning` is taken as it is.
 fn tune(
     spec: &AoSpec,
     mesh: &AoMesh,
@@ -158,6 +162,24 @@ fn tune(
 ) -> anyhow::Result<(AccelSettings, Vec<TuningRow>)> {
     if candidates.len() == 1 {
         return Ok((candidates[0].clone(), vec![]));
+    }
+    if let Some(kept) = spec.reused.as_ref().and_then(|r| r.get(&mesh.name, structure)) {
+        let candidate = candidates.iter().position(|c| c == kept).expect("checked on reading");
+        let row = TuningRow {
+            mesh: mesh.name.clone(),
+            structure,
+            settings: kept.clone(),
+            frame: Estimate::NAN,
+            work: Work::ZERO,
+            verdict: Verdict {
+                candidate,
+                against: candidate,
+                word: REUSED.into(),
+                rounds: vec![],
+            },
+            chosen: true,
+        };
+        return Ok((kept.clone(), vec![row]));
     }
     let scenes = candidates
         .iter()
@@ -178,24 +200,24 @@ fn tune(
         ..spec.header.schedule
     };
     let times = time_scenes(&scenes, size, &schedule, backend, &|| {})?;
-    let mut rows: Vec<TuningRow> = candidates
+    let kept = keep(&times);
+    let estimates: Vec<Estimate> = times.iter().map(|t| median_interval(t)).collect();
+    let rows = candidates
         .iter()
-        .zip(&times)
+        .zip(estimates)
         .zip(work)
-        .map(|((settings, t), work)| TuningRow {
+        .zip(verdicts(&kept, times))
+        .map(|(((settings, frame), work), verdict)| TuningRow {
             mesh: mesh.name.clone(),
             structure,
             settings: settings.clone(),
-            frame: median_interval(t),
+            frame,
             work,
-            chosen: false,
+            chosen: verdict.candidate == kept.index,
+            verdict,
         })
         .collect();
-    let best = (0..rows.len())
-        .min_by(|&a, &b| rows[a].frame.median.total_cmp(&rows[b].frame.median))
-        .expect("at least one candidate");
-    rows[best].chosen = true;
-    Ok((candidates[best].clone(), rows))
+    Ok((candidates[kept.index].clone(), rows))
 }
 
 /// One untimed frame of `scene` (`structure` at `settings`, rays issued as `issue`): its image,

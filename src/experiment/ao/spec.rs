@@ -7,6 +7,7 @@ use crate::accel::{AccelSettings, Issue};
 use crate::config::{ConfigError, Source};
 use crate::experiment::comparison::{Claim, Comparison};
 use crate::experiment::header::{plain_name, Header};
+use crate::experiment::tuning::KeptTuning;
 use crate::key_path;
 use crate::mesh::file::MAX_FILE_TRIANGLES;
 use crate::mesh::{clean, Triangles};
@@ -43,8 +44,8 @@ fn single() -> Vec<Issue> {
 /// The small tuning sweep run per mesh before the timed frames, as the paper tuned each method
 /// per scene (CRT: BSP depth and leaf size; VLF-RT: tile-BSP depth): a structure's candidates
 /// are the lists of its `[accel.NAME]` table, or its own grid where the file gives no table;
-/// each is timed at `width` x `height` in `repeats` interleaved rounds, and the fastest median
-/// is kept.
+/// each is timed at `width` x `height` in `repeats` interleaved rounds, and the first listed is
+/// kept unless a later one is decidedly faster ([`crate::timing::tuning::keep`]).
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Tuning {
@@ -125,6 +126,8 @@ pub struct AoSpec {
     pub claim: Claim,
     /// The meshes.
     pub meshes: Vec<AoMesh>,
+    /// Settings kept by an earlier run (`--tuning`), taken instead of tuning again.
+    pub reused: Option<KeptTuning>,
 }
 
 /// `positions` centred on their bounding box and scaled into the unit ball.
@@ -311,6 +314,7 @@ impl AoSpec {
             tuning: f.tuning,
             claim: f.claim,
             meshes,
+            reused: None,
         })
     }
 }

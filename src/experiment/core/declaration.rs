@@ -70,6 +70,15 @@ pub trait Declaration: Clone {
     /// cache, shared by its shards and their merge); called once before any unit is measured.
     fn keep_state_in(&mut self, _home: &Path) {}
 
+    /// Takes the settings kept in the tuning.csv at `path` (`--tuning`) in place of tuning them
+    /// again; the file becomes one of its inputs. Kinds that tune nothing refuse it.
+    fn reuse_tuning(&mut self, _path: &Path) -> Result<(), String> {
+        Err(format!(
+            "--tuning: `{}` experiments tune no structure",
+            self.header().kind.name()
+        ))
+    }
+
     /// What, beside its label, determines `unit`'s outcome on `adapter`, where that is less than
     /// the default (every input's content and every axis's values): a unit keyed by it is taken
     /// from the journal after edits that cannot change it (a sweep's group after another scheme

@@ -175,6 +175,9 @@ impl<D: Declaration> Experiment for Declared<D> {
 
     fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
         let mut spec = self.filtered(&run.cli.filter)?;
+        if let Some(path) = &run.cli.tuning {
+            spec.reuse_tuning(path).map_err(BadInput)?;
+        }
         spec.keep_state_in(run.home);
         if let Some(shard) = run.cli.shard {
             return self.run_shard(&spec, shard, run);

@@ -11,7 +11,20 @@ use crate::timing::{EstimateColumns, FRAME_S, RULE};
 use serde::Serialize;
 use std::path::Path;
 
-/// Writes fps.csv, plots/fps.png, report.md and index.html under `out`.
+/// A row of rounds.csv: one configuration's timed frame in one round, so every median and
+/// interval of fps.csv recomputes from committed numbers.
+#[derive(Serialize)]
+struct RoundCsv<'a> {
+    scene: &'a str,
+    lights: u32,
+    width: u32,
+    height: u32,
+    round: usize,
+    #[serde(with = "float")]
+    frame_s: f64,
+}
+
+/// Writes fps.csv, rounds.csv, plots/fps.png, report.md and index.html under `out`.
 pub fn write_fps(
     spec: &FpsSpec,
     rows: &[FpsRow],
@@ -20,6 +33,22 @@ pub fn write_fps(
     out: &Path,
 ) -> anyhow::Result<()> {
     write_rows(&out.join("fps.csv"), rows.iter().map(|r| csv_row(spec, r, adapter)))?;
+    write_rows(
+        &out.join("rounds.csv"),
+        rows.iter().flat_map(|r| {
+            r.frame_seconds
+                .iter()
+                .enumerate()
+                .map(move |(round, &frame_s)| RoundCsv {
+                    scene: &r.scene,
+                    lights: r.lights,
+                    width: r.width,
+                    height: r.height,
+                    round,
+                    frame_s,
+                })
+        }),
+    )?;
     let mut series = Vec::new();
     let mut refs = Vec::new();
     let pixels: Vec<f64> = spec.resolutions.iter().map(|r| (r[0] * r[1]) as f64 / 1e6).collect();
@@ -105,7 +134,7 @@ pub fn write_fps(
             r.shadow_rays_per_s()
         );
     }
-    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `plots/fps.png`, `index.html` (the page); nodes and tests are counted on the CPU backend only (n/a on the GPU).\n";
+    md += "\nOutputs: `fps.csv` (one row per configuration, with the adapter), `rounds.csv` (every timed frame, in round order: each median and interval recomputes from it), `plots/fps.png`, `index.html` (the page); nodes and tests are counted on the CPU backend only (n/a on the GPU).\n";
     write_atomic(&out.join("report.md"), md.as_bytes())?;
     page::write(
         out,

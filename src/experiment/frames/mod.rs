@@ -24,8 +24,9 @@ use crate::experiment::core::filter::{keep_at, Axis};
 use crate::experiment::core::{Cost, Declaration, Unit};
 use crate::experiment::header::Header;
 use crate::experiment::progress::Progress;
+use crate::experiment::tuning::KeptTuning;
 use crate::render::Backend;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 impl FramesSpec {
     /// The scenes as the `scene` axis names them: `classroom`, or each triangle count.
@@ -66,7 +67,18 @@ impl Declaration for FramesSpec {
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
-        vec![self.path.clone()]
+        let mut v = vec![self.path.clone()];
+        v.extend(self.reused.iter().map(|k| k.path.clone()));
+        v
+    }
+
+    fn reuse_tuning(&mut self, path: &Path) -> Result<(), String> {
+        let kept = KeptTuning::read(path, "scene")?;
+        for scene in self.scene_names() {
+            kept.check(self.candidates.iter().map(|c| (scene.as_str(), c.as_slice())))?;
+        }
+        self.reused = Some(kept);
+        Ok(())
     }
 
     type Axis = FramesAxis;

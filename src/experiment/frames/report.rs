@@ -7,6 +7,7 @@ use super::runner::{BuildRow, FrameRow, FramesOutcome};
 use super::spec::{Cameras, FramesSpec, Generator};
 use super::verdict::{label, labels, over_frames, verdict};
 use crate::accel::settings::ParameterColumns;
+use crate::experiment::tuning::{round_rows, REUSED};
 use crate::files::write_atomic;
 use crate::metrics::stats::median;
 use crate::output::images::{exposure, tonemap};
@@ -73,18 +74,35 @@ struct BuildCost {
     memory_bytes: u64,
 }
 
+/// A row of rounds.csv: one timed render of one frame and structure, in round order, so every
+/// frame's median and interval in frames.csv, and every per-frame ratio, recomputes from
+/// committed numbers.
+#[derive(Serialize)]
+struct RoundCsv<'a> {
+    triangles: usize,
+    structure: &'a str,
+    update: &'a str,
+    shading: &'a str,
+    viewpoint: &'a str,
+    frame: u32,
+    round: usize,
+    #[serde(with = "float")]
+    frame_s: f64,
+}
+
 /// The columns of a candidate's time over the tuning cameras in tuning.csv.
 const TUNING_S: [&str; 3] = ["tuning_s", "tuning_s_lo", "tuning_s_hi"];
 
 /// A row of tuning.csv: the unit that tuned, the scene size and structure, the candidate's
 /// parameters one column each, its build, its time over the tuning cameras ([`TUNING_S`]) and
 /// its work.
-type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, BuildTime, EstimateColumns, TuningWork);
+type TuningCsv<'a> = (Tuned<'a>, ParameterColumns, BuildTime, EstimateColumns, TuningWork<'a>);
 
 /// The columns before the parameters in tuning.csv.
 #[derive(Serialize)]
 struct Tuned<'a> {
     unit: &'a str,
+    scene: &'a str,
     triangles: usize,
     structure: &'a str,
 }
@@ -96,11 +114,15 @@ struct BuildTime {
     build_s: f64,
 }
 
-/// The columns after the time in tuning.csv.
+/// The columns after the time in tuning.csv: its work, and how it was judged
+/// ([`crate::experiment::tuning::Verdict`]).
 #[derive(Serialize)]
-struct TuningWork {
+struct TuningWork<'a> {
     nodes_visited: u64,
     primitive_tests: u64,
+    candidate: usize,
+    against: usize,
+    word: &'a str,
     chosen: bool,
 }
 
@@ -150,6 +172,21 @@ pub fn write_frames(
         }),
     )?;
     write_rows(
+        &out.join("rounds.csv"),
+        rows.iter().flat_map(|r| {
+            r.renders.iter().enumerate().map(move |(round, &frame_s)| RoundCsv {
+                triangles: r.triangles,
+                structure: r.structure,
+                update: r.update,
+                shading: r.shading.name(),
+                viewpoint: &r.viewpoint,
+                frame: r.frame,
+                round,
+                frame_s,
+            })
+        }),
+    )?;
+    write_rows(
         &out.join("builds.csv"),
         outcome.builds.iter().map(|b: &BuildRow| -> BuildCsv {
             (
@@ -172,6 +209,7 @@ pub fn write_frames(
                 (
                     Tuned {
                         unit,
+                        scene: &t.scene,
                         triangles: t.triangles,
                         structure: t.structure,
                     },
@@ -183,10 +221,20 @@ pub fn write_frames(
                     TuningWork {
                         nodes_visited: t.work.nodes,
                         primitive_tests: t.work.primitives,
+                        candidate: t.verdict.candidate,
+                        against: t.verdict.against,
+                        word: &t.verdict.word,
                         chosen: t.chosen,
                     },
                 )
             }),
+        )?;
+        write_rows(
+            &out.join("tuning_rounds.csv"),
+            outcome
+                .tuning
+                .iter()
+                .flat_map(|(_, t)| round_rows(&t.scene, t.structure, &t.verdict)),
         )?;
     }
     let summaries = summarise(spec, outcome);
@@ -547,11 +595,24 @@ fn tuning_paragraph(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         .tuning
         .iter()
         .filter(|(_, t)| t.chosen)
-        .map(|(unit, t)| format!("{unit}: `{}` {}", t.structure, t.settings.describe()))
+        .map(|(unit, t)| {
+            format!(
+                "{unit}: `{}` {} ({})",
+                t.structure,
+                t.settings.describe(),
+                t.verdict.word
+            )
+        })
         .collect();
+    let reused = spec.reused.as_ref().map_or(String::new(), |k| {
+        format!(
+            " Settings the file `{}` keeps are taken as kept there (`--tuning`, word `{REUSED}`), not timed again.",
+            k.path.display()
+        )
+    });
     let t = &spec.tuning;
     format!(
-        "Tuning, per scene before its frames are timed: {}; each candidate built and timed rendering {} camera(s) per viewpoint drawn at random with their own seed ({}, never the frames measured) at {}x{} under {} shading, in {} interleaved rounds, the fastest median kept (`tuning.csv`). At one setting: {}. Kept: {}.\n\n",
+        "Tuning, per scene before its frames are timed: {}; each candidate built and timed rendering {} camera(s) per viewpoint drawn at random with their own seed ({}, never the frames measured) at {}x{} under {} shading, in {} interleaved rounds; the first listed is kept unless a later one is *faster* than the one kept so far by the rule below (`tuning.csv` gives each candidate's word, `tuning_rounds.csv` its rounds).{} At one setting: {}. Kept: {}.\n\n",
         tuned.join("; "),
         t.cameras,
         t.seed,
@@ -559,6 +620,7 @@ fn tuning_paragraph(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         spec.height,
         super::tuning::tuning_shading(spec).name(),
         t.repeats,
+        reused,
         if fixed.is_empty() { "none".to_string() } else { fixed.join(", ") },
         kept.join("; ")
     )
@@ -642,7 +704,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, device: &str, seconds: f64
             crate::output::numbers::per_triangle(b.memory_bytes, b.triangles)
         );
     }
-    md += "\nOutputs: `frames.csv` (one row per frame and structure), `summary.csv` (the medians above), `builds.csv`, `tuning.csv` (where a structure was tuned), `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
+    md += "\nOutputs: `frames.csv` (one row per frame and structure), `rounds.csv` (every timed render, in round order), `summary.csv` (the medians above), `builds.csv`, `tuning.csv` and `tuning_rounds.csv` (where a structure was tuned), `plots/frame_time_SHADING.png` (render time along the path, largest scene, first viewpoint)";
     if spec.motion.is_some() {
         md += ", `plots/update_time_SHADING.png` (update time along the path)";
     }

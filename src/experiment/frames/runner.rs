@@ -337,7 +337,7 @@ pub fn run_block(
         (block.shadings.len() * block.viewpoints.len()) as u64 * block.frames.len() as u64,
     );
     bar.message(format!("tuning {} structures", spec.structures.len()));
-    let (structures, tuning) = super::tuning::tune(spec, &generated, backend)?;
+    let (structures, tuning) = super::tuning::tune(spec, (&spec.scene_names()[s], &generated), backend)?;
     outcome
         .tuning
         .extend(tuning.into_iter().map(|t| (block.label(spec), t)));

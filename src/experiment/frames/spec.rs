@@ -14,6 +14,7 @@ pub use super::cameras::{Cameras, MAX_FRAMES};
 pub use super::candidates::{FramesTuning, MAX_TUNING_CAMERAS};
 pub use super::motion::Motion;
 pub use super::scenes::{Generator, MAX_TRIANGLES};
+use crate::experiment::tuning::KeptTuning;
 
 use super::cameras::viewpoints;
 use super::candidates::candidates;
@@ -168,6 +169,8 @@ pub struct FramesSpec {
     pub motion: Option<Motion>,
     /// Frames saved as pictures, evenly along the path.
     pub strip: u32,
+    /// Settings kept by an earlier run (`--tuning`), taken instead of tuning again.
+    pub reused: Option<KeptTuning>,
 }
 
 impl FramesSpec {
@@ -289,6 +292,7 @@ impl FramesSpec {
             block: f.path.block,
             motion,
             strip: f.strip,
+            reused: None,
         };
         check_memory(
             source,

@@ -2,7 +2,8 @@
 //! tuned both of its methods per scene (Table 1 gives each one's best depth) and as the ao kind
 //! does: a structure whose `[accel.NAME]` table lists several values is built at every
 //! combination, each candidate renders the tuning cameras at the experiment's own resolution
-//! ([`tuning_shading`]) in interleaved rounds, and the fastest median is kept. The tuning cameras are
+//! ([`tuning_shading`]) in interleaved rounds, and the first listed is kept unless a later one
+//! is decidedly faster than the one kept so far ([`keep`]). The tuning cameras are
 //! drawn at random from every viewpoint with their own seed, never the frames measured, so the
 //! choice is not fitted to the frames it is judged on. A structure with one candidate is not
 //! timed. Candidates of one structure are held together and dropped before the next is tuned.
@@ -13,9 +14,11 @@ use super::spec::{FramesSpec, Generator, ShadingName, SAMPLING};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::AccelSettings;
+use crate::experiment::tuning::{verdicts, Verdict, REUSED};
 use crate::render::{Backend, View};
 use crate::scene::camera::Camera;
 use crate::scene::procedural::{classroom, random, Generated};
+use crate::timing::tuning::keep;
 use crate::timing::{median_interval, Estimate, Schedule};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -24,6 +27,8 @@ use std::time::Instant;
 /// One candidate of the tuning sweep, timed: a row of tuning.csv.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TuningRow {
+    /// The scene, as the `scene` axis names it.
+    pub scene: String,
     /// Triangles in the scene.
     pub triangles: usize,
     /// Structure name.
@@ -31,12 +36,15 @@ pub struct TuningRow {
     pub structure: RegistryName,
     /// Its parameters.
     pub settings: AccelSettings,
-    /// Median seconds to render every tuning camera once, with its interval over rounds.
+    /// Median seconds to render every tuning camera once, with its interval over rounds (NaN
+    /// where reused).
     pub seconds: Estimate,
     /// What rendering every tuning camera once cost.
     pub work: Work,
     /// Build seconds.
     pub build_seconds: f64,
+    /// How it was judged, and its per-round times.
+    pub verdict: Verdict,
     /// Whether this candidate was kept.
     pub chosen: bool,
 }
@@ -74,11 +82,11 @@ fn tuning_cameras(spec: &FramesSpec) -> Vec<Camera> {
         .collect()
 }
 
-/// The settings each structure of `spec` renders `generated` with (its fastest candidate, or
-/// its one), and every candidate timed.
+/// The settings each structure of `spec` renders `generated` (the scene named `scene`) with:
+/// the candidate [`keep`] keeps, the one `--tuning` kept, or its one; and every candidate's row.
 pub fn tune(
     spec: &FramesSpec,
-    generated: &Generated,
+    (scene, generated): (&str, &Generated),
     backend: &mut dyn Backend,
 ) -> anyhow::Result<(Vec<AccelSettings>, Vec<TuningRow>)> {
     let cameras = tuning_cameras(spec);
@@ -92,6 +100,27 @@ pub fn tune(
     for candidates in &spec.candidates {
         if candidates.len() == 1 {
             chosen.push(candidates[0].clone());
+            continue;
+        }
+        if let Some(kept) = spec.reused.as_ref().and_then(|r| r.get(scene, candidates[0].name)) {
+            let candidate = candidates.iter().position(|c| c == kept).expect("checked on reading");
+            rows.push(TuningRow {
+                scene: scene.to_string(),
+                triangles: generated.triangle_count(),
+                structure: kept.name,
+                settings: kept.clone(),
+                seconds: Estimate::NAN,
+                work: Work::ZERO,
+                build_seconds: f64::NAN,
+                verdict: Verdict {
+                    candidate,
+                    against: candidate,
+                    word: REUSED.into(),
+                    rounds: vec![],
+                },
+                chosen: true,
+            });
+            chosen.push(kept.clone());
             continue;
         }
         let mut scenes = Vec::new();
@@ -123,23 +152,26 @@ pub fn tune(
             }
             Ok(start.elapsed().as_secs_f64())
         })?;
-        let first = rows.len();
-        for ((c, t), (w, scene)) in candidates.iter().zip(&times).zip(work.into_iter().zip(&scenes)) {
+        let kept = keep(&times);
+        let estimates: Vec<Estimate> = times.iter().map(|t| median_interval(t)).collect();
+        for ((c, seconds), ((w, built), verdict)) in candidates
+            .iter()
+            .zip(estimates)
+            .zip(work.into_iter().zip(&scenes).zip(verdicts(&kept, times)))
+        {
             rows.push(TuningRow {
+                scene: scene.to_string(),
                 triangles: generated.triangle_count(),
                 structure: c.name,
                 settings: c.clone(),
-                seconds: median_interval(t),
+                seconds,
                 work: w,
-                build_seconds: scene.accel.as_ref().map_or(0.0, |a| a.stats().build_time.as_secs_f64()),
-                chosen: false,
+                build_seconds: built.accel.as_ref().map_or(0.0, |a| a.stats().build_time.as_secs_f64()),
+                chosen: verdict.candidate == kept.index,
+                verdict,
             });
         }
-        let best = (first..rows.len())
-            .min_by(|&a, &b| rows[a].seconds.median.total_cmp(&rows[b].seconds.median))
-            .expect("at least two candidates");
-        rows[best].chosen = true;
-        chosen.push(rows[best].settings.clone());
+        chosen.push(candidates[kept.index].clone());
     }
     Ok((chosen, rows))
 }

@@ -114,7 +114,7 @@ pub fn section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, 
         .filter(|&r| r > 0)
         .collect();
     let mut s = format!(
-        "\n### At equal time, from the error-vs-time curves\n\nEach scheme's error (mean over seeds) at every swept count, interpolated linearly in log-log between counts, and its frame time as a fixed cost plus a cost per ray fitted to the medians of its timed counts (every median within {:.1} % of its fit, the worst over schemes); nothing extrapolated: `n/a` outside a scheme's measured range. Budgets: uniform sampling's fitted frame time at {} rays. Intervals: 95 % percentile bootstrap over {REPLICATES} draws of seeds and timing rounds together, so each word carries both noises (with few seeds a percentile interval is somewhat narrower than 95 %); words by the rule (see Timing) on the ratio to uniform's. Timing rounds per configuration: {}.\n",
+        "\n### At equal time, from the error-vs-time curves\n\nEach scheme's error (mean over seeds) at every swept count, interpolated linearly in log-log between counts, and its frame time as a fixed cost plus a cost per ray fitted to the medians of its timed counts (every median within {:.1} % of its fit, the worst over schemes); nothing extrapolated: `n/a` outside a scheme's measured range. Budgets: uniform sampling's fitted frame time at {} rays. Intervals: 95 % expanded percentile bootstrap over {REPLICATES} draws of seeds and timing rounds together (rounds paired across schemes at each count, as they were timed; the tails widened for the few seeds), so each word carries both noises; words by the rule (see Timing) on the ratio to uniform's. Timing rounds per configuration: {}.\n",
         100.0 * worst_fit,
         budgets.iter().map(u32::to_string).collect::<Vec<_>>().join(", "),
         match (rounds.iter().min(), rounds.iter().max()) {
@@ -127,10 +127,16 @@ pub fn section(outcome: &Outcome, summaries: &[Summary], slice: &Slice, n: u32, 
     for &b in &budgets {
         let budget_of = |d: &Drawn| d.time_at_rays(b as f64);
         let budget = uniform_measured.time_at_rays(b as f64).unwrap_or(f64::NAN);
+        // Rays in a budget are (t - a) / c: a timing change of x moves them by x / share.
+        let share = uniform_measured
+            .time_model()
+            .map_or(f64::NAN, |m| m.per_ray * b as f64 / budget);
         let _ = write!(
             s,
-            "\n**Budget: uniform@{b}'s frame time ({:.3} ms).**\n\n| scheme | rays in the budget | RMSE | RMSE / uniform's | blurred RMSE / uniform's |\n|---|---|---|---|---|\n",
-            1e3 * budget
+            "\n**Budget: uniform@{b}'s frame time ({:.3} ms; {:.0} % of it spent per ray, so a 5 % change in a scheme's time moves its rays in the budget by {:.0} %).**\n\n| scheme | rays in the budget | RMSE | RMSE / uniform's | blurred RMSE / uniform's |\n|---|---|---|---|---|\n",
+            1e3 * budget,
+            100.0 * share,
+            5.0 / share
         );
         for ((scheme, c), (_, cb)) in rmse.iter().zip(&blurred) {
             let rays = as_measured(c).rays_at_time(budget);

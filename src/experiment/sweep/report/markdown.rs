@@ -127,7 +127,7 @@ fn timing_section(outcome: &Outcome, warmup: u32) -> String {
         "
 ## Timing
 
-Every configuration on the timing grid timed with its first seed, once per round, sequentially: the configurations a comparison holds (each scheme and uniform sampling, each structure and the first, at one pattern, ray count, light radius and light count) are visited back to back in seeded ABBA order, and after {first} rounds and every {every} after, up to {cap}, every open comparison is read by the rule; a decided one stops, and a configuration stops being timed when all of its have ({min}-{max} rounds here; `timings.csv` holds every round, and replaying these looks on it gives every word below). Order seed {seed}; {warmup} warm-up frame(s) before each timed frame; clock: {clock}. {RULE}
+Every configuration on the timing grid timed with its first seed, once per round, sequentially: the configurations a comparison holds (each scheme and uniform sampling, each structure and the first, at one pattern, ray count, light radius and light count) are visited back to back in seeded ABBA order, and after {first} rounds and every {every} after, up to {cap}, every open comparison is read by the rule; a decided one stops, and a configuration stops being timed when all of its have ({min}-{max} rounds here; `timings.csv` holds every round: replaying these looks on it gives the round each comparison stopped at and its word there, and the equal-time answers below recompute from it and `runs.csv`). Order seed {seed}; {warmup} warm-up frame(s) before each timed frame; clock: {clock}. {RULE}
 
 ",
         first = t.looks.first_look,
@@ -248,6 +248,7 @@ fn cost_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64, looks
         };
         let matched = match uniform {
             None => "n/a".to_string(),
+            Some(_) if scheme == DiskScheme::Uniform => "reference".to_string(),
             Some(u) => time_rank(at.timing.as_ref(), u.timing.as_ref(), looks),
         };
         let count = |v: Option<u64>| v.map_or("n/a".to_string(), |v| format!("{v:.3e}", v = v as f64));

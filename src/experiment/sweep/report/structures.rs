@@ -37,7 +37,7 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
     }
     let base = &names[0];
     let mut s = format!(
-        "\n## What the acceleration structure costs\n\nEvery configuration rendered with each structure beside `{base}`: seeds whose shadow images are identical bit for bit, the frame times (median ms [95 % interval]), the time ratio with its interval and the rule's word (see Timing), and the nodes visited and primitives tested in one frame where the backend counts them.\n\n| lights | scheme | pattern | rays | radius (m) | structure | same images | frame ms | `{base}` ms | time / `{base}`'s | word | nodes | `{base}` nodes | tests | `{base}` tests |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+        "\n## What the acceleration structure costs\n\nEvery configuration rendered with each structure beside `{base}`: seeds whose shadow images are identical bit for bit, the frame times (median ms [95 % interval]), the time ratio with its interval, the rule's word (see Timing) and the rounds it took, and the nodes visited and primitives tested in one frame where the backend counts them.\n\n| lights | scheme | pattern | rays | radius (m) | structure | same images | frame ms | `{base}` ms | time / `{base}`'s | word | rounds | nodes | `{base}` nodes | tests | `{base}` tests |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let (mut identical, mut compared, mut ratios) = (0, 0, Vec::new());
     for other in summaries.iter().filter(|x| x.config.accelerator != *base) {
@@ -51,12 +51,12 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
         let (same, both) = same_images(outcome, &other.config, &reference);
         identical += same;
         compared += both;
-        let (ratio, word) = match (&other.timing, &first.timing) {
+        let (ratio, word, rounds) = match (&other.timing, &first.timing) {
             (Some(a), Some(b)) => {
                 let d = compare(a, b, outcome.timings.looks);
-                (d.ratio, d.word.word())
+                (d.ratio, d.word.word(), d.rounds.to_string())
             }
-            _ => (crate::timing::Estimate::NAN, "untimed"),
+            _ => (crate::timing::Estimate::NAN, "untimed", "n/a".to_string()),
         };
         if ratio.median.is_finite() {
             ratios.push(ratio.median);
@@ -67,7 +67,7 @@ pub fn structure_section(spec: &Spec, outcome: &Outcome, summaries: &[Summary]) 
             w.map_or("n/a".to_string(), |w| format!("{:.3e}", f(w) as f64))
         };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {same}/{both} | {} | {} | {} | {word} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {same}/{both} | {} | {} | {} | {word} | {rounds} | {} | {} | {} | {} |\n",
             c.lights,
             c.scheme,
             c.pattern,
