@@ -9,8 +9,10 @@
 #   scripts/stability.sh NAME K
 #
 # Output: target/stability/NAME/stability.csv (place, committed word, words of the reruns,
-# held) and a one-line tally on stdout. A committed word held in fewer than K runs is a finding:
-# the README quotes the tally beside each answer.
+# held), copied to results/NAME-stability.csv (a plain file beside the folder, which holds only
+# what the binary writes) with the host and commit in target/stability/NAME/host.txt, and a
+# one-line tally on stdout. A committed word held in fewer than K runs is a finding: the README
+# quotes the tally beside each answer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
@@ -85,6 +87,13 @@ done
         printf ',%s\n' "$held"
     done < "$out/committed.tsv"
 } > "$out/stability.csv"
+
+cp "$out/stability.csv" "results/$name-stability.csv"
+{
+    echo "commit $(git rev-parse HEAD)"
+    grep -m1 'model name' /proc/cpuinfo || true
+    echo "cores $(nproc)"
+} > "$out/host.txt"
 
 total=$(($(wc -l < "$out/stability.csv") - 1))
 all=$(awk -F, -v k="$runs" 'NR > 1 && $NF == k' "$out/stability.csv" | wc -l)

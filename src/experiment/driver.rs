@@ -33,7 +33,8 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
     }
     let choice = backend_for(experiment.as_ref(), choice)?;
     let mut inputs = Vec::new();
-    for path in experiment.inputs() {
+    // A reused tuning decides what is built, so it is an input as the experiment file is.
+    for path in experiment.inputs().into_iter().chain(cli.tuning.clone()) {
         inputs.push(Input::read(&path).map_err(|e| BadInput(format!("{}: cannot read: {e}", path.display())))?);
     }
     if cli.dry_run {

@@ -54,7 +54,7 @@ pub struct RoundRow<'a> {
     pub round: usize,
     /// Seconds.
     #[serde(with = "crate::output::table::float")]
-    pub seconds: f64,
+    pub time_s: f64,
 }
 
 /// Every round of `verdict`, as rows of tuning_rounds.csv.
@@ -63,17 +63,13 @@ pub fn round_rows<'a>(
     structure: &'a str,
     verdict: &'a Verdict,
 ) -> impl Iterator<Item = RoundRow<'a>> + 'a {
-    verdict
-        .rounds
-        .iter()
-        .enumerate()
-        .map(move |(round, &seconds)| RoundRow {
-            scene,
-            structure,
-            candidate: verdict.candidate,
-            round,
-            seconds,
-        })
+    verdict.rounds.iter().enumerate().map(move |(round, &time_s)| RoundRow {
+        scene,
+        structure,
+        candidate: verdict.candidate,
+        round,
+        time_s,
+    })
 }
 
 /// The settings an earlier run kept, per scene and structure, read from its tuning.csv
@@ -142,21 +138,28 @@ impl KeptTuning {
         self.kept.get(&(scene.to_string(), structure.to_string()))
     }
 
-    /// Checks that every setting kept for a `(scene, structure)` the experiment tunes is one
-    /// of its candidates there (`tuned` lists them), so that a file from another experiment
-    /// cannot slip in a setting the experiment never offered.
+    /// Checks that the file keeps a setting for every `(scene, structure)` the experiment tunes
+    /// (`tuned` lists each one's candidates; one candidate is not tuned), and that it is one of
+    /// the candidates there: a file from another experiment, or from a run filtered to fewer
+    /// scenes, would otherwise slip in a setting never offered or leave a structure to be timed
+    /// again, apart from the rest.
     pub fn check<'a>(&self, tuned: impl IntoIterator<Item = (&'a str, &'a [AccelSettings])>) -> Result<(), String> {
         for (scene, candidates) in tuned {
-            let Some(first) = candidates.first() else { continue };
-            if let Some(kept) = self.get(scene, first.name) {
-                if !candidates.contains(kept) {
-                    return Err(format!(
-                        "{}: `{}` on `{scene}` kept {}, which is not among the experiment's candidates",
-                        self.path.display(),
-                        first.name,
-                        kept.describe()
-                    ));
-                }
+            let [first, _, ..] = candidates else { continue };
+            let Some(kept) = self.get(scene, first.name) else {
+                return Err(format!(
+                    "{}: keeps no setting of `{}` on `{scene}`, which this experiment tunes (a file from a filtered run, or another experiment?)",
+                    self.path.display(),
+                    first.name
+                ));
+            };
+            if !candidates.contains(kept) {
+                return Err(format!(
+                    "{}: `{}` on `{scene}` kept {}, which is not among the experiment's candidates",
+                    self.path.display(),
+                    first.name,
+                    kept.describe()
+                ));
             }
         }
         Ok(())
@@ -236,6 +239,12 @@ mod tests {
         assert_eq!(kept.get("man", "kdtree"), Some(&a));
         assert_eq!(kept.get("man", "vlf"), None);
         assert!(kept.check([("cow", &[a.clone(), b.clone()][..])]).is_ok());
+        let err = kept.check([("man", &[vlf.clone(), vlf.clone()][..])]).unwrap_err();
+        assert!(err.contains("keeps no setting of `vlf` on `man`"), "{err}");
+        assert!(
+            kept.check([("man", &[vlf.clone()][..])]).is_ok(),
+            "one candidate is not tuned"
+        );
         let err = kept.check([("cow", &[a.clone(), kd(40, "median")][..])]).unwrap_err();
         assert!(err.contains("not among the experiment's candidates"), "{err}");
     }

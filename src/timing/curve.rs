@@ -213,13 +213,52 @@ impl Drawn {
 /// each count's rounds (`None`: every round as measured).
 struct Draw {
     seeds: Vec<usize>,
-    rounds: Option<(Stream, u32)>,
+    rounds: Option<Rounds>,
+}
+
+/// How a replicate draws rounds: from `stream`, at each ray count (its index in `counts`) among
+/// the rounds every curve compared there was timed in (its shared prefix: sequential timing
+/// stops a configuration's rounds on its own, and round `i` is the same time slot in every
+/// series), the same indices for every curve, so the drift a round shares cancels in a ratio.
+struct Rounds {
+    stream: Stream,
+    /// Each ray count of any curve, sorted, with the rounds every curve timed there.
+    counts: Vec<(f64, usize)>,
+}
+
+impl Rounds {
+    /// `stream`'s draw over `curves`.
+    fn over(stream: Stream, curves: &[&[Measured]]) -> Rounds {
+        let mut counts: Vec<(f64, usize)> = Vec::new();
+        for p in curves.iter().flat_map(|c| c.iter()).filter(|p| !p.seconds.is_empty()) {
+            match counts.iter_mut().find(|(rays, _)| *rays == p.rays) {
+                Some((_, n)) => *n = (*n).min(p.seconds.len()),
+                None => counts.push((p.rays, p.seconds.len())),
+            }
+        }
+        counts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        Rounds { stream, counts }
+    }
+
+    /// The median of `seconds` (timed at `rays`) over this replicate's rounds.
+    fn median(&self, rays: f64, seconds: &[f64]) -> f64 {
+        let (k, n) = self
+            .counts
+            .iter()
+            .enumerate()
+            .find(|(_, (r, _))| *r == rays)
+            .map(|(k, (_, n))| (k as u32, *n))
+            .expect("every timed count is listed");
+        let stride = stride(self.counts.iter().map(|c| c.1).max().unwrap_or(0));
+        let drawn: Vec<f64> = (0..n as u32)
+            .map(|i| seconds[((self.stream.unit(stride * k + i) * n as f64) as usize).min(n - 1)])
+            .collect();
+        median(&drawn)
+    }
 }
 
 impl Draw {
     fn curve(&self, points: &[Measured]) -> Drawn {
-        // Rounds are drawn per ray count (its index in the stream), so every curve timed at a
-        // count draws the same rounds there.
         // Failed seeds (NaN) are left out of the mean; a count with none left has no error.
         let mean = |errors: &[f64]| {
             let picked: Vec<f64> = self
@@ -230,25 +269,16 @@ impl Draw {
                 .collect();
             picked.iter().sum::<f64>() / picked.len() as f64
         };
-        let time = |k: u32, seconds: &[f64]| {
-            let n = seconds.len();
-            match &self.rounds {
-                None => median(seconds),
-                Some((stream, base)) => median(
-                    &(0..n as u32)
-                        .map(|i| {
-                            let u = stream.unit(base + stride(n) * k + i);
-                            seconds[((u * n as f64) as usize).min(n - 1)]
-                        })
-                        .collect::<Vec<_>>(),
-                ),
-            }
-        };
         let timed: Vec<(f64, f64)> = points
             .iter()
-            .enumerate()
-            .filter(|(_, p)| !p.seconds.is_empty())
-            .map(|(_, p)| (p.rays, time(p.rays as u32, &p.seconds)))
+            .filter(|p| !p.seconds.is_empty())
+            .map(|p| {
+                let t = match &self.rounds {
+                    None => median(&p.seconds),
+                    Some(rounds) => rounds.median(p.rays, &p.seconds),
+                };
+                (p.rays, t)
+            })
             .collect();
         Drawn {
             // A count whose every seed failed has no error and is left out of the curve, so
@@ -308,7 +338,7 @@ pub fn bootstrap(
         // Seeds pair across curves, and so do the rounds drawn at each count.
         let draw = Draw {
             seeds: seeds_drawn,
-            rounds: Some((Stream::new(seed ^ r, 0x0b00_7576, None), 0)),
+            rounds: Some(Rounds::over(Stream::new(seed ^ r, 0x0b00_7576, None), curves)),
         };
         let drawn: Vec<Drawn> = curves.iter().map(|c| draw.curve(c)).collect();
         values.extend(stat(&drawn).filter(|v| v.is_finite()));

@@ -6,7 +6,7 @@
 //! under this rule a rerun, a shard or another host of the same kind keeps the same setting
 //! unless a candidate is decidedly faster on one and not on the other.
 
-use super::interval::paired_ratio;
+use super::interval::{coverage, paired_ratio};
 use super::rule::Comparison;
 use super::Estimate;
 
@@ -33,7 +33,8 @@ pub struct Kept {
 /// The candidate to keep among `times` (one series of per-round times per candidate, all timed
 /// in the same interleaved rounds; the first is the default), walking them in listed order: a
 /// candidate replaces the one kept so far only where the rule calls it *faster*. A candidate
-/// whose rounds do not pair with the default's (a failed timing) is never kept.
+/// whose rounds do not pair with the default's (a failed timing), or that has too few rounds for
+/// a 95 % interval (under six), is never kept.
 pub fn keep(times: &[Vec<f64>]) -> Kept {
     assert!(!times.is_empty(), "at least the default is timed");
     let mut index = 0;
@@ -47,7 +48,8 @@ pub fn keep(times: &[Vec<f64>]) -> Kept {
         word: None,
     }];
     for (i, t) in times.iter().enumerate().skip(1) {
-        let ratio = if t.len() == times[index].len() && !t.is_empty() {
+        // Fewer rounds than a 95 % interval needs give no word (three give [min, max]: 75 %).
+        let ratio = if t.len() == times[index].len() && !t.is_empty() && coverage(t.len()) >= 0.95 {
             paired_ratio(t, &times[index])
         } else {
             Estimate::NAN
@@ -117,8 +119,13 @@ mod tests {
     fn an_unpaired_or_single_round_candidate_is_undecided_and_never_kept() {
         let k = keep(&[series(1.0, 9, 0), series(0.5, 8, 1)]);
         assert_eq!((k.index, k.considered[1].word), (0, Some(Comparison::Undecided)));
-        // One round: no interval, so no word, however large the difference.
+        // One round, or three (a [min, max] interval covers 75 %): no word, however large the
+        // difference.
         let k = keep(&[vec![1.0], vec![0.1]]);
         assert_eq!((k.index, k.considered[1].word), (0, Some(Comparison::Undecided)));
+        let k = keep(&[series(1.0, 3, 0), series(0.5, 3, 1)]);
+        assert_eq!((k.index, k.considered[1].word), (0, Some(Comparison::Undecided)));
+        let k = keep(&[series(1.0, 6, 0), series(0.5, 6, 1)]);
+        assert_eq!((k.index, k.considered[1].word), (1, Some(Comparison::Faster)));
     }
 }

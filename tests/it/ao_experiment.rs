@@ -86,7 +86,11 @@ fn the_ci_experiment_writes_its_outputs_and_every_structure_agrees() {
         );
     }
     let tables = common::assert_tidy_tables(&out);
-    assert_eq!(tables.len(), 3, "ao.csv, rounds.csv and tuning.csv: {tables:?}");
+    assert_eq!(
+        tables.len(),
+        4,
+        "ao.csv, rounds.csv, tuning.csv and tuning_rounds.csv: {tables:?}"
+    );
     // Every timed frame is committed: each row's median and interval recompute from rounds.csv.
     let mut rounds = csv::Reader::from_path(out.join("rounds.csv")).unwrap();
     let rh = rounds.headers().unwrap().clone();

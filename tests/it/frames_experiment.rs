@@ -54,7 +54,7 @@ fn random_cameras_and_tuning_keep_one_candidate_and_draw_seeded_independent_fram
         )
         .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]")
         .replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]")
-            + "\n[accel.kdtree]\nmax_depth = [8, 20]\n\n[tuning]\ncameras = 2\nrepeats = 3\n"
+            + "\n[accel.kdtree]\nmax_depth = [8, 20]\n\n[tuning]\ncameras = 2\nrepeats = 6\n"
     };
     let dir = tempfile::tempdir().unwrap();
     let (header, rows, report) = run(dir.path(), &tuned(7));
@@ -136,7 +136,11 @@ fn the_ci_walkthrough_renders_every_frame_identically_with_every_structure() {
     let col = |name: &str| common::column(&header, name);
     assert_eq!(rows.len(), 2 * 3 * 5, "2 shadings x 3 frames x 5 structures");
     let tables = common::assert_tidy_tables(&dir.path().join("out"));
-    assert_eq!(tables.len(), 3, "frames.csv, builds.csv and summary.csv: {tables:?}");
+    assert_eq!(
+        tables.len(),
+        4,
+        "frames.csv, rounds.csv, builds.csv and summary.csv: {tables:?}"
+    );
     let builds = std::fs::read_to_string(dir.path().join("out/builds.csv")).unwrap();
     assert!(
         builds.starts_with("triangles,structure,bvh_preset,") && builds.contains("\n51224,vlf,,3,32,4,uniform,32,,,"),

@@ -250,58 +250,181 @@ fn a_filter_keeps_its_value_after_another_axis_thins_the_list() {
     ]);
 }
 
-/// `--tuning` takes the settings a whole run kept: shards given the whole run's tuning.csv, and
-/// their merge, build the same structures, so every column but the clock's equals the whole
-/// run's (the real ao-ci file, whose kd-trees and field have candidates timed against each
-/// other); the reused settings carry the word `reused`. A kind that tunes nothing, a file kept
-/// for another candidate grid and a missing file are refused as bad input.
+/// `path`'s tuning.csv with `chosen` moved, on the rows of `scene` and `structure`, from the kept
+/// candidate to another, written to `to`: a choice the timing did not make, which only
+/// `--tuning` can bring about. Returns the parameter column and value now kept.
+fn choose_another(
+    path: &Path,
+    to: &Path,
+    (scene_column, scene, structure): (&str, &str, &str),
+    column: &str,
+) -> String {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let at = |name: &str| headers.iter().position(|h| h == name).unwrap();
+    let mut rows: Vec<Vec<String>> = reader
+        .records()
+        .map(|r| r.unwrap().iter().map(str::to_string).collect())
+        .collect();
+    let mine: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i][at(scene_column)] == scene && rows[i][at("structure")] == structure)
+        .collect();
+    assert!(mine.len() >= 2, "{structure} on {scene}: no candidates to move to");
+    let kept = *mine.iter().find(|&&i| rows[i][at("chosen")] == "true").unwrap();
+    let other = *mine.iter().find(|&&i| i != kept).unwrap();
+    rows[kept][at("chosen")] = "false".into();
+    rows[other][at("chosen")] = "true".into();
+    let mut w = csv::Writer::from_path(to).unwrap();
+    w.write_record(&headers).unwrap();
+    for r in &rows {
+        w.write_record(r).unwrap();
+    }
+    w.flush().unwrap();
+    rows[other][at(column)].clone()
+}
+
+/// The rows of a table whose `column` equals `value`, by another `column2` value.
+fn column_values(path: &Path, filter: (&str, &str), column: &str) -> Vec<String> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    let at = |name: &str| headers.iter().position(|h| h == name).unwrap();
+    reader
+        .records()
+        .map(Result::unwrap)
+        .filter(|r| &r[at(filter.0)] == filter.1)
+        .map(|r| r[at(column)].to_string())
+        .collect()
+}
+
+/// `--tuning` builds what the file kept: given the whole run's tuning.csv (copied out of its
+/// folder), two shards and their merge equal the whole run in every column but the clock's; given
+/// a copy with one choice moved to a candidate the timing did not keep, shards and merge build
+/// that one (so the file, not a second timing, decides). The reused settings carry the word
+/// `reused` and nothing timed. `experiment` is a variant whose `scene`-column `scene` tunes
+/// `structure` over `column`; `table` is its table of rows with parameters.
+fn tuning_file_decides_what_shards_build(
+    experiment: &Path,
+    (scene_column, scene, structure, column): (&str, &str, &str, &str),
+    table: &str,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = experiment.as_os_str();
+    let at = |name: &str| dir.path().join(name);
+    let out = |p: &Path| -> [OsString; 2] { ["--out".into(), p.into()] };
+    let [o, f] = out(&at("full"));
+    run_ok(&[exp, &o, &f]);
+    let rounds = std::fs::read_to_string(at("full/tuning_rounds.csv")).unwrap();
+    assert!(rounds.lines().count() > 1, "no tuning rounds:\n{rounds}");
+    let same = at("kept.csv");
+    std::fs::copy(at("full/tuning.csv"), &same).unwrap();
+    let moved = at("moved.csv");
+    let value = choose_another(&same, &moved, (scene_column, scene, structure), column);
+    let sharded = |name: &str, tuning: &Path| -> PathBuf {
+        let [o, s] = out(&at(name));
+        for extra in [["--shard", "1/2"], ["--shard", "2/2"], ["--merge", "2"]] {
+            let args: Vec<&OsStr> = vec![
+                exp,
+                &o,
+                &s,
+                OsStr::new("--tuning"),
+                tuning.as_os_str(),
+                OsStr::new(extra[0]),
+                OsStr::new(extra[1]),
+            ];
+            run_ok(&args);
+        }
+        at(name)
+    };
+    let kept = sharded("same", &same);
+    assert!(
+        common::without_clock(&at("full").join(table)) == common::without_clock(&kept.join(table)),
+        "{table} of the shards given the whole run's tuning differs from the whole run's"
+    );
+    let tuning = std::fs::read_to_string(kept.join("tuning.csv")).unwrap();
+    assert!(tuning.lines().skip(1).all(|l| l.contains(",reused,")), "{tuning}");
+    assert!(!kept.join("tuning_rounds.csv").exists(), "nothing was timed for tuning");
+    let other = sharded("moved", &moved);
+    let built = column_values(&other.join(table), (scene_column, scene), column);
+    let mine: Vec<&String> = built.iter().filter(|v| !v.is_empty()).collect();
+    assert!(
+        !mine.is_empty() && mine.iter().all(|v| **v == value),
+        "{column}: {built:?}, the file keeps {value}"
+    );
+    let whole = column_values(&at("full").join(table), (scene_column, scene), column);
+    assert_ne!(whole, built, "the moved choice built what the whole run built");
+}
+
 #[test]
-fn shards_given_the_whole_runs_tuning_build_and_count_what_it_built() {
+fn ao_shards_given_a_tuning_file_build_what_it_kept() {
     let dir = tempfile::tempdir().unwrap();
     let exp = variant(dir.path(), "experiments/ao-ci.toml", |t| {
         t.replace("name = \"ao-ci\"", "name = \"ao-ci-tuned\"")
     });
-    let exp = exp.as_os_str();
-    let (full, sharded) = (dir.path().join("full"), dir.path().join("sharded"));
-    let out = |p: &Path| -> [OsString; 2] { ["--out".into(), p.into()] };
-    let [o, f] = out(&full);
-    run_ok(&[exp, &o, &f]);
-    let tuning = full.join("tuning.csv");
-    let rounds = std::fs::read_to_string(full.join("tuning_rounds.csv")).unwrap();
-    assert!(rounds.lines().count() > 1, "no tuning rounds:\n{rounds}");
-    let [o, s] = out(&sharded);
-    let with_tuning = |extra: &[&OsStr]| {
-        let mut args: Vec<&OsStr> = vec![exp, &o, &s, OsStr::new("--tuning"), tuning.as_os_str()];
-        args.extend_from_slice(extra);
-        run_ok(&args);
-    };
-    with_tuning(&[OsStr::new("--shard"), OsStr::new("1/2")]);
-    with_tuning(&[OsStr::new("--shard"), OsStr::new("2/2")]);
-    with_tuning(&[OsStr::new("--merge"), OsStr::new("2")]);
-    assert!(
-        common::without_clock(&full.join("ao.csv")) == common::without_clock(&sharded.join("ao.csv")),
-        "ao.csv of the shards given the whole run's tuning differs from the whole run's"
-    );
-    let kept = std::fs::read_to_string(sharded.join("tuning.csv")).unwrap();
-    let whole_kept = std::fs::read_to_string(&tuning).unwrap();
-    let chosen = |text: &str| text.lines().filter(|l| l.ends_with(",true")).count();
-    assert_eq!(chosen(&kept), chosen(&whole_kept), "{kept}");
-    assert!(kept.lines().skip(1).all(|l| l.contains(",reused,")), "{kept}");
+    tuning_file_decides_what_shards_build(&exp, ("mesh", "cow", "vlf", "vlf_depth"), "ao.csv");
+}
 
-    // Refusals: exit 2, before anything is measured.
-    let [o, b] = out(&dir.path().join("bad"));
-    let fps = common::repo("experiments/fps-ci.toml");
-    let (code, err) = run(&[fps.as_os_str(), &o, &b, OsStr::new("--tuning"), tuning.as_os_str()]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("tune no structure"), "{err}");
-    let regrid = variant(dir.path(), "experiments/ao-ci.toml", |t| {
+#[test]
+fn frames_shards_given_a_tuning_file_build_what_it_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = variant(dir.path(), "experiments/frames-ci.toml", |t| {
+        t.replace(
+            "generator = \"classroom\"",
+            "generator = \"random-triangles\"\ntriangles = [300, 2400]\nseed = 5",
+        )
+        .replace("frames = 3", "frames = 2\nviewpoints = [\"outside\", \"inside\"]")
+        .replace("shadings = [\"opengl\", \"whitted\"]", "shadings = [\"opengl\"]")
+        .replace("tiles = 32\ndepth = 3", "tiles = 32\ndepth = [2, 3]")
+            + "\n[tuning]\ncameras = 1\nrepeats = 6\n"
+    });
+    tuning_file_decides_what_shards_build(&exp, ("triangles", "2400", "vlf", "vlf_depth"), "builds.csv");
+}
+
+/// Refusals of `--tuning`, exit 2 before anything is measured: a kind that tunes nothing, a file
+/// kept for another candidate grid, a file inside the results folder the run replaces, a missing
+/// file.
+#[test]
+fn bad_tuning_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = variant(dir.path(), "experiments/ao-ci.toml", |t| {
+        t.replace("name = \"ao-ci\"", "name = \"ao-ci-tuned\"")
+    });
+    let full = dir.path().join("full");
+    run_ok(&[exp.as_os_str(), OsStr::new("--out"), full.as_os_str()]);
+    let tuning = dir.path().join("kept.csv");
+    std::fs::copy(full.join("tuning.csv"), &tuning).unwrap();
+    let bad = dir.path().join("bad");
+    let refused = |experiment: &Path, file: &Path, out: &Path, says: &str| {
+        let (code, err) = run(&[
+            experiment.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+            OsStr::new("--tuning"),
+            file.as_os_str(),
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(says), "{err}");
+    };
+    refused(
+        &common::repo("experiments/fps-ci.toml"),
+        &tuning,
+        &bad,
+        "tune no structure",
+    );
+    let other = dir.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    let regrid = variant(&other, "experiments/ao-ci.toml", |t| {
         t.replace("depth = [2, 4]", "depth = [1, 3]")
     });
-    let (code, err) = run(&[regrid.as_os_str(), &o, &b, OsStr::new("--tuning"), tuning.as_os_str()]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("not among the experiment's candidates"), "{err}");
-    let missing = dir.path().join("none.csv");
-    let (code, err) = run(&[exp, &o, &b, OsStr::new("--tuning"), missing.as_os_str()]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("none.csv") && err.contains("cannot read"), "{err}");
+    refused(&regrid, &tuning, &bad, "not among the experiment's candidates");
+    refused(
+        &exp,
+        &full.join("tuning.csv"),
+        &full,
+        "lies in the results folder this run replaces",
+    );
+    refused(&exp, &dir.path().join("none.csv"), &bad, "cannot read");
+    assert!(
+        full.join("tuning_rounds.csv").exists(),
+        "a refused run left the earlier results"
+    );
 }

@@ -90,6 +90,14 @@ fn check(folder: &Path, t: Times, id: &[&str], control: Option<&str>) -> (usize,
     let (mut checked, mut problems) = (0, Vec::new());
     for r in rows(&folder.join(table)) {
         let Some(s) = series.get(&key(&r, id)) else {
+            // A row with a time must have the rounds it came from.
+            if !r[t.columns[0]].is_empty() {
+                problems.push(format!(
+                    "{}/{table} {}: a time without rounds",
+                    folder.display(),
+                    key(&r, id)
+                ));
+            }
             continue;
         };
         let e = median_interval(s);
@@ -116,7 +124,7 @@ const SWEEP: &[&str] = &["scheme", "pattern", "samples", "light_radius", "lights
 fn check_tuning(folder: &Path, scene: &str) -> (usize, Vec<String>) {
     let t = Times {
         rounds: "tuning_rounds.csv",
-        column: "seconds",
+        column: "time_s",
         table: "tuning.csv",
         columns: if scene == "mesh" {
             FRAME
@@ -139,6 +147,10 @@ fn check_tuning(folder: &Path, scene: &str) -> (usize, Vec<String>) {
             .map(|r| by_round.get(&key(r, &rounds_id)).cloned().unwrap_or_default())
             .collect();
         if times.iter().any(Vec::is_empty) {
+            problems.push(format!(
+                "{}/tuning.csv {structure}: a candidate without rounds",
+                folder.display()
+            ));
             continue;
         }
         for (r, s) in candidates.iter().zip(&times) {
@@ -156,7 +168,11 @@ fn check_tuning(folder: &Path, scene: &str) -> (usize, Vec<String>) {
         let kept = keep(&times);
         for (i, (r, c)) in candidates.iter().zip(&kept.considered).enumerate() {
             let (word, chosen) = (considered_word(c), (i == kept.index).to_string());
-            if r["word"] != word || r["chosen"] != chosen || r["candidate"] != i.to_string() {
+            if r["word"] != word
+                || r["chosen"] != chosen
+                || r["candidate"] != i.to_string()
+                || r["against"] != c.against.to_string()
+            {
                 problems.push(format!(
                     "{}/tuning.csv {structure} candidate {i}: word {} chosen {} but its rounds give {word} {chosen}",
                     folder.display(),
@@ -225,8 +241,11 @@ fn committed_times_recompute_from_their_rounds() {
         "ao",
         "ao/tuning",
         "ao-bundles",
+        "ao-bundles/tuning",
         "ao-bundles-gpu",
+        "ao-bundles-gpu/tuning",
         "walkthrough",
+        "walkthrough/tuning",
         "scaling",
         "scaling/tuning",
         "dynamic",

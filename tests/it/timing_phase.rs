@@ -241,7 +241,7 @@ fn frame_rates_are_timed_in_interleaved_rounds() {
     let out = dir.path().join("out");
     let adapter = backend.adapter().clone();
     penumbra::experiment::fps::report::write_fps(&spec, &rows, &adapter, 1.0, &out).unwrap();
-    assert_eq!(common::assert_tidy_tables(&out).len(), 1);
+    assert_eq!(common::assert_tidy_tables(&out).len(), 2, "fps.csv and rounds.csv");
     let header = std::fs::read_to_string(out.join("fps.csv")).unwrap();
     assert!(header.starts_with("scene,lights,width,height,samples,timed_frames,frame_s,frame_s_lo,frame_s_hi,frames_per_s,paper_frames_per_s,"), "{header}");
     assert!(out.join("plots/fps.svg").is_file());

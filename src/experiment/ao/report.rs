@@ -84,8 +84,8 @@ struct Tuned<'a> {
 /// ([`crate::experiment::tuning::Verdict`]).
 #[derive(Serialize)]
 struct Candidate<'a> {
-    nodes_visited: u64,
-    primitive_tests: u64,
+    nodes_visited: Option<u64>,
+    primitive_tests: Option<u64>,
     candidate: usize,
     against: usize,
     word: &'a str,
@@ -208,6 +208,11 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     out
 }
 
+/// Whether a tuning candidate was timed here (not taken from `--tuning`).
+fn timed(t: &TuningRow) -> bool {
+    t.verdict.word != REUSED
+}
+
 /// Writes ao.csv, tuning.csv, images/, plots/frame_time.png, report.md and index.html into `outputs`
 /// (each path checked to stay in it: mesh names become file names).
 pub fn write_ao(
@@ -232,8 +237,8 @@ pub fn write_ao(
                     ParameterColumns::of(&t.settings),
                     t.frame.columns(FRAME_S),
                     Candidate {
-                        nodes_visited: t.work.nodes,
-                        primitive_tests: t.work.primitives,
+                        nodes_visited: timed(t).then_some(t.work.nodes),
+                        primitive_tests: timed(t).then_some(t.work.primitives),
                         candidate: t.verdict.candidate,
                         against: t.verdict.against,
                         word: &t.verdict.word,
@@ -242,10 +247,12 @@ pub fn write_ao(
                 )
             }),
         )?;
-        write_rows(
-            &out("tuning_rounds.csv")?,
-            tuning.iter().flat_map(|t| round_rows(&t.mesh, t.structure, &t.verdict)),
-        )?;
+        if tuning.iter().any(timed) {
+            write_rows(
+                &out("tuning_rounds.csv")?,
+                tuning.iter().flat_map(|t| round_rows(&t.mesh, t.structure, &t.verdict)),
+            )?;
+        }
     }
     let csv = rows.iter().map(|r| -> CsvRow {
         (

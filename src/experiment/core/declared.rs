@@ -23,6 +23,23 @@ use crate::experiment::progress::Progress;
 use crate::render::Backend;
 use std::path::{Path, PathBuf};
 
+/// Refuses a `--tuning` file inside the results folder `home`, which this run (or the merge of
+/// its shards) replaces: the file it builds from would be overwritten by its own output.
+fn refuse_tuning_inside(path: &Path, home: &Path) -> Result<(), BadInput> {
+    let (Ok(file), Ok(home)) = (path.canonicalize(), home.canonicalize()) else {
+        return Ok(());
+    };
+    if file.starts_with(&home) {
+        return Err(BadInput(format!(
+            "--tuning {}: the file lies in the results folder this run replaces ({}); copy it out first (e.g. `cp {} tuning-kept.csv`) and pass the copy",
+            path.display(),
+            home.display(),
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
 /// A declared kind as an experiment.
 pub struct Declared<D>(pub D);
 
@@ -176,6 +193,7 @@ impl<D: Declaration> Experiment for Declared<D> {
     fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
         let mut spec = self.filtered(&run.cli.filter)?;
         if let Some(path) = &run.cli.tuning {
+            refuse_tuning_inside(path, run.home)?;
             spec.reuse_tuning(path).map_err(BadInput)?;
         }
         spec.keep_state_in(run.home);

@@ -244,6 +244,9 @@ pub fn rerun_command(cli: &Cli) -> String {
     for f in &cli.filter {
         words.extend(["--filter".into(), f.to_string()]);
     }
+    if let Some(t) = &cli.tuning {
+        words.extend(["--tuning".into(), t.display().to_string()]);
+    }
     words.push("--shard".into());
     words.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" ")
 }

@@ -32,8 +32,9 @@ pub struct FramesTuning {
     /// Tuning cameras drawn per viewpoint.
     #[serde(default = "two")]
     pub cameras: u32,
-    /// Interleaved rounds per candidate.
-    #[serde(default = "three")]
+    /// Interleaved rounds per candidate: at least six, the fewest whose order-statistic
+    /// interval covers 95 % (the rule's words need it, [`crate::timing::tuning::keep`]).
+    #[serde(default = "six")]
     pub repeats: u32,
     /// Seed of the tuning cameras' draws.
     #[serde(default = "tuning_seed")]
@@ -44,7 +45,7 @@ impl Default for FramesTuning {
     fn default() -> Self {
         FramesTuning {
             cameras: two(),
-            repeats: three(),
+            repeats: six(),
             seed: tuning_seed(),
         }
     }
@@ -54,8 +55,8 @@ fn two() -> u32 {
     2
 }
 
-fn three() -> u32 {
-    3
+fn six() -> u32 {
+    6
 }
 
 /// The tuning cameras' seed when the file gives none: apart from any `[path] seed` a file is
@@ -81,11 +82,11 @@ impl FramesTuning {
                 format!("tuning cameras per viewpoint: must be in 1..={MAX_TUNING_CAMERAS}"),
             ));
         }
-        if !(3..=crate::experiment::header::MAX_REPEATS).contains(&tuning.repeats) {
+        if !(6..=crate::experiment::header::MAX_REPEATS).contains(&tuning.repeats) {
             return Err(err(
                 &key_path!["tuning", "repeats"],
                 format!(
-                    "must be in 3..={} (the rounds behind each candidate's median and its interval)",
+                    "must be in 6..={} (the rounds behind each candidate's median and its 95 % interval: fewer cannot give one)",
                     crate::experiment::header::MAX_REPEATS
                 ),
             ));
@@ -97,15 +98,15 @@ impl FramesTuning {
                     .into(),
             ));
         }
-        // Tuning picks by time, once per unit; blocks of one scene may run on different
-        // machines, so their picks could differ and one scene's frames would mix settings.
+        // Tuning times candidates once per unit; blocks of one scene may run on different
+        // machines, so what they keep could differ and one scene's frames would mix settings.
         if let (Some(_), Some(listed)) = (block, candidates.iter().find(|c| c.len() > 1)) {
             return Err(err(
                 &key_path!["path", "block"],
                 format!(
-                    "`{}` lists {} candidates to tune, and tuning picks by time once per unit: blocks of one scene \
-                 (which may run on different machines) could pick differently; give `[accel.{}]` one value \
-                 per key (an unblocked run's tuning.csv says which is fastest) or remove `block`",
+                    "`{}` lists {} candidates to tune, and tuning times them once per unit: blocks of one scene \
+                 (which may run on different machines) could keep different ones; give `[accel.{}]` one value \
+                 per key (an unblocked run's tuning.csv says which it kept) or remove `block`",
                     listed[0].name,
                     listed.len(),
                     listed[0].name

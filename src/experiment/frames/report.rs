@@ -118,12 +118,17 @@ struct BuildTime {
 /// ([`crate::experiment::tuning::Verdict`]).
 #[derive(Serialize)]
 struct TuningWork<'a> {
-    nodes_visited: u64,
-    primitive_tests: u64,
+    nodes_visited: Option<u64>,
+    primitive_tests: Option<u64>,
     candidate: usize,
     against: usize,
     word: &'a str,
     chosen: bool,
+}
+
+/// Whether a tuning candidate was timed here (not taken from `--tuning`).
+fn timed(t: &super::tuning::TuningRow) -> bool {
+    t.verdict.word != REUSED
 }
 
 /// Writes frames.csv, builds.csv, tuning.csv (where a structure was tuned), plots/, images/, report.md and index.html under `out`.
@@ -219,8 +224,8 @@ pub fn write_frames(
                     },
                     t.seconds.columns(TUNING_S),
                     TuningWork {
-                        nodes_visited: t.work.nodes,
-                        primitive_tests: t.work.primitives,
+                        nodes_visited: timed(t).then_some(t.work.nodes),
+                        primitive_tests: timed(t).then_some(t.work.primitives),
                         candidate: t.verdict.candidate,
                         against: t.verdict.against,
                         word: &t.verdict.word,
@@ -229,13 +234,15 @@ pub fn write_frames(
                 )
             }),
         )?;
-        write_rows(
-            &out.join("tuning_rounds.csv"),
-            outcome
-                .tuning
-                .iter()
-                .flat_map(|(_, t)| round_rows(&t.scene, t.structure, &t.verdict)),
-        )?;
+        if outcome.tuning.iter().any(|(_, t)| timed(t)) {
+            write_rows(
+                &out.join("tuning_rounds.csv"),
+                outcome
+                    .tuning
+                    .iter()
+                    .flat_map(|(_, t)| round_rows(&t.scene, t.structure, &t.verdict)),
+            )?;
+        }
     }
     let summaries = summarise(spec, outcome);
     write_rows(&out.join("summary.csv"), summaries.iter().map(Summary::row))?;
