@@ -25,6 +25,23 @@ pub struct Verdict {
 /// The word a candidate kept from `--tuning FILE` carries.
 pub const REUSED: &str = "reused";
 
+impl Verdict {
+    /// Candidate `candidate`, kept by `--tuning` and not timed.
+    pub fn reused(candidate: usize) -> Verdict {
+        Verdict {
+            candidate,
+            against: candidate,
+            word: REUSED.into(),
+            rounds: vec![],
+        }
+    }
+
+    /// Whether it was timed here (not taken from `--tuning`).
+    pub fn timed(&self) -> bool {
+        self.word != REUSED
+    }
+}
+
 /// One verdict per candidate of `kept`, with the rounds timed (`times`, one series per candidate).
 pub fn verdicts(kept: &Kept, times: Vec<Vec<f64>>) -> Vec<Verdict> {
     kept.considered

@@ -208,11 +208,6 @@ pub fn verdict(spec: &AoSpec, rows: &[AoRow]) -> String {
     out
 }
 
-/// Whether a tuning candidate was timed here (not taken from `--tuning`).
-fn timed(t: &TuningRow) -> bool {
-    t.verdict.word != REUSED
-}
-
 /// Writes ao.csv, tuning.csv, images/, plots/frame_time.png, report.md and index.html into `outputs`
 /// (each path checked to stay in it: mesh names become file names).
 pub fn write_ao(
@@ -237,8 +232,8 @@ pub fn write_ao(
                     ParameterColumns::of(&t.settings),
                     t.frame.columns(FRAME_S),
                     Candidate {
-                        nodes_visited: timed(t).then_some(t.work.nodes),
-                        primitive_tests: timed(t).then_some(t.work.primitives),
+                        nodes_visited: t.verdict.timed().then_some(t.work.nodes),
+                        primitive_tests: t.verdict.timed().then_some(t.work.primitives),
                         candidate: t.verdict.candidate,
                         against: t.verdict.against,
                         word: &t.verdict.word,
@@ -247,7 +242,7 @@ pub fn write_ao(
                 )
             }),
         )?;
-        if tuning.iter().any(timed) {
+        if tuning.iter().any(|t| t.verdict.timed()) {
             write_rows(
                 &out("tuning_rounds.csv")?,
                 tuning.iter().flat_map(|t| round_rows(&t.mesh, t.structure, &t.verdict)),

@@ -12,7 +12,7 @@ use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::{AccelSettings, Issue};
 use crate::experiment::progress::Progress;
-use crate::experiment::tuning::{verdicts, Verdict, REUSED};
+use crate::experiment::tuning::{verdicts, Verdict};
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
 use crate::scene::ambient::AmbientOcclusion;
@@ -105,6 +105,7 @@ pub struct TuningRow {
     /// Whether this candidate was kept.
     pub chosen: bool,
 }
+
 /// The AO frames' sampling (the grid needs none; fixed for the record).
 const SAMPLING: Sampling = Sampling {
     scheme: DiskScheme::Uniform,
@@ -171,12 +172,7 @@ fn tune(
             settings: kept.clone(),
             frame: Estimate::NAN,
             work: Work::ZERO,
-            verdict: Verdict {
-                candidate,
-                against: candidate,
-                word: REUSED.into(),
-                rounds: vec![],
-            },
+            verdict: Verdict::reused(candidate),
             chosen: true,
         };
         return Ok((kept.clone(), vec![row]));

@@ -126,11 +126,6 @@ struct TuningWork<'a> {
     chosen: bool,
 }
 
-/// Whether a tuning candidate was timed here (not taken from `--tuning`).
-fn timed(t: &super::tuning::TuningRow) -> bool {
-    t.verdict.word != REUSED
-}
-
 /// Writes frames.csv, builds.csv, tuning.csv (where a structure was tuned), plots/, images/, report.md and index.html under `out`.
 pub fn write_frames(
     spec: &FramesSpec,
@@ -224,8 +219,8 @@ pub fn write_frames(
                     },
                     t.seconds.columns(TUNING_S),
                     TuningWork {
-                        nodes_visited: timed(t).then_some(t.work.nodes),
-                        primitive_tests: timed(t).then_some(t.work.primitives),
+                        nodes_visited: t.verdict.timed().then_some(t.work.nodes),
+                        primitive_tests: t.verdict.timed().then_some(t.work.primitives),
                         candidate: t.verdict.candidate,
                         against: t.verdict.against,
                         word: &t.verdict.word,
@@ -234,7 +229,7 @@ pub fn write_frames(
                 )
             }),
         )?;
-        if outcome.tuning.iter().any(|(_, t)| timed(t)) {
+        if outcome.tuning.iter().any(|(_, t)| t.verdict.timed()) {
             write_rows(
                 &out.join("tuning_rounds.csv"),
                 outcome

@@ -14,7 +14,7 @@ use super::spec::{FramesSpec, Generator, ShadingName, SAMPLING};
 use crate::accel::settings::{registry_name, RegistryName};
 use crate::accel::work::Work;
 use crate::accel::AccelSettings;
-use crate::experiment::tuning::{verdicts, Verdict, REUSED};
+use crate::experiment::tuning::{verdicts, Verdict};
 use crate::render::{Backend, View};
 use crate::scene::camera::Camera;
 use crate::scene::procedural::{classroom, random, Generated};
@@ -112,12 +112,7 @@ pub fn tune(
                 seconds: Estimate::NAN,
                 work: Work::ZERO,
                 build_seconds: f64::NAN,
-                verdict: Verdict {
-                    candidate,
-                    against: candidate,
-                    word: REUSED.into(),
-                    rounds: vec![],
-                },
+                verdict: Verdict::reused(candidate),
                 chosen: true,
             });
             chosen.push(kept.clone());
