@@ -6,8 +6,9 @@
 # answers) and writes, per word of the committed report results/NAME/report.md, in how many of
 # the K reruns the same place held the same word:
 #
-#   scripts/stability.sh NAME K
+#   scripts/stability.sh [--reuse] NAME K
 #
+# --reuse compares the K runs already in target/stability/NAME instead of running them again.
 # Output: target/stability/NAME/stability.csv (place, committed word, words of the reruns,
 # held), copied to results/NAME-stability.csv (a plain file beside the folder, which holds only
 # what the binary writes) with the host and commit in target/stability/NAME/host.txt, and a
@@ -17,8 +18,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 
+reuse=false
+if [[ ${1:-} == --reuse ]]; then
+    reuse=true
+    shift
+fi
 if [[ $# -ne 2 || ! $2 =~ ^[1-9][0-9]*$ ]]; then
-    echo "usage: $0 NAME K   (K >= 1 reruns of experiments/NAME.toml)" >&2
+    echo "usage: $0 [--reuse] NAME K   (K >= 1 reruns of experiments/NAME.toml)" >&2
     exit 2
 fi
 name=$1
@@ -30,19 +36,21 @@ committed=results/$name/report.md
 
 out=target/stability/$name
 mkdir -p "$out"
-cargo build --release --bin sweep
-for k in $(seq 1 "$runs"); do
-    echo "run $k of $runs" >&2
-    target/release/sweep "$experiment" --fresh --out "$out/run-$k" -q
-done
+if ! $reuse; then
+    cargo build --release --bin sweep
+    for k in $(seq 1 "$runs"); do
+        echo "run $k of $runs" >&2
+        target/release/sweep "$experiment" --fresh --out "$out/run-$k" -q
+    done
+fi
 
-# Every word with its place: the section it sits under (the last heading or bold line) and,
-# in a table, the row's first cell and the column's header; outside tables, the word's order
-# in the section.
+# Every word with its place: the section it sits under (the last heading or bold line, without
+# the times a heading states, which differ from run to run) and, in a table, the row's first
+# cell and the column's header; outside tables, the word's order in the section.
 words() {
     awk '
         function trim(s) { gsub(/^[ \t*]+|[ \t*]+$/, "", s); return s }
-        /^#+ / { section = $0; n = 0; header = ""; next }
+        /^#+ / { section = $0; gsub(/,? *[0-9.]+ ms \[[^]]*\]/, "", section); n = 0; header = ""; next }
         /^\*\*[^|]*\*\*/ && !/^\*\*Answer/ { section = $0; sub(/ \(.*$/, "", section); n = 0; header = ""; next }
         /^\|/ {
             cells = split($0, c, "|")
