@@ -36,6 +36,19 @@ struct FrameOf<'a> {
     frame: u32,
 }
 
+impl<'a> FrameOf<'a> {
+    fn of(r: &'a FrameRow) -> FrameOf<'a> {
+        FrameOf {
+            triangles: r.triangles,
+            structure: r.structure,
+            update: r.update,
+            shading: r.shading.name(),
+            viewpoint: &r.viewpoint,
+            frame: r.frame,
+        }
+    }
+}
+
 /// The columns after the frame time in frames.csv.
 #[derive(Serialize)]
 struct FrameCost {
@@ -74,17 +87,14 @@ struct BuildCost {
     memory_bytes: u64,
 }
 
-/// A row of rounds.csv: one timed render of one frame and structure, in round order, so every
-/// frame's median and interval in frames.csv, and every per-frame ratio, recomputes from
-/// committed numbers.
+/// A row of rounds.csv: one timed render of one frame and structure ([`FrameOf`]), in round
+/// order, so every frame's median and interval in frames.csv, and every per-frame ratio,
+/// recomputes from committed numbers.
+type RoundCsv<'a> = (FrameOf<'a>, Round);
+
+/// The columns after the frame in rounds.csv.
 #[derive(Serialize)]
-struct RoundCsv<'a> {
-    triangles: usize,
-    structure: &'a str,
-    update: &'a str,
-    shading: &'a str,
-    viewpoint: &'a str,
-    frame: u32,
+struct Round {
     round: usize,
     #[serde(with = "float")]
     frame_s: f64,
@@ -141,14 +151,7 @@ pub fn write_frames(
         &out.join("frames.csv"),
         rows.iter().map(|r| -> FrameCsv {
             (
-                FrameOf {
-                    triangles: r.triangles,
-                    structure: r.structure,
-                    update: r.update,
-                    shading: r.shading.name(),
-                    viewpoint: &r.viewpoint,
-                    frame: r.frame,
-                },
+                FrameOf::of(r),
                 Estimate {
                     median: r.seconds,
                     ..median_interval(&r.renders)
@@ -174,16 +177,10 @@ pub fn write_frames(
     write_rows(
         &out.join("rounds.csv"),
         rows.iter().flat_map(|r| {
-            r.renders.iter().enumerate().map(move |(round, &frame_s)| RoundCsv {
-                triangles: r.triangles,
-                structure: r.structure,
-                update: r.update,
-                shading: r.shading.name(),
-                viewpoint: &r.viewpoint,
-                frame: r.frame,
-                round,
-                frame_s,
-            })
+            r.renders
+                .iter()
+                .enumerate()
+                .map(move |(round, &frame_s)| -> RoundCsv { (FrameOf::of(r), Round { round, frame_s }) })
         }),
     )?;
     write_rows(
