@@ -33,13 +33,11 @@ const AA_EQUAL: f64 = 0.95;
 /// that changes it fails here until someone looks again; a listed cell that reaches [`POWER`],
 /// and any unlisted cell below it, fail too.
 ///
-/// Three in the committed frames: inside the scene at 4K against obvhs' BVH2 and CWBVH and at
-/// 16K against the SAH kd-tree, where the per-frame speed-ups spread widely (MAD 0.12-0.23).
-const SHORTFALLS: &[(&str, f64)] = &[
-    ("scaling opengl 4000 inside bvh", 0.865),
-    ("scaling opengl 4000 inside cwbvh", 0.730),
-    ("scaling opengl 16000 inside kdtree-sah", 0.885),
-];
+/// None in the committed frames. An earlier regeneration of scaling had three (inside the
+/// scene at 4K against BVH2 and CWBVH, at 16K against the SAH kd-tree: MAD 0.12-0.23); the
+/// current one reaches full power everywhere, so a spread that wide is host noise a rerun can
+/// bring back, and this list is where it would be recorded.
+const SHORTFALLS: &[(&str, f64)] = &[];
 
 /// Per (shading, triangles, viewpoint), per structure, frame -> seconds.
 type Frames = BTreeMap<(String, usize, String), BTreeMap<String, BTreeMap<u32, f64>>>;
@@ -111,6 +109,7 @@ fn check(name: &str) {
     let mut worst = (f64::INFINITY, f64::INFINITY);
     let mut cells = 0;
     let mut short = Vec::new();
+    let mut recovered = Vec::new();
     for ((shading, triangles, viewpoint), by_structure) in committed_frames(name) {
         let ours = &by_structure[subject];
         for (other, theirs) in by_structure.iter().filter(|(s, _)| s.as_str() != subject) {
@@ -128,10 +127,9 @@ fn check(name: &str) {
             if power < POWER {
                 short.push((cell, power));
             } else {
-                assert!(
-                    listed.is_none(),
-                    "{cell}: listed as short of {POWER} but reaches {power:.3}"
-                );
+                if listed.is_some() {
+                    recovered.push(format!("{cell}: listed as short of {POWER} but reaches {power:.3}"));
+                }
                 worst.0 = worst.0.min(power);
             }
             worst.1 = worst.1.min(aa);
@@ -139,6 +137,7 @@ fn check(name: &str) {
         }
     }
     assert!(cells > 0, "{name}: no frames compared");
+    assert!(recovered.is_empty(), "{}", recovered.join("\n"));
     eprintln!(
         "{name}: {cells} cells and pairs, {n} frames each: least power {:.3} outside the listed shortfalls, least A/A equal {:.3}",
         worst.0, worst.1
