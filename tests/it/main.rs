@@ -34,6 +34,7 @@ mod realtime_experiment;
 mod receiver_masks;
 mod regression;
 mod render_plan;
+mod report_words;
 mod reproduction;
 mod results_fresh;
 mod rim_samples;
