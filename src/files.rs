@@ -79,9 +79,17 @@ pub fn read_regular(path: &Path) -> anyhow::Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// The text of the regular file `path` ([`open_regular`]).
+/// The text of the regular file `path` ([`open_regular`]); bytes that are not UTF-8 are refused
+/// naming the offset of the first.
 pub fn read_regular_text(path: &Path) -> anyhow::Result<String> {
-    String::from_utf8(read_regular(path)?).map_err(|_| anyhow::anyhow!("{}: not UTF-8 text", path.display()))
+    String::from_utf8(read_regular(path)?).map_err(|e| {
+        Refused(format!(
+            "{}: not UTF-8 text (byte {} starts an invalid sequence); refused",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        ))
+        .into()
+    })
 }
 
 /// Checks that `root`, if it exists, and everything under it are folders and regular files: no

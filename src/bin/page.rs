@@ -3,9 +3,10 @@
 //! or after the page changed. A fresh run writes a richer page (labels, table links, FLIP maps
 //! against each gallery's reference) than one rebuilt from file names. Exit status: 0 done, 2 a
 //! folder refused (no report.md; a link, pipe or device where its files or folders belong; an
-//! unreadable image), 1 else.
+//! unreadable image), 1 else (standard output closed or full included).
 
 use clap::Parser;
+use penumbra::experiment::cli::{print_out, report_error};
 use std::path::PathBuf;
 
 /// Rebuild results folders' comparison pages from their files.
@@ -20,8 +21,10 @@ struct Args {
 fn main() -> std::process::ExitCode {
     let args = Args::parse();
     for dir in &args.folders {
-        if let Err(e) = penumbra::output::page::rebuild(dir) {
-            eprintln!("error: {e:#}");
+        let written = penumbra::output::page::rebuild(dir)
+            .and_then(|()| print_out(&format!("wrote {}\n", dir.join("index.html").display())).map_err(Into::into));
+        if let Err(e) = written {
+            report_error(&e);
             // A folder whose files cannot be taken as they are is bad input (status 2).
             return if e.is::<penumbra::files::Refused>() {
                 std::process::ExitCode::from(2)
@@ -29,7 +32,6 @@ fn main() -> std::process::ExitCode {
                 std::process::ExitCode::FAILURE
             };
         }
-        println!("wrote {}", dir.join("index.html").display());
     }
     std::process::ExitCode::SUCCESS
 }

@@ -15,7 +15,7 @@ fn main() -> std::process::ExitCode {
     driver::init_logging(&cli);
     let result = driver::run(&cli);
     if let Err(e) = &result {
-        eprintln!("error: {e:#}");
+        penumbra::experiment::cli::report_error(e);
     }
     driver::exit_status(&result)
 }

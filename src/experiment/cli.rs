@@ -105,3 +105,32 @@ pub struct BadInput(pub String);
 #[derive(Debug, thiserror::Error)]
 #[error("{0} runs failed; {1}")]
 pub struct RunsFailed(pub usize, pub String);
+
+/// Standard output could not take what a command prints (a reader that closed its pipe, a full
+/// disk): the command ends with status 1 instead of a panic, quietly where the reader went away
+/// (`sweep --dry-run ... | head -1`).
+#[derive(Debug, thiserror::Error)]
+#[error("writing to standard output: {0}")]
+pub struct StdoutFailed(pub std::io::Error);
+
+/// Prints `text` on standard output and flushes it; a failure there is returned, not a panic.
+pub fn print_out(text: &str) -> Result<(), StdoutFailed> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(StdoutFailed)
+}
+
+/// Prints the error a command ends on to standard error where it can still be written there
+/// (a full or closed standard error loses the message, never the exit status), except a closed
+/// standard output, whose reader asked for no more.
+pub fn report_error(e: &anyhow::Error) {
+    use std::io::Write;
+    let reader_gone = e
+        .downcast_ref::<StdoutFailed>()
+        .is_some_and(|s| s.0.kind() == std::io::ErrorKind::BrokenPipe);
+    if !reader_gone {
+        let _ = writeln!(std::io::stderr(), "error: {e:#}");
+    }
+}

@@ -38,7 +38,7 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
         inputs.push(Input::read(&path).map_err(|e| BadInput(format!("{}: cannot read: {e}", path.display())))?);
     }
     if cli.dry_run {
-        print!("{}", experiment.dry_run(cli)?);
+        super::cli::print_out(&experiment.dry_run(cli)?)?;
         return Ok(());
     }
     // The folder's name checks the filters: a wrong one is refused here, before any folder or
@@ -195,7 +195,9 @@ pub fn init_logging(cli: &Cli) {
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
         .with_ansi(terminal)
-        .with_target(false);
+        .with_target(false)
+        // A full or closed standard error loses log lines, never the run: no fallback print.
+        .log_internal_errors(false);
     if terminal {
         builder.without_time().init();
     } else {

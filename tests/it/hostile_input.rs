@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Every file under `root` with its bytes.
-fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+pub(crate) fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![root.to_path_buf()];
     while let Some(dir) = stack.pop() {
@@ -33,14 +33,14 @@ fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 /// A scratch tree: `root/a/b/work` is the working folder (so `../../x` stays inside `root`),
 /// holding the experiment as `exp.toml` and earlier results of experiment `name` (of the kind
 /// the text declares) in `results/NAME`.
-struct Scratch {
+pub(crate) struct Scratch {
     _dir: tempfile::TempDir,
-    root: PathBuf,
-    work: PathBuf,
+    pub(crate) root: PathBuf,
+    pub(crate) work: PathBuf,
 }
 
 impl Scratch {
-    fn new(experiment: &str, name: &str) -> Scratch {
+    pub(crate) fn new(experiment: &str, name: &str) -> Scratch {
         let dir = tempfile::tempdir().unwrap();
         let root = dir.path().to_path_buf();
         let work = root.join("a/b/work");
@@ -55,7 +55,7 @@ impl Scratch {
     }
 
     /// Runs the binary in the working folder.
-    fn run(&self, args: &[&str]) -> (i32, String) {
+    pub(crate) fn run(&self, args: &[&str]) -> (i32, String) {
         self.run_with(args, &[])
     }
 
@@ -86,7 +86,7 @@ fn shipped(file: &str) -> String {
 }
 
 /// The tiny sweep (`common::tiny_experiment`) with its scene path made absolute.
-fn tiny() -> String {
+pub(crate) fn tiny() -> String {
     let dir = tempfile::tempdir().unwrap();
     let exp = common::tiny_experiment(dir.path(), |t| t);
     std::fs::read_to_string(exp).unwrap().replace(
@@ -996,8 +996,31 @@ fn output_within_a_minute(mut command: Command) -> (i32, String) {
     }
 }
 
+/// A small, well-formed EXR whose header declares a `side` x `side` image: its data and display
+/// windows rewritten (box2i: x min, y min, x max, y max), which a reader that trusts the header
+/// allocates for before it finds the pixels missing.
+fn exr_claiming(side: i32) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("small.exr");
+    penumbra::output::images::write_exr(&path, &[0.5; 16], 4, 4).unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    for name in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
+        let at = bytes
+            .windows(name.len())
+            .position(|w| w == name)
+            .expect("a window attribute")
+            + name.len()
+            + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&(side - 1).to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&(side - 1).to_le_bytes());
+    }
+    bytes
+}
+
 /// The `page` binary on a results folder with a link or a pipe where its files or folders
-/// belong: exit 2 naming the path, at once, and nothing written anywhere (the folder included).
+/// belong, an image whose header declares more than a results image can be, or a text that is
+/// not UTF-8: exit 2 naming the path, at once, and nothing written anywhere (the folder
+/// included).
 #[test]
 fn page_refuses_links_and_pipes_where_a_folders_files_belong() {
     use penumbra::output::images::write_exr;
@@ -1010,6 +1033,9 @@ fn page_refuses_links_and_pipes_where_a_folders_files_belong() {
         ("a table a link", "more.csv", link("../elsewhere/t.csv")),
         ("an image a pipe", "images/b.exr", FIFO.to_vec()),
         ("an image a link", "images/b.exr", link("../elsewhere/x.exr")),
+        ("a 60000 x 60000 image", "images/b.exr", exr_claiming(60_000)),
+        ("a table not UTF-8", "runs.csv", b"a,b\n1,\xff\n".to_vec()),
+        ("report.md not UTF-8", "report.md", b"# a report \xc3\x28\n".to_vec()),
     ];
     let mut failures = Vec::new();
     for (what, planted, bytes) in &cases {
@@ -1042,6 +1068,13 @@ fn page_refuses_links_and_pipes_where_a_folders_files_belong() {
         }
         if !stderr.contains(&format!("r/{planted}")) {
             wrong.push(format!("does not name r/{planted}"));
+        }
+        // The huge image is refused from its header, not by a reader that tried to allocate it.
+        if what.contains("60000") && !stderr.contains("60000 x 60000 image; refused before reading") {
+            wrong.push("not refused from its header".into());
+        }
+        if what.contains("UTF-8") && !stderr.contains("starts an invalid sequence") {
+            wrong.push("does not say where the text stops being UTF-8".into());
         }
         if snapshot(dir.path()) != before {
             wrong.push("wrote something".into());

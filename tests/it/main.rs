@@ -23,6 +23,7 @@ mod gpu_backend;
 mod gpu_resources;
 mod hard_cases;
 mod hostile_input;
+mod hostile_output;
 mod kdtree;
 mod kdtree_sah;
 mod kinds_on_the_core;

@@ -189,6 +189,22 @@ fn bad_realtime_files_are_refused_at_their_key() {
             "sweep.frames[1]",
             "ascending",
         ),
+        (
+            (
+                "variants = [\"static\", \"moving\"]",
+                "variants = [\"static\", \"static\"]",
+            ),
+            "sweep.variants[1]",
+            "`static` is listed twice",
+        ),
+        (
+            (
+                "[timing]",
+                "[verdict]\nbudget_schemes = [[\"paper\", 16], [\"uniform\", 4], [\"paper\", 16]]\n\n[timing]",
+            ),
+            "verdict.budget_schemes[2]",
+            "paper at 16 rays is listed twice",
+        ),
     ] {
         let err = common::rejected_at(dir.path(), &text.replace(edit.0, edit.1), key);
         assert!(

@@ -241,7 +241,7 @@ impl RealtimeSpec {
         nonempty("seeds", s.seeds.is_empty())?;
         let mut variants = Vec::new();
         for (i, v) in s.variants.iter().enumerate() {
-            variants.push(match v.as_str() {
+            let variant = match v.as_str() {
                 "static" => Variant::Static,
                 "moving" => Variant::Moving,
                 _ => {
@@ -250,7 +250,11 @@ impl RealtimeSpec {
                         format!("unknown variant `{v}`; one of static, moving"),
                     ))
                 }
-            });
+            };
+            if variants.contains(&variant) {
+                return Err(source.error(&key_path!["sweep", "variants", i], format!("`{v}` is listed twice")));
+            }
+            variants.push(variant);
         }
         let motion = match &f.motion {
             Some(mt) => {
@@ -391,6 +395,12 @@ impl RealtimeSpec {
             None => DEFAULT_BUDGETS.iter().copied().filter(swept).collect(),
         };
         for (i, (scheme, rays)) in budgets.iter().enumerate() {
+            if budgets[..i].contains(&(*scheme, *rays)) {
+                return Err(source.error(
+                    &key_path!["verdict", "budget_schemes", i],
+                    format!("{scheme} at {rays} rays is listed twice"),
+                ));
+            }
             if !swept(&(*scheme, *rays)) {
                 return Err(source.error(
                     &key_path!["verdict", "budget_schemes", i],

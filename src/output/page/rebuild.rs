@@ -26,7 +26,14 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
         ("plots", ".png"),
         ("plots", ".svg"),
     ] {
-        files_in(dir, sub, suffix)?;
+        let listed = files_in(dir, sub, suffix)?;
+        // Texts the page embeds are read now too: one that is not UTF-8 is refused before any
+        // picture is drawn.
+        if matches!(suffix, ".csv" | ".svg") {
+            for file in &listed {
+                read_regular_text(&dir.join(file))?;
+            }
+        }
     }
     for written in ["index.html", "page_data.js"] {
         if std::fs::symlink_metadata(dir.join(written)).is_ok_and(|m| m.is_dir()) {
@@ -188,10 +195,46 @@ fn natural(name: &str) -> Vec<(u128, String)> {
     key
 }
 
-/// A one-channel EXR's values, width and height.
+/// Refuses an EXR whose header promises more than the page could hold, before any pixel is
+/// read: a side or pixel count past what an experiment writes ([`MAX_IMAGE_SIDE`],
+/// [`MAX_IMAGE_PIXELS`]), or decoded samples, their f32 copy and the picture drawn from them past
+/// the memory this process may still take ([`crate::accel::memory::available`]). A compressed
+/// file a few MB long can declare gigabytes of pixels.
+fn check_exr_header(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    use crate::config::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
+    let meta = exr::meta::MetaData::read_from_buffered(bytes, false)
+        .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
+        if w > MAX_IMAGE_SIDE as u64 || h > MAX_IMAGE_SIDE as u64 || w * h > MAX_IMAGE_PIXELS {
+            return Err(Refused(format!(
+                "{}: a {w} x {h} image; refused before reading (results images are at most \
+                 {MAX_IMAGE_SIDE} pixels a side and {MAX_IMAGE_PIXELS} pixels)",
+                path.display()
+            ))
+            .into());
+        }
+        // Decoded samples, the f32 values and the 8-bit picture drawn from them.
+        let need = w * h * (header.channels.bytes_per_pixel as u64 + 4 + 4);
+        if let Some(budget) = crate::accel::memory::available().filter(|b| need > b.bytes) {
+            return Err(Refused(format!(
+                "{}: a {w} x {h} image needs {:.1} GB to read, more than {}; refused before reading",
+                path.display(),
+                need as f64 / 1e9,
+                budget.describe()
+            ))
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// A one-channel EXR's values, width and height, its header checked first
+/// ([`check_exr_header`]).
 fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
     use exr::prelude::*;
     let bytes = read_regular(path)?;
+    check_exr_header(path, &bytes)?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()

@@ -1,0 +1,123 @@
+//! Where a run's output goes is hostile too: a standard stream that is full or whose reader
+//! has gone, and a results folder whose files share their inodes with a backup (`cp -al`).
+//! Every case ends with the command's own exit status (never a panic's 101), says why where
+//! standard error can still take it, and changes nothing outside the output folder.
+
+use crate::hostile_input::{snapshot, tiny, Scratch};
+use std::fs::File;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// `/dev/full` for writing: every write fails with ENOSPC.
+fn full() -> Stdio {
+    Stdio::from(File::options().write(true).open("/dev/full").unwrap())
+}
+
+/// The write end of a pipe whose reader has already gone: every write fails with EPIPE.
+fn closed_pipe() -> Stdio {
+    use std::os::fd::{FromRawFd, OwnedFd};
+    let mut ends = [0; 2];
+    assert_eq!(unsafe { libc::pipe(ends.as_mut_ptr()) }, 0, "pipe");
+    // SAFETY: both descriptors were just opened by pipe(2) and are owned by nothing else.
+    let (reader, writer) = unsafe { (OwnedFd::from_raw_fd(ends[0]), OwnedFd::from_raw_fd(ends[1])) };
+    drop(reader);
+    Stdio::from(writer)
+}
+
+/// Runs `command` and returns its exit status (-1 when a signal ended it) and standard error
+/// (empty when standard error was redirected elsewhere).
+fn status_and_stderr(command: &mut Command) -> (i32, String) {
+    let out = command.output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_full_or_closed_standard_stream_ends_the_command_with_its_status() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let sweep = |args: &[&str]| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_sweep"));
+        c.current_dir(&s.work).args(args);
+        c
+    };
+    // A dry run's plan into a full disk: status 1, said on standard error.
+    let (code, stderr) = status_and_stderr(sweep(&["exp.toml", "--dry-run"]).stdout(full()));
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("standard output"), "{stderr}");
+    // Into a pipe whose reader went away (`| head -1`): status 1, nothing said.
+    let (code, stderr) = status_and_stderr(sweep(&["exp.toml", "--dry-run"]).stdout(closed_pipe()));
+    assert_eq!((code, stderr.as_str()), (1, ""));
+    // Bad input with standard error full keeps its status 2 and writes nothing.
+    let before = snapshot(&s.root);
+    std::fs::write(
+        s.work.join("bad.toml"),
+        tiny().replace("seeds = [1, 2]", "seeds = [1, 1]"),
+    )
+    .unwrap();
+    let (code, _) = status_and_stderr(sweep(&["bad.toml"]).stderr(full()));
+    assert_eq!(code, 2);
+    std::fs::remove_file(s.work.join("bad.toml")).unwrap();
+    assert_eq!(snapshot(&s.root), before, "a refused run wrote something");
+    // A whole run with standard error full (its log lines and progress lost) succeeds.
+    let (code, _) = status_and_stderr(sweep(&["exp.toml", "--fresh"]).stderr(full()));
+    assert_eq!(code, 0);
+    let results = s.work.join("results/tiny");
+    assert!(results.join("report.md").is_file());
+    // The page binary's "wrote" line into a full disk or a closed pipe.
+    for (out, says) in [(full(), true), (closed_pipe(), false)] {
+        let (code, stderr) = status_and_stderr(Command::new(env!("CARGO_BIN_EXE_page")).arg(&results).stdout(out));
+        assert_eq!(code, 1, "{stderr}");
+        assert_eq!(stderr.contains("standard output"), says, "{stderr}");
+    }
+}
+
+/// Every regular file under `from` hard-linked at the same place under `to`: the backup
+/// `cp -al` makes.
+fn link_tree(from: &Path, to: &Path) {
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let there = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            std::fs::create_dir_all(&there).unwrap();
+            link_tree(&path, &there);
+        } else {
+            std::fs::hard_link(&path, &there).unwrap();
+        }
+    }
+}
+
+/// A results folder backed up with hard links, then resumed with more seeds (new units
+/// appended to its journal): the backup, sharing every inode at the start, is byte for byte
+/// what it was, and the resumed folder holds the new runs.
+#[test]
+fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
+    assert_eq!(code, 0, "{stderr}");
+    let (results, backup) = (s.work.join("results/tiny"), s.root.join("backup"));
+    link_tree(&results, &backup);
+    let before = snapshot(&backup);
+    // The journal's files by their names inside the folder, with their bytes.
+    let journal = |dir: &Path| -> Vec<(std::path::PathBuf, Vec<u8>)> {
+        snapshot(&dir.join(".journal"))
+            .into_iter()
+            .map(|(p, bytes)| (p.strip_prefix(dir).unwrap().to_path_buf(), bytes))
+            .collect()
+    };
+    assert!(!journal(&backup).is_empty(), "the run keeps a journal");
+    std::fs::write(
+        s.work.join("exp.toml"),
+        tiny().replace("seeds = [1, 2]", "seeds = [1, 2, 3]"),
+    )
+    .unwrap();
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(snapshot(&backup), before, "the backup changed through a shared inode");
+    assert_ne!(
+        journal(&results),
+        journal(&backup),
+        "the resumed run journaled nothing new"
+    );
+}
