@@ -34,6 +34,153 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     result.with_context(|| format!("writing {}", path.display()))
 }
 
+/// A folder a run writes into, held open for the run: every file is created and replaced
+/// through the handle (`openat` and `renameat`, never following a link), so a folder swapped for
+/// a link to somewhere else while the run goes is never written through; [`Folder::check_held`]
+/// then says so before anything reads the swapped path.
+pub struct Folder {
+    path: std::path::PathBuf,
+    handle: std::fs::File,
+    identity: (u64, u64),
+}
+
+impl Folder {
+    /// Creates `path` (and its parents) where missing and holds it; a link or a non-folder
+    /// there is refused.
+    pub fn create(path: &Path) -> anyhow::Result<Folder> {
+        use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+        check_plain_folder(path)?;
+        std::fs::create_dir_all(path).with_context(|| format!("creating {}", path.display()))?;
+        let handle = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_DIRECTORY | libc::O_NOFOLLOW)
+            .open(path)
+            .map_err(|e| Refused(format!("{}: cannot hold it as a folder: {e}", path.display())))?;
+        let m = handle.metadata()?;
+        Ok(Folder {
+            path: path.to_path_buf(),
+            handle,
+            identity: (m.dev(), m.ino()),
+        })
+    }
+
+    /// The path the folder was opened at.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Refuses a folder whose path no longer names the folder held: swapped for a link, moved
+    /// or replaced while the run went.
+    pub fn check_held(&self) -> anyhow::Result<()> {
+        use std::os::unix::fs::MetadataExt;
+        let now = std::fs::symlink_metadata(&self.path)
+            .ok()
+            .filter(|m| m.file_type().is_dir())
+            .map(|m| (m.dev(), m.ino()));
+        if now != Some(self.identity) {
+            return Err(Refused(format!(
+                "{}: replaced (by a link, or another folder) while the run was writing into it; \
+                 refused, and nothing was written through it",
+                self.path.display()
+            ))
+            .into());
+        }
+        Ok(())
+    }
+
+    /// `name` (one path component) as a C string.
+    fn component(&self, name: &str) -> anyhow::Result<std::ffi::CString> {
+        anyhow::ensure!(
+            !name.is_empty() && !name.contains('/') && name != "." && name != "..",
+            "{}: `{name}` is not a file name",
+            self.path.display()
+        );
+        Ok(std::ffi::CString::new(name)?)
+    }
+
+    /// Writes `bytes` to the folder's file `name` atomically (a fresh temporary file, flushed,
+    /// renamed over it), through the handle; then checks the folder is still the one held.
+    pub fn write_atomic(&self, name: &str, bytes: &[u8]) -> anyhow::Result<()> {
+        use std::os::fd::{AsRawFd, FromRawFd};
+        let target = self.component(name)?;
+        let tmp_name = temporary(Path::new(name));
+        let tmp = self.component(&tmp_name.to_string_lossy())?;
+        let dir = self.handle.as_raw_fd();
+        let result = (|| -> std::io::Result<()> {
+            // SAFETY: openat on a held folder's descriptor and a NUL-terminated name; the
+            // descriptor it returns is owned by the File made from it.
+            let fd = unsafe {
+                libc::openat(
+                    dir,
+                    tmp.as_ptr(),
+                    libc::O_WRONLY | libc::O_CREAT | libc::O_EXCL | libc::O_NOFOLLOW | libc::O_CLOEXEC,
+                    0o644,
+                )
+            };
+            if fd < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            let mut f = unsafe { std::fs::File::from_raw_fd(fd) };
+            f.write_all(bytes)?;
+            f.sync_all()?;
+            // SAFETY: both names are NUL-terminated and relative to the held descriptor.
+            if unsafe { libc::renameat(dir, tmp.as_ptr(), dir, target.as_ptr()) } != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        })();
+        if result.is_err() {
+            // SAFETY: as above; a temporary file that is not there is no error worth reporting.
+            unsafe { libc::unlinkat(dir, tmp.as_ptr(), 0) };
+        }
+        result.with_context(|| format!("writing {}", self.path.join(name).display()))?;
+        self.check_held()
+    }
+
+    /// The bytes of the folder's regular file `name`, read through the handle (a link, pipe or
+    /// device there refused as [`open_regular`] refuses it); none where there is no such file.
+    pub fn read(&self, name: &str) -> anyhow::Result<Option<Vec<u8>>> {
+        use std::os::fd::{AsRawFd, FromRawFd};
+        let c = self.component(name)?;
+        let shown = self.path.join(name);
+        // SAFETY: openat on the held descriptor with a NUL-terminated name; the descriptor it
+        // returns is owned by the File made from it.
+        let fd = unsafe {
+            libc::openat(
+                self.handle.as_raw_fd(),
+                c.as_ptr(),
+                libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC,
+            )
+        };
+        if fd < 0 {
+            let e = std::io::Error::last_os_error();
+            return match e.raw_os_error() {
+                Some(libc::ENOENT) => Ok(None),
+                Some(libc::ELOOP) => Err(Refused(format!(
+                    "{}: a symbolic link; refused (it could lead outside the folder)",
+                    shown.display()
+                ))
+                .into()),
+                _ => Err(Refused(format!("{}: cannot open: {e}", shown.display())).into()),
+            };
+        }
+        let mut file = unsafe { std::fs::File::from_raw_fd(fd) };
+        let kind = file.metadata()?.file_type();
+        if !kind.is_file() {
+            return Err(Refused(format!(
+                "{}: not a regular file ({}); refused",
+                shown.display(),
+                describe(kind)
+            ))
+            .into());
+        }
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes)
+            .with_context(|| format!("reading {}", shown.display()))?;
+        Ok(Some(bytes))
+    }
+}
+
 /// A path refused as a place to read or write (a link, pipe, device or folder where a regular
 /// file or a plain folder belongs): bad input, exit status 2.
 #[derive(Debug, thiserror::Error)]

@@ -121,3 +121,48 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
         "the resumed run journaled nothing new"
     );
 }
+
+/// A results folder's `.journal` or `cache` swapped for a link to a folder elsewhere while the
+/// run goes (paused after its first journaled unit): the run never writes through the link,
+/// ends with status 2 naming the swapped folder, and the earlier results stay whole.
+#[cfg(feature = "test-hooks")]
+#[test]
+fn a_folder_swapped_for_a_link_mid_run_is_never_written_through() {
+    let two_radii = tiny().replace("light_radii = [0.02]", "light_radii = [0.02, 0.04]");
+    for swapped in [".journal", "cache"] {
+        let s = Scratch::new(&two_radii, "tiny");
+        let home = s.work.join("results/tiny");
+        let earlier = std::fs::read(home.join("runs.csv")).unwrap();
+        let (foreign, pause) = (s.root.join("foreign"), s.root.join("pause"));
+        std::fs::create_dir(&foreign).unwrap();
+        std::fs::write(foreign.join("theirs"), b"theirs").unwrap();
+        let before = snapshot(&foreign);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
+            .current_dir(&s.work)
+            .args(["exp.toml", "--fresh"])
+            .env("PENUMBRA_TEST_PAUSE_AFTER", format!("1:{}", pause.display()))
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while !pause.exists() {
+            assert!(start.elapsed().as_secs() < 300, "{swapped}: the run never paused");
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "{swapped}: the run ended before pausing"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let target = home.join(swapped);
+        assert!(target.is_dir(), "{swapped} is there while the run goes");
+        std::fs::rename(&target, home.join(format!("{swapped}-moved"))).unwrap();
+        std::os::unix::fs::symlink(&foreign, &target).unwrap();
+        std::fs::remove_file(&pause).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{swapped}: {stderr}");
+        assert!(stderr.contains(&format!("tiny/{swapped}")), "{swapped}: {stderr}");
+        assert_eq!(snapshot(&foreign), before, "{swapped}: written through the link");
+        assert_eq!(std::fs::read(home.join("runs.csv")).unwrap(), earlier, "{swapped}");
+    }
+}

@@ -44,39 +44,80 @@ struct Journaled<O> {
 /// The first line of a journaled unit's file, before the FNV-1a of the rest.
 const CHECK: &str = "# fnv1a ";
 
-/// A folder of journaled units, one TOML file each, written atomically as each finishes.
+/// A folder of journaled units, one TOML file each, written atomically as each finishes,
+/// through a handle held for the run ([`crate::files::Folder`]): a journal folder swapped for a
+/// link mid-run is never written or read through.
 pub(super) struct UnitJournal {
-    dir: PathBuf,
+    folder: crate::files::Folder,
 }
 
 impl UnitJournal {
     pub(super) fn open(dir: &Path, fresh: bool) -> anyhow::Result<UnitJournal> {
+        crate::files::check_plain_folder(dir)?;
         if fresh && dir.exists() {
             std::fs::remove_dir_all(dir)?;
         }
-        std::fs::create_dir_all(dir)?;
-        Ok(UnitJournal { dir: dir.into() })
+        Ok(UnitJournal {
+            folder: crate::files::Folder::create(dir)?,
+        })
+    }
+
+    fn name(key: &str) -> String {
+        format!("{key}.toml")
     }
 
     pub(super) fn path(&self, key: &str) -> PathBuf {
-        self.dir.join(format!("{key}.toml"))
+        self.folder.path().join(Self::name(key))
     }
 
-    /// The outcome journaled under `key`: none if no file is there, and a refusal if one is
-    /// there but is not the file this run wrote (its first line, `# fnv1a HASH`, hashes the rest
-    /// as written: an edited, cut or foreign file would otherwise be taken as measured).
+    /// The outcome journaled under `key` in this journal, read through its handle, with the
+    /// bytes of its file ([`UnitJournal::parse`]).
+    fn read_held<O: DeserializeOwned>(&self, key: &str) -> anyhow::Result<Option<(O, Vec<u8>)>> {
+        let path = self.path(key);
+        let damaged = |why: String| {
+            BadInput(format!(
+                "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
+                path.display()
+            ))
+        };
+        let Some(bytes) = self
+            .folder
+            .read(&Self::name(key))
+            .map_err(|e| damaged(format!("cannot be read ({e:#})")))?
+        else {
+            return Ok(None);
+        };
+        let text = std::str::from_utf8(&bytes).map_err(|_| damaged("is not UTF-8 text".into()))?;
+        Ok(Some((Self::parse(&path, text, key)?, bytes)))
+    }
+
+    /// The outcome journaled under `key` at `path` (a shard's journal, read by a merge): none
+    /// if no file is there, and a refusal if one is there but is not the file its run wrote
+    /// ([`UnitJournal::parse`]).
     pub(super) fn read<O: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Option<O>> {
         if std::fs::symlink_metadata(path).is_err() {
             return Ok(None);
         }
+        let text = crate::files::read_regular_text(path).map_err(|e| {
+            BadInput(format!(
+                "{}: a journaled unit cannot be read ({e:#}); remove the file to measure the unit again, or rerun with --fresh",
+                path.display()
+            ))
+        })?;
+        Self::parse(path, &text, key).map(Some)
+    }
+
+    /// A journaled unit's outcome from the text of its file at `path`, refused where it is not
+    /// the file a run wrote (its first line, `# fnv1a HASH`, hashes the rest as written: an
+    /// edited, cut or foreign file would otherwise be taken as measured).
+    fn parse<O: DeserializeOwned>(path: &Path, text: &str, key: &str) -> anyhow::Result<O> {
         let damaged = |why: &str| {
             BadInput(format!(
                 "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
                 path.display()
             ))
         };
-        let text = crate::files::read_regular_text(path).map_err(|e| damaged(&format!("cannot be read ({e:#})")))?;
-        let (check, body) = text.split_once('\n').unwrap_or((&text, ""));
+        let (check, body) = text.split_once('\n').unwrap_or((text, ""));
         if check.strip_prefix(CHECK) != Some(&format!("{:016x}", fnv1a(body.as_bytes()))) {
             return Err(damaged("has changed since it was written (its checksum does not match)").into());
         }
@@ -84,7 +125,7 @@ impl UnitJournal {
         if j.key != key {
             return Err(damaged(&format!("holds unit {} under another unit's name", j.key)).into());
         }
-        Ok(Some(j.outcome))
+        Ok(j.outcome)
     }
 
     fn write<O: Serialize>(&self, key: &str, label: &str, outcome: O) -> anyhow::Result<()> {
@@ -94,15 +135,17 @@ impl UnitJournal {
             outcome,
         })?;
         let text = format!("{CHECK}{:016x}\n{body}", fnv1a(body.as_bytes()));
-        crate::files::write_atomic(&self.path(key), text.as_bytes())?;
+        self.folder.write_atomic(&Self::name(key), text.as_bytes())?;
         die_after_journaled();
         Ok(())
     }
 }
 
-/// Test hook: with `PENUMBRA_TEST_DIE_AFTER=n` set, the process aborts (no cleanup, as when a
-/// node kills a job) right after its n-th journaled unit (a sweep's group, an ao mesh, a block of
-/// frames), so tests interrupt a run at a known point.
+/// Test hooks after each journaled unit, so tests interrupt or change a run at a known point
+/// (a sweep's group, an ao mesh, a block of frames): with `PENUMBRA_TEST_DIE_AFTER=n` the
+/// process aborts (no cleanup, as when a node kills a job) right after its n-th; with
+/// `PENUMBRA_TEST_PAUSE_AFTER=n:FILE` it creates FILE after its n-th and waits, up to a minute,
+/// until the test removes it (a folder swapped for a link while the run goes).
 pub fn die_after_journaled() {
     #[cfg(feature = "test-hooks")]
     {
@@ -114,6 +157,15 @@ pub fn die_after_journaled() {
             .and_then(|v| v.parse().ok());
         if limit == Some(n) {
             std::process::abort();
+        }
+        let pause = std::env::var("PENUMBRA_TEST_PAUSE_AFTER").ok();
+        if let Some((at, file)) = pause.as_deref().and_then(|v| v.split_once(':')) {
+            if at.parse() == Ok(n) && std::fs::write(file, b"paused").is_ok() {
+                let start = std::time::Instant::now();
+                while std::path::Path::new(file).exists() && start.elapsed().as_secs() < 60 {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+            }
         }
     }
 }
@@ -133,8 +185,8 @@ pub(super) fn measure_all<D: Declaration>(
     let mut journaled = Vec::with_capacity(units.len());
     for unit in units {
         let key = unit_key(spec, context, backend.adapter(), unit);
-        let earlier = UnitJournal::read::<D::Outcome>(&journal.path(&key), &key)?;
-        journaled.push((key, earlier.filter(|o| spec.failed(o) == 0)));
+        let earlier = journal.read_held::<D::Outcome>(&key)?;
+        journaled.push((key, earlier.filter(|(o, _)| spec.failed(o) == 0)));
     }
     let bar = progress.bar("units", units.len() as u64);
     let mut out = Measured {
@@ -144,8 +196,7 @@ pub(super) fn measure_all<D: Declaration>(
         files: Vec::new(),
     };
     for (unit, (key, earlier)) in units.iter().zip(journaled) {
-        let path = journal.path(&key);
-        let outcome = match earlier {
+        let (outcome, bytes) = match earlier {
             Some(o) => {
                 out.resumed += 1;
                 o
@@ -154,11 +205,11 @@ pub(super) fn measure_all<D: Declaration>(
                 bar.message(unit.label.clone());
                 let measured = spec.measure(unit, backend, progress)?;
                 journal.write(&key, &unit.label, measured)?;
-                UnitJournal::read(&path, &key)?
-                    .ok_or_else(|| anyhow::anyhow!("{}: a journaled unit does not read back", path.display()))?
+                journal.read_held(&key)?.ok_or_else(|| {
+                    anyhow::anyhow!("{}: a journaled unit does not read back", journal.path(&key).display())
+                })?
             }
         };
-        let bytes = crate::files::read_regular(&path)?;
         out.files.push(UnitFile {
             key,
             fnv1a: format!("{:016x}", fnv1a(&bytes)),

@@ -71,6 +71,7 @@ impl Sweep {
             .cache
             .clone()
             .unwrap_or_else(|| std::env::temp_dir().join("penumbra-cache"));
+        let cache = crate::files::Folder::create(&cache)?;
         let reference = Arc::new(Reference::build(&self.spec, backend, lights, radius, &cache, &context)?);
         for warning in reference.warnings() {
             tracing::warn!("{warning}");

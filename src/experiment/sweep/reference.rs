@@ -9,7 +9,6 @@ use crate::reference::OnAxis;
 use crate::render::{Backend, Sampling, View};
 use crate::sampling::{DiskScheme, Pattern};
 use anyhow::Context;
-use std::path::Path;
 
 /// Everything the runs of one (lights on, light radius) pair are judged against.
 #[derive(Clone)]
@@ -39,13 +38,14 @@ pub struct Reference {
 }
 
 impl Reference {
-    /// Renders (or loads from `cache`) the ground truth and computes the exact image if any.
+    /// Renders (or loads from `cache`, a folder held for the write) the ground truth and
+    /// computes the exact image if any.
     pub fn build(
         spec: &Spec,
         backend: &mut dyn Backend,
         lights: u32,
         radius: f64,
-        cache: &Path,
+        cache: &crate::files::Folder,
         context: &str,
     ) -> anyhow::Result<Reference> {
         let scene = spec.scene_with(
@@ -63,8 +63,8 @@ impl Reference {
         };
         // The context holds the build id: a changed renderer never reuses a cached ground truth.
         let key = format!("{context};lights={lights};r={radius:e}");
-        let file = cache.join(format!("ground-truth-{:016x}.bin", fnv1a(key.as_bytes())));
-        let (per_light, hit) = match load_cached(&file, view, lights as usize) {
+        let file = format!("ground-truth-{:016x}.bin", fnv1a(key.as_bytes()));
+        let (per_light, hit) = match load_cached(cache, &file, view, lights as usize) {
             Some(cached) => cached,
             None => {
                 let sampling = Sampling {
@@ -77,7 +77,7 @@ impl Reference {
                     .render(&scene, view, sampling)
                     .context("rendering the ground truth")?;
                 let rendered = (f.visibility, f.hit);
-                save_cached(&file, &rendered)?;
+                save_cached(cache, &file, &rendered)?;
                 rendered
             }
         };
@@ -178,8 +178,13 @@ const MAGIC: &[u8; 8] = b"PNBRGT02";
 
 /// Cached (visibility of the measured light, object ids) of a ground-truth render.
 /// A cached ground truth: each light's visibility image, then the hit ids.
-fn load_cached(path: &Path, view: View, lights: usize) -> Option<(Vec<Vec<f32>>, Vec<u32>)> {
-    let bytes = crate::files::read_regular(path).ok()?;
+fn load_cached(
+    cache: &crate::files::Folder,
+    name: &str,
+    view: View,
+    lights: usize,
+) -> Option<(Vec<Vec<f32>>, Vec<u32>)> {
+    let bytes = cache.read(name).ok()??;
     let n = view.pixels();
     if bytes.len() != 8 + 4 * n * (lights + 1) || &bytes[..8] != MAGIC {
         return None;
@@ -191,11 +196,11 @@ fn load_cached(path: &Path, view: View, lights: usize) -> Option<(Vec<Vec<f32>>,
     Some((vis, hit))
 }
 
-fn save_cached(path: &Path, (vis, hit): &(Vec<Vec<f32>>, Vec<u32>)) -> anyhow::Result<()> {
+fn save_cached(cache: &crate::files::Folder, name: &str, (vis, hit): &(Vec<Vec<f32>>, Vec<u32>)) -> anyhow::Result<()> {
     let mut bytes = MAGIC.to_vec();
     for v in vis {
         bytes.extend_from_slice(bytemuck::cast_slice(v));
     }
     bytes.extend_from_slice(bytemuck::cast_slice(hit));
-    crate::files::write_atomic(path, &bytes)
+    cache.write_atomic(name, &bytes)
 }
