@@ -105,5 +105,7 @@ cp "$out/stability.csv" "results/$name-stability.csv"
 
 total=$(($(wc -l < "$out/stability.csv") - 1))
 all=$(awk -F, -v k="$runs" 'NR > 1 && $NF == k' "$out/stability.csv" | wc -l)
-undecided=$(awk -F, 'NR > 1 && $2 == "undecided"' "$out/stability.csv" | wc -l)
-echo "$name: $all of $total committed words held in all $runs reruns ($undecided of them undecided); $out/stability.csv"
+# Places hold commas inside their quotes, so the committed word is counted from the right.
+undecided=$(awk -F, -v k="$runs" 'NR > 1 && $NF == k && $(NF - k - 1) == "undecided"' \
+    "$out/stability.csv" | wc -l)
+echo "$name: $all of $total committed words held in all $runs reruns ($undecided of those undecided); $out/stability.csv"
