@@ -11,7 +11,12 @@
 //! Each expected text is built from the CSVs with the library's rule and printing and must
 //! appear in report.md as written; a report cell of a kind checked here that no recomputed text
 //! matches fails too, so a report that drifts from its CSVs, or CSVs that cannot give back what
-//! the report says, are caught.
+//! the report says, are caught. Sweep cells are matched to the configuration their section
+//! names (lights, structure, radius, count), so a cell moved between tables fails.
+//!
+//! Beyond that sample, every interval any report prints with a word beside it (equal-time
+//! budgets, time to reach a target, realtime budgets, speed-ups) must carry the rule's word for
+//! that printed interval.
 
 use crate::common;
 use crate::round_times::rows;
@@ -61,34 +66,61 @@ fn sweep(folder: &Path) -> (usize, Vec<String>) {
         into.entry(id).or_default().push(r["frame_s"].parse().unwrap());
     }
     // Every scheme against uniform sampling at its own count, pattern, radius, lights, structure.
-    let mut expected: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    let mut expected: BTreeMap<Vec<String>, String> = BTreeMap::new();
     for (id, s) in series.iter().filter(|(id, _)| id[0] != "uniform") {
         let mut base = id.clone();
         base[0] = "uniform".into();
         if let Some(u) = series.get(&base) {
             let (ratio, word) = decided_text(s, u, looks);
-            expected
-                .entry(id[0].clone())
-                .or_default()
-                .push(format!("{ratio}x uniform's time: {word}"));
+            expected.insert(id.clone(), format!("{ratio}x uniform's time: {word}"));
         }
     }
     let text = report(folder);
     let (mut matched, mut problems) = (0, Vec::new());
-    for line in text.lines().filter(|l| l.contains("x uniform's time: ")) {
+    // The section a cell lies in names the rest of its configuration: lights (and the
+    // structure, where several are swept) in its heading, the radius in its first paragraph,
+    // the count in its table's header.
+    let (mut lights, mut accelerator, mut radius, mut samples) = (None, None, None, None);
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix("## ") {
+            let inside = rest
+                .split_once('(')
+                .map_or("", |(_, r)| r.strip_suffix(')').unwrap_or(r));
+            lights = inside.split_once(" light(s)").map(|(l, _)| l.to_string());
+            accelerator = inside.split_once("accelerator=").map(|(_, a)| a.to_string());
+            (radius, samples) = (None, None);
+        }
+        if let Some((_, r)) = line.split_once("light radius ") {
+            radius = r.split_once(" m").and_then(|(r, _)| r.parse::<f64>().ok());
+        }
+        if let Some((_, n)) = line.split_once("| vs uniform@") {
+            samples = n.split_once(' ').map(|(n, _)| n.to_string());
+        }
+        if !line.contains("x uniform's time: ") {
+            continue;
+        }
         let scheme = line.trim_start_matches("| ").split(" |").next().unwrap_or("");
         let cell = line
             .split(" | ")
             .find(|c| c.contains("x uniform's time: "))
             .unwrap()
             .trim_end_matches(" |");
-        if expected.get(scheme).is_some_and(|e| e.iter().any(|x| x == cell)) {
+        let here = |id: &Vec<String>| {
+            id[0] == scheme
+                && id[1] == "per-pixel"
+                && Some(&id[2]) == samples.as_ref()
+                && id[3].parse::<f64>().ok() == radius
+                && Some(&id[4]) == lights.as_ref()
+                && accelerator.as_ref().is_none_or(|a| &id[5] == a)
+        };
+        let want: Vec<&String> = expected.iter().filter(|(id, _)| here(id)).map(|(_, t)| t).collect();
+        if want.len() == 1 && want[0] == cell {
             matched += 1;
         } else {
             problems.push(format!(
-                "{}: `{scheme}`'s `{cell}` is not what timings.csv gives (it gives {:?})",
-                folder.display(),
-                expected.get(scheme)
+                "{}: `{scheme}`'s `{cell}` (lights {lights:?}, {accelerator:?}, radius {radius:?}, \
+                 {samples:?} rays) is not what timings.csv gives: {want:?}",
+                folder.display()
             ));
         }
     }
@@ -282,4 +314,75 @@ fn every_ratio_a_report_states_recomputes_from_its_csvs() {
         );
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The word a report gives an interval, where a word follows it in the same phrase: the
+/// interval's bounds, the word, and the text between them.
+fn worded_intervals(text: &str) -> Vec<(f64, f64, &'static str, String)> {
+    const WORDS: [&str; 6] = ["faster", "slower", "better", "worse", "equivalent", "undecided"];
+    let mut out = Vec::new();
+    for (at, _) in text.match_indices(" [") {
+        let rest = &text[at + 2..];
+        let ratio_before = text[..at].rsplit([' ', '(', '*']).next().unwrap_or("");
+        let Some((inside, after)) = rest.split_once(']') else {
+            continue;
+        };
+        let Some((lo, hi)) = inside.split_once(", ") else {
+            continue;
+        };
+        let (Ok(lo), Ok(hi), Ok(_)) = (lo.parse::<f64>(), hi.parse::<f64>(), ratio_before.parse::<f64>()) else {
+            continue;
+        };
+        // The phrase ends at the next cell, clause or interval.
+        let mut end = after.find(['|', ';', '[', '\n']).unwrap_or(after.len()).min(40);
+        while !after.is_char_boundary(end) {
+            end -= 1;
+        }
+        let phrase = &after[..end];
+        let word = phrase
+            .split(|c: char| !c.is_ascii_alphabetic())
+            .enumerate()
+            .find(|&(i, w)| WORDS.contains(&w) && !(i > 0 && phrase.contains(&format!("frames {w}"))))
+            .map(|(_, w)| WORDS.into_iter().find(|x| *x == w).unwrap());
+        if let Some(word) = word {
+            out.push((lo, hi, word, phrase.to_string()));
+        }
+    }
+    out
+}
+
+/// Whatever the comparison, a word must be the rule's for the interval printed beside it
+/// (intervals are printed with the digits that decide them): a direction only for an interval
+/// wholly beyond the margin, *equivalent* only wholly inside it, *undecided* otherwise; an
+/// error is *better* below 1 and *worse* above.
+#[test]
+fn every_word_in_every_report_is_the_rules_for_its_printed_interval() {
+    let (lo_band, hi_band) = penumbra::timing::rule::band();
+    let (mut seen, mut problems) = (0, Vec::new());
+    for entry in std::fs::read_dir(common::repo("results")).unwrap() {
+        let report = entry.unwrap().path().join("report.md");
+        let Ok(text) = std::fs::read_to_string(&report) else {
+            continue;
+        };
+        for (lo, hi, word, phrase) in worded_intervals(&text) {
+            seen += 1;
+            let (outside, inside) = (hi < lo_band || lo > hi_band, lo >= lo_band && hi <= hi_band);
+            let fits = match word {
+                "equivalent" => inside,
+                "undecided" => !outside && !inside,
+                "better" => hi < lo_band,
+                "worse" => lo > hi_band,
+                _ => outside,
+            };
+            if !fits {
+                problems.push(format!("{}: [{lo}, {hi}]{phrase}", report.display()));
+            }
+        }
+    }
+    assert!(seen > 300, "only {seen} worded intervals found in the reports");
+    assert!(
+        problems.is_empty(),
+        "words the rule does not give:\n{}",
+        problems.join("\n")
+    );
 }
