@@ -28,6 +28,38 @@ pub struct Comparison {
     /// The `[accel.NAME]` tables given, each a listed structure's settings (with `lists`, every
     /// candidate its lists spell out).
     pub tables: BTreeMap<&'static str, Vec<AccelSettings>>,
+    /// Where each structure's settings are written.
+    pub places: SettingsPlaces,
+}
+
+/// Where each compared structure's settings are in the experiment file (its `[accel.NAME]`
+/// table, or its place in `structures` where it has none), so a build refused while the run
+/// goes is bad input located there: a kd-tree whose leaves outgrow the memory budget is known
+/// only while it builds, and the file's settings are what to change.
+#[derive(Clone, Debug, Default)]
+pub struct SettingsPlaces(BTreeMap<&'static str, ConfigError>);
+
+impl SettingsPlaces {
+    /// The error of a build of `name` refused with `e` (on `what`: a mesh, a scene), at the
+    /// place of `name`'s settings; `e` itself where `name` is not compared here.
+    pub fn refused(&self, name: &str, what: &str, e: anyhow::Error) -> anyhow::Error {
+        match self.0.get(name) {
+            Some(place) => ConfigError {
+                message: format!("{what}: {e:#}"),
+                ..place.clone()
+            }
+            .into(),
+            None => e,
+        }
+    }
+
+    /// The place of `name`'s settings, with `message`.
+    pub fn error(&self, name: &str, message: String) -> Option<ConfigError> {
+        self.0.get(name).map(|place| ConfigError {
+            message,
+            ..place.clone()
+        })
+    }
 }
 
 impl Comparison {
@@ -57,7 +89,23 @@ impl Comparison {
         if claim.subject == claim.baseline {
             return Err(source.error(&key_path!["claim", "baseline"], "must differ from `subject`"));
         }
-        Ok(Comparison { names, tables })
+        let places = names
+            .iter()
+            .enumerate()
+            .map(|(i, &name)| {
+                let at = if tables.contains_key(name) {
+                    key_path!["accel", name]
+                } else {
+                    key_path!["structures", i]
+                };
+                (name, source.error(&at, String::new()))
+            })
+            .collect();
+        Ok(Comparison {
+            names,
+            tables,
+            places: SettingsPlaces(places),
+        })
     }
 }
 

@@ -1182,3 +1182,73 @@ fn an_edited_sweep_journal_is_refused_not_resumed() {
     let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
     assert_eq!(code, 0, "{stderr}");
 }
+
+/// A kd-tree whose leaves outgrow the memory budget is known only while it builds (slivers
+/// crossing one another straddle every plane): the ao kind refuses it there as bad input, exit
+/// 2, at the structure's `[accel.kdtree]` table with the mesh named, and leaves the earlier
+/// results as they were (no journal folder made for nothing).
+#[test]
+fn a_kd_tree_outgrowing_its_budget_mid_run_is_refused_at_its_settings() {
+    // Near-diameters of a circle of 1024 points, one from each point, and a small triangle
+    // off to the side that moves the median planes off the centre.
+    let n = 1024;
+    let at = |k: usize| {
+        let a = std::f64::consts::TAU * (k % n) as f64 / n as f64;
+        (a.cos(), a.sin())
+    };
+    let mut obj = String::new();
+    for k in 0..n {
+        for (x, y) in [at(k), at(k + n / 2 - 1), at(k + n / 2)] {
+            obj += &format!("v {x} {y} 0\n");
+        }
+        obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    obj += "v 1.6 1.3 0\nv 1.61 1.3 0\nv 1.6 1.31 0\n";
+    obj += &format!("f {} {} {}\n", 3 * n + 1, 3 * n + 2, 3 * n + 3);
+    let text = r#"kind = "ao"
+name = "ao-ci"
+width = 8
+height = 8
+rays = 33
+weighting = "plain"
+max_distance = 4.0
+structures = ["bvh", "kdtree"]
+
+[timing]
+warmup = 0
+repeats = 6
+
+[tuning]
+width = 8
+height = 8
+repeats = 6
+
+[claim]
+subject = "kdtree"
+baseline = "bvh"
+
+[accel.kdtree]
+max_depth = 20
+
+[[meshes]]
+name = "slivers"
+path = "slivers.obj"
+"#;
+    let s = Scratch::new(text, "ao-ci");
+    std::fs::write(s.work.join("slivers.obj"), obj).unwrap();
+    let before = snapshot(&s.root);
+    // 16 MB: the plan's estimate of each structure fits; a quarter of it, a million leaf
+    // entries, does not hold this tree.
+    let (code, stderr) = s.run_with(&["exp.toml"], &[("PENUMBRA_MEMORY_BYTES", "16000000")]);
+    assert_eq!(code, 2, "{stderr}");
+    for part in [
+        "exp.toml:23:",
+        "accel.kdtree",
+        "mesh `slivers`",
+        "triangle entries",
+        "max_depth",
+    ] {
+        assert!(stderr.contains(part), "no `{part}` in: {stderr}");
+    }
+    assert_eq!(snapshot(&s.root), before, "the refused run left something behind");
+}

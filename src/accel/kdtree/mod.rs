@@ -234,11 +234,11 @@ impl KdTree {
         }
         if layout.overflowed {
             return Err(format!(
-                "the kd-tree ({}) over {} triangles would hold more than {budget} triangle entries ({:.1} GB) in its leaves: \
+                "the kd-tree ({}) over {} triangles would hold more than {budget} triangle entries ({:.1} MB) in its leaves: \
                  its triangles straddle the planes at every depth (slivers crossing one another); lower `max_depth`",
                 settings.describe(),
                 triangles.positions.len(),
-                budget as f64 * 4.0 / 1e9
+                budget as f64 * 4.0 / 1e6
             ));
         }
         Ok(KdTree {

@@ -114,7 +114,8 @@ const SAMPLING: Sampling = Sampling {
     frame: 0,
 };
 
-/// The scene of `mesh` indexed by the structure `settings` name, with the experiment's AO pass.
+/// The scene of `mesh` indexed by the structure `settings` name, with the experiment's AO pass;
+/// a build refused (its leaves past the memory budget) is bad input at the structure's settings.
 pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, settings: AccelSettings) -> anyhow::Result<Scene> {
     let descriptor = Mesh {
         source: mesh.path.display().to_string(),
@@ -124,9 +125,11 @@ pub fn ao_scene(spec: &AoSpec, mesh: &AoMesh, settings: AccelSettings) -> anyhow
         triangles: mesh.triangles.positions.len(),
         skipped: Default::default(),
     };
+    let name = settings.name;
     let scene = Scene::analytic(vec![], vec![], vec![])
         .with_cameras(BTreeMap::from([("ao".to_string(), camera())]))
-        .try_with_meshes(vec![descriptor], mesh.triangles.clone(), settings)?
+        .try_with_meshes(vec![descriptor], mesh.triangles.clone(), settings)
+        .map_err(|e| spec.places.refused(name, &format!("mesh `{}`", mesh.name), e))?
         .with_ambient(Some(spec.ao.clone()));
     Ok(scene)
 }

@@ -5,7 +5,7 @@
 use crate::accel::settings::candidates;
 use crate::accel::{AccelSettings, Issue};
 use crate::config::{ConfigError, Source};
-use crate::experiment::comparison::{Claim, Comparison};
+use crate::experiment::comparison::{Claim, Comparison, SettingsPlaces};
 use crate::experiment::header::{plain_name, Header};
 use crate::experiment::tuning::KeptTuning;
 use crate::key_path;
@@ -128,6 +128,8 @@ pub struct AoSpec {
     pub meshes: Vec<AoMesh>,
     /// Settings kept by an earlier run (`--tuning`), taken instead of tuning again.
     pub reused: Option<KeptTuning>,
+    /// Where each structure's settings are, for a build refused mid-run.
+    pub places: SettingsPlaces,
 }
 
 /// `positions` centred on their bounding box and scaled into the unit ball.
@@ -218,6 +220,7 @@ impl AoSpec {
         let Comparison {
             names,
             tables: mut given,
+            places,
         } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
         let structures: Vec<(&'static str, Vec<AccelSettings>)> = names
             .into_iter()
@@ -282,16 +285,13 @@ impl AoSpec {
             return Err(err(&key_path!["meshes"], "list at least one mesh".into()));
         }
         let available = crate::accel::memory::available();
-        for (i, (name, candidates)) in structures.iter().enumerate() {
+        for (name, candidates) in &structures {
             for m in &meshes {
                 for c in candidates {
                     crate::accel::memory::check(c, m.triangles.positions.len(), available).map_err(|e| {
-                        let at = if f.accel.contains_key(*name) {
-                            key_path!["accel", *name]
-                        } else {
-                            key_path!["structures", i]
-                        };
-                        err(&at, format!("mesh `{}`: {e}", m.name))
+                        places
+                            .error(name, format!("mesh `{}`: {e}", m.name))
+                            .expect("a compared structure")
                     })?;
                 }
             }
@@ -315,6 +315,7 @@ impl AoSpec {
             claim: f.claim,
             meshes,
             reused: None,
+            places,
         })
     }
 }

@@ -13,7 +13,7 @@
 
 use super::declaration::{context, dealt, identity, Declaration, Unit};
 use super::filter::{self, Axis, Filter};
-use super::journal::{measure_all, Measured, UnitJournal};
+use super::journal::{Measured, UnitJournal};
 use super::merge::{merge_units, ShardManifest, SHARD_MANIFEST};
 use super::shard::{share_line, Shard};
 use crate::experiment::cli::{BadInput, Cli};
@@ -66,8 +66,7 @@ pub fn measure_whole<D: Declaration>(
 ) -> anyhow::Result<Measured<D::Outcome>> {
     let units = spec.units();
     let context = context(spec, backend.adapter())?;
-    let journal = UnitJournal::open(&home.join(".journal"), fresh)?;
-    measure_all(spec, &units, &context, &journal, backend, progress)
+    UnitJournal::open(&home.join(".journal"), fresh)?.measure(spec, &units, &context, backend, progress)
 }
 
 impl<D: Declaration> Declared<D> {
@@ -108,7 +107,7 @@ impl<D: Declaration> Declared<D> {
         let context = context(spec, run.backend.adapter())?;
         let mine = share(&units, shard);
         let journal = UnitJournal::open(&dir.join(".journal"), run.cli.fresh)?;
-        let measured = measure_all(spec, &mine, &context, &journal, run.backend, run.progress)?;
+        let measured = journal.measure(spec, &mine, &context, run.backend, run.progress)?;
         let resumed = measured.resumed;
         let manifest = ShardManifest {
             shard: shard.to_string(),

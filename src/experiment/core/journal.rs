@@ -49,6 +49,8 @@ const CHECK: &str = "# fnv1a ";
 /// link mid-run is never written or read through.
 pub(super) struct UnitJournal {
     folder: crate::files::Folder,
+    /// Whether this run made the folder (a refused run then takes it away again if empty).
+    created: bool,
 }
 
 impl UnitJournal {
@@ -57,9 +59,29 @@ impl UnitJournal {
         if fresh && dir.exists() {
             std::fs::remove_dir_all(dir)?;
         }
+        let created = std::fs::symlink_metadata(dir).is_err();
         Ok(UnitJournal {
             folder: crate::files::Folder::create(dir)?,
+            created,
         })
+    }
+
+    /// Measures `units` into this journal ([`measure_all`]); a run that fails before it
+    /// journals anything leaves no journal folder it made behind.
+    pub(super) fn measure<D: Declaration>(
+        &self,
+        spec: &D,
+        units: &[Unit],
+        context: &str,
+        backend: &mut dyn Backend,
+        progress: &Progress,
+    ) -> anyhow::Result<Measured<D::Outcome>> {
+        let measured = measure_all(spec, units, context, self, backend, progress);
+        if measured.is_err() && self.created && self.folder.check_held().is_ok() {
+            // Removes only an empty folder: whatever was journaled stays for a resume.
+            let _ = std::fs::remove_dir(self.folder.path());
+        }
+        measured
     }
 
     fn name(key: &str) -> String {
@@ -172,7 +194,7 @@ pub fn die_after_journaled() {
 
 /// Measures `units` (or takes them from `journal`), each outcome read back from its file. A
 /// journaled outcome with failed runs is measured again: a failure is never resumed.
-pub(super) fn measure_all<D: Declaration>(
+fn measure_all<D: Declaration>(
     spec: &D,
     units: &[Unit],
     context: &str,

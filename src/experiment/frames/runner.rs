@@ -157,6 +157,14 @@ impl Variant {
     }
 }
 
+/// The scene of `generated` indexed by `settings`; a build refused (its leaves past the memory
+/// budget) is bad input at the structure's settings in the experiment file.
+pub(super) fn build(spec: &FramesSpec, generated: &Generated, settings: &AccelSettings) -> anyhow::Result<Scene> {
+    generated
+        .scene(BTreeMap::new(), settings.clone())
+        .map_err(|e| spec.places.refused(settings.name, &generated.description, e))
+}
+
 /// The variants of `generated`: one per structure, or with motion, one per way each structure
 /// follows it (each with a structure of its own); and each structure's build.
 fn variants(
@@ -167,7 +175,7 @@ fn variants(
     let mut out = Vec::new();
     let mut builds = Vec::new();
     for settings in structures {
-        let scene = generated.scene(BTreeMap::new(), settings.clone())?;
+        let scene = build(spec, generated, settings)?;
         let accel = scene.accel.as_ref().expect("generated scenes have triangles");
         let stats = accel.stats();
         builds.push(BuildRow {
@@ -190,7 +198,7 @@ fn variants(
             let scene = if k + 1 == methods.len() {
                 scene.clone()
             } else {
-                generated.scene(BTreeMap::new(), settings.clone())?
+                build(spec, generated, settings)?
             };
             out.push(Variant {
                 structure: settings.name,

@@ -21,7 +21,7 @@ use super::candidates::candidates;
 use super::memory::check_memory;
 use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
-use crate::experiment::comparison::{Claim, Comparison};
+use crate::experiment::comparison::{Claim, Comparison, SettingsPlaces};
 use crate::experiment::header::Header;
 use crate::key_path;
 use crate::render::Sampling;
@@ -171,6 +171,8 @@ pub struct FramesSpec {
     pub strip: u32,
     /// Settings kept by an earlier run (`--tuning`), taken instead of tuning again.
     pub reused: Option<KeptTuning>,
+    /// Where each structure's settings are, for a build refused mid-run.
+    pub places: SettingsPlaces,
 }
 
 impl FramesSpec {
@@ -191,7 +193,11 @@ impl FramesSpec {
                 format!("must be in 1..={}, got {}", Shading::MAX_MIRROR_DEPTH, f.mirror_depth),
             ));
         }
-        let Comparison { names, tables: given } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
+        let Comparison {
+            names,
+            tables: given,
+            places,
+        } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
         let candidates = candidates(names, &given);
         let structures: Vec<AccelSettings> = candidates.iter().map(|c| c[0].clone()).collect();
         let tuning = FramesTuning::read(source, f.tuning, &candidates, f.path.block)?;
@@ -293,6 +299,7 @@ impl FramesSpec {
             motion,
             strip: f.strip,
             reused: None,
+            places,
         };
         check_memory(
             source,

@@ -21,7 +21,6 @@ use crate::scene::procedural::{classroom, random, Generated};
 use crate::timing::tuning::keep;
 use crate::timing::{median_interval, Estimate, Schedule};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// One candidate of the tuning sweep, timed: a row of tuning.csv.
@@ -120,7 +119,7 @@ pub fn tune(
         }
         let mut scenes = Vec::new();
         for c in candidates {
-            let mut scene = generated.scene(BTreeMap::new(), c.clone())?;
+            let mut scene = super::runner::build(spec, generated, c)?;
             scene.shading = shading;
             scenes.push(scene);
         }
