@@ -458,7 +458,7 @@ pub fn build(triangles: &Triangles, settings: &AccelSettings) -> anyhow::Result<
 
 /// Leaf entries a kd-tree build may make: a quarter of the memory budget at 4 bytes each (the
 /// build holds its triangle lists besides), where a budget is known.
-fn kdtree_entries() -> usize {
+pub(crate) fn kdtree_entries() -> usize {
     memory::available().map_or(kdtree::MAX_ENTRIES, |b| (b.bytes / 16) as usize)
 }
 

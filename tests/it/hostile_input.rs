@@ -1252,3 +1252,54 @@ path = "slivers.obj"
     }
     assert_eq!(snapshot(&s.root), before, "the refused run left something behind");
 }
+
+/// An EXR whose header declares 4 x 4 pixels, made 8 GiB long (sparse: nothing on disk): the
+/// page refuses it from its header and length, exit 2 naming it, without reading 8 GiB.
+#[test]
+fn page_refuses_an_image_longer_than_its_header_declares() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("r");
+    std::fs::create_dir_all(folder.join("images")).unwrap();
+    std::fs::write(folder.join("report.md"), "# a report\n").unwrap();
+    let image = folder.join("images/a.exr");
+    penumbra::output::images::write_exr(&image, &[0.5; 16], 4, 4).unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&image)
+        .unwrap()
+        .set_len(8 << 30)
+        .unwrap();
+    // Names only: the image's 8 GiB are not read here either.
+    let names = |d: &Path| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = walk(d);
+        v.sort();
+        v
+    };
+    let before = names(&folder);
+    let mut page = Command::new(env!("CARGO_BIN_EXE_page"));
+    page.arg(&folder);
+    let (code, stderr) = output_within_a_minute(page);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("images/a.exr") && stderr.contains("8589934592 bytes, more than an EXR"),
+        "{stderr}"
+    );
+    assert_eq!(names(&folder), before, "wrote something");
+    assert_eq!(
+        std::fs::read_to_string(folder.join("report.md")).unwrap(),
+        "# a report\n"
+    );
+}
+
+/// Every path under `root`.
+fn walk(root: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(root).unwrap().flatten() {
+        let p = e.path();
+        if e.file_type().unwrap().is_dir() {
+            out.extend(walk(&p));
+        }
+        out.push(p);
+    }
+    out
+}

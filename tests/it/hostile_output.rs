@@ -89,8 +89,9 @@ fn link_tree(from: &Path, to: &Path) {
 }
 
 /// A results folder backed up with hard links, then resumed with more seeds (new units
-/// appended to its journal): the backup, sharing every inode at the start, is byte for byte
-/// what it was, and the resumed folder holds the new runs.
+/// appended to its journal) and one cached ground truth to write again under its name, that
+/// name hard-linked to a file outside: the backup, sharing every inode at the start, is byte
+/// for byte what it was, the outside file too, and the resumed folder holds the new runs.
 #[test]
 fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
     let s = Scratch::new(&tiny(), "tiny");
@@ -107,6 +108,17 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
             .collect()
     };
     assert!(!journal(&backup).is_empty(), "the run keeps a journal");
+    // A cached ground truth whose name the run will write again (its content no longer reads
+    // as one: a cache miss) shares its inode with a file outside the folder.
+    let cached = std::fs::read_dir(results.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .min()
+        .expect("a cached ground truth");
+    let outside = s.root.join("outside");
+    std::fs::write(&outside, b"not a ground truth").unwrap();
+    std::fs::remove_file(&cached).unwrap();
+    std::fs::hard_link(&outside, &cached).unwrap();
     std::fs::write(
         s.work.join("exp.toml"),
         tiny().replace("seeds = [1, 2]", "seeds = [1, 2, 3]"),
@@ -119,6 +131,14 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
         journal(&results),
         journal(&backup),
         "the resumed run journaled nothing new"
+    );
+    assert!(
+        std::fs::read(&cached).unwrap() != b"not a ground truth",
+        "the run did not write the cached ground truth again"
+    );
+    assert!(
+        std::fs::read(&outside).unwrap() == b"not a ground truth",
+        "written through the cache file's shared inode"
     );
 }
 

@@ -335,7 +335,13 @@ impl Accelerator for KdTree {
         _step: DVec3,
     ) -> anyhow::Result<crate::accel::Updated> {
         match method {
-            crate::accel::UpdateMethod::Rebuild => *self = KdTree::build(moved, self.settings).named(self.name),
+            // The same budget as the first build: a moved part whose triangles now straddle
+            // every plane is refused, not built past the memory there is.
+            crate::accel::UpdateMethod::Rebuild => {
+                *self = KdTree::within(moved, self.settings, super::kdtree_entries())
+                    .map_err(anyhow::Error::msg)?
+                    .named(self.name)
+            }
             m => return Err(crate::accel::unknown_update(self, m)),
         }
         Ok(crate::accel::Updated::Rebuilt)

@@ -126,7 +126,10 @@ impl FpsSpec {
                 r[1],
             )?;
             if f.resolutions[..i].contains(r) {
-                return Err(source.error(&key_path!["resolutions", i], "is listed twice"));
+                return Err(source.error(
+                    &key_path!["resolutions", i],
+                    format!("{} x {} is listed twice", r[0], r[1]),
+                ));
             }
         }
         if f.scenes.is_empty() {

@@ -407,7 +407,10 @@ pub fn run_block(
                         }
                     }
                     for (v, u) in variants.iter_mut().zip(&mut updates) {
-                        let (took, did) = v.update(&current, object, step)?;
+                        let (took, did) = v.update(&current, object, step).map_err(|e| {
+                            spec.places
+                                .refused(v.structure, &format!("updating for frame {frame}"), e)
+                        })?;
                         *u = Some((took.as_secs_f64(), did));
                     }
                 }

@@ -345,7 +345,10 @@ impl RealtimeSpec {
                 m => m,
             };
             if accumulations.contains(&parsed) {
-                return Err(source.error(&key_path!["sweep", "accumulations", i], "is listed twice"));
+                return Err(source.error(
+                    &key_path!["sweep", "accumulations", i],
+                    format!("`{a}` is listed twice"),
+                ));
             }
             accumulations.push(parsed);
         }
@@ -355,13 +358,13 @@ impl RealtimeSpec {
                 .parse()
                 .map_err(|e: String| source.error(&key_path!["sweep", "filters", i], e))?;
             if filters.contains(&filter) {
-                return Err(source.error(&key_path!["sweep", "filters", i], "is listed twice"));
+                return Err(source.error(&key_path!["sweep", "filters", i], format!("`{name}` is listed twice")));
             }
             filters.push(filter);
         }
         for (i, seed) in s.seeds.iter().enumerate() {
             if s.seeds[..i].contains(seed) {
-                return Err(source.error(&key_path!["sweep", "seeds", i], "is listed twice"));
+                return Err(source.error(&key_path!["sweep", "seeds", i], format!("{seed} is listed twice")));
             }
         }
         let settings = f.filters.unwrap_or_default();

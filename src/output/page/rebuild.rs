@@ -8,7 +8,7 @@
 //! the next strip of its size and length. A missing PNG beside an EXR is drawn from it.
 
 use super::{files_in, write_stored, Gallery, Page, Shot, Tone};
-use crate::files::{read_regular, read_regular_text, Refused};
+use crate::files::{read_regular_text, Refused};
 use crate::output::images::{exposure, write_png};
 use anyhow::Context;
 use std::path::Path;
@@ -195,15 +195,18 @@ fn natural(name: &str) -> Vec<(u128, String)> {
     key
 }
 
-/// Refuses an EXR whose header promises more than the page could hold, before any pixel is
-/// read: a side or pixel count past what an experiment writes ([`MAX_IMAGE_SIDE`],
-/// [`MAX_IMAGE_PIXELS`]), or decoded samples, their f32 copy and the picture drawn from them past
-/// the memory this process may still take ([`crate::accel::memory::available`]). A compressed
-/// file a few MB long can declare gigabytes of pixels.
-fn check_exr_header(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+/// Refuses an EXR whose header promises more than the page could hold, reading the header
+/// only: a side or pixel count past what an experiment writes ([`MAX_IMAGE_SIDE`],
+/// [`MAX_IMAGE_PIXELS`]), decoded samples, their f32 copy and the picture drawn from them past
+/// the memory this process may still take ([`crate::accel::memory::available`]), or a file
+/// longer than its declared pixels stored raw, plus an eighth and a MiB (a sparse file of
+/// gigabytes behind a small header). A compressed file a few MB long can declare gigabytes of
+/// pixels.
+fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
     use crate::config::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
-    let meta = exr::meta::MetaData::read_from_buffered(bytes, false)
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
         .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
+    let mut raw = 0u64;
     for header in &meta.headers {
         let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
         if w > MAX_IMAGE_SIDE as u64 || h > MAX_IMAGE_SIDE as u64 || w * h > MAX_IMAGE_PIXELS {
@@ -214,8 +217,10 @@ fn check_exr_header(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
             ))
             .into());
         }
+        let stored = w * h * header.channels.bytes_per_pixel as u64;
+        raw += stored;
         // Decoded samples, the f32 values and the 8-bit picture drawn from them.
-        let need = w * h * (header.channels.bytes_per_pixel as u64 + 4 + 4);
+        let need = stored + w * h * (4 + 4);
         if let Some(budget) = crate::accel::memory::available().filter(|b| need > b.bytes) {
             return Err(Refused(format!(
                 "{}: a {w} x {h} image needs {:.1} GB to read, more than {}; refused before reading",
@@ -226,6 +231,15 @@ fn check_exr_header(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
             .into());
         }
     }
+    let len = file.metadata()?.len();
+    let most = raw + raw / 8 + (1 << 20);
+    if len > most {
+        return Err(Refused(format!(
+            "{}: {len} bytes, more than an EXR of the size its header declares takes ({most}); refused before reading",
+            path.display()
+        ))
+        .into());
+    }
     Ok(())
 }
 
@@ -233,8 +247,13 @@ fn check_exr_header(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
 /// ([`check_exr_header`]).
 fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
     use exr::prelude::*;
-    let bytes = read_regular(path)?;
-    check_exr_header(path, &bytes)?;
+    use std::io::{Read, Seek};
+    let mut file = crate::files::open_regular(path)?;
+    check_exr_header(path, &file)?;
+    let mut bytes = Vec::new();
+    file.rewind()
+        .and_then(|_| file.read_to_end(&mut bytes))
+        .with_context(|| format!("reading {}", path.display()))?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()
