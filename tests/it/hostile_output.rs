@@ -186,3 +186,30 @@ fn a_folder_swapped_for_a_link_mid_run_is_never_written_through() {
         assert_eq!(std::fs::read(home.join("runs.csv")).unwrap(), earlier, "{swapped}");
     }
 }
+
+/// A folder where a cached ground truth's file belongs is refused when the run reads the cache,
+/// exit 2 naming it, before the render whose result could not be written there; the earlier
+/// results stay as they were.
+#[test]
+fn a_folder_at_a_cached_ground_truths_name_is_refused_before_rendering() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
+    assert_eq!(code, 0, "{stderr}");
+    let home = s.work.join("results/tiny");
+    let cached = std::fs::read_dir(home.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .min()
+        .expect("a cached ground truth");
+    std::fs::remove_file(&cached).unwrap();
+    std::fs::create_dir(&cached).unwrap();
+    let before = snapshot(&s.root);
+    let (code, stderr) = s.run(&["exp.toml"]);
+    assert_eq!(code, 2, "{stderr}");
+    let name = cached.file_name().unwrap().to_string_lossy();
+    assert!(
+        stderr.contains(&*name) && stderr.contains("not a regular file"),
+        "{stderr}"
+    );
+    assert_eq!(snapshot(&s.root), before, "the refused run changed something");
+}

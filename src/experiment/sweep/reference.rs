@@ -64,7 +64,7 @@ impl Reference {
         // The context holds the build id: a changed renderer never reuses a cached ground truth.
         let key = format!("{context};lights={lights};r={radius:e}");
         let file = format!("ground-truth-{:016x}.bin", fnv1a(key.as_bytes()));
-        let (per_light, hit) = match load_cached(cache, &file, view, lights as usize) {
+        let (per_light, hit) = match load_cached(cache, &file, view, lights as usize)? {
             Some(cached) => cached,
             None => {
                 let sampling = Sampling {
@@ -176,27 +176,28 @@ impl Reference {
 
 const MAGIC: &[u8; 8] = b"PNBRGT02";
 
-/// Cached (visibility of the measured light, object ids) of a ground-truth render.
-/// A cached ground truth: each light's visibility image, then the hit ids.
-fn load_cached(
-    cache: &crate::files::Folder,
-    name: &str,
-    view: View,
-    lights: usize,
-) -> Option<(Vec<Vec<f32>>, Vec<u32>)> {
-    let bytes = cache.read(name).ok()??;
+/// A ground-truth render as cached: each light's visibility image, then the hit ids.
+type Cached = (Vec<Vec<f32>>, Vec<u32>);
+
+/// A cached ground truth: each light's visibility image, then the hit ids; none where there is
+/// none or its bytes are not one of this size (rendered again), and a refusal where a link, a
+/// folder or another non-file holds its name (before the render it would be written over).
+fn load_cached(cache: &crate::files::Folder, name: &str, view: View, lights: usize) -> anyhow::Result<Option<Cached>> {
+    let Some(bytes) = cache.read(name)? else {
+        return Ok(None);
+    };
     let n = view.pixels();
     if bytes.len() != 8 + 4 * n * (lights + 1) || &bytes[..8] != MAGIC {
-        return None;
+        return Ok(None);
     }
     let vis = (0..lights)
         .map(|l| bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n * l..8 + 4 * n * (l + 1)]))
         .collect();
     let hit: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[8 + 4 * n * lights..]);
-    Some((vis, hit))
+    Ok(Some((vis, hit)))
 }
 
-fn save_cached(cache: &crate::files::Folder, name: &str, (vis, hit): &(Vec<Vec<f32>>, Vec<u32>)) -> anyhow::Result<()> {
+fn save_cached(cache: &crate::files::Folder, name: &str, (vis, hit): &Cached) -> anyhow::Result<()> {
     let mut bytes = MAGIC.to_vec();
     for v in vis {
         bytes.extend_from_slice(bytemuck::cast_slice(v));
