@@ -99,7 +99,13 @@ pub fn load(path: &Path) -> Result<MeshFile, MeshFileError> {
             meta.len()
         )));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "not UTF-8 text (byte {} starts an invalid sequence)",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
     parse(&text, path)
 }
 
@@ -356,5 +362,17 @@ mod tests {
         let e = face_fits(MAX_FILE_TRIANGLES - 2, 5).unwrap_err();
         assert!(e.contains("past 16777216 triangles"), "{e}");
         assert!(face_fits(MAX_FILE_TRIANGLES - 3, 5).is_ok());
+    }
+
+    #[test]
+    fn a_mesh_file_that_is_not_utf8_is_refused_at_its_first_bad_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.obj");
+        std::fs::write(&path, b"v 0 0 0\nv 1 0 0\nv 0 1 0\n# caf\xe9\nf 1 2 3\n").unwrap();
+        let e = load(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("m.obj") && e.contains("byte 29 starts an invalid sequence"),
+            "{e}"
+        );
     }
 }
