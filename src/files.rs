@@ -152,28 +152,17 @@ impl Folder {
                 libc::O_RDONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK | libc::O_CLOEXEC,
             )
         };
-        if fd < 0 {
+        let opened = if fd < 0 {
             let e = std::io::Error::last_os_error();
-            return match e.raw_os_error() {
-                Some(libc::ENOENT) => Ok(None),
-                Some(libc::ELOOP) => Err(Refused(format!(
-                    "{}: a symbolic link; refused (it could lead outside the folder)",
-                    shown.display()
-                ))
-                .into()),
-                _ => Err(Refused(format!("{}: cannot open: {e}", shown.display())).into()),
-            };
-        }
-        let mut file = unsafe { std::fs::File::from_raw_fd(fd) };
-        let kind = file.metadata()?.file_type();
-        if !kind.is_file() {
-            return Err(Refused(format!(
-                "{}: not a regular file ({}); refused",
-                shown.display(),
-                describe(kind)
-            ))
-            .into());
-        }
+            if e.raw_os_error() == Some(libc::ENOENT) {
+                return Ok(None);
+            }
+            Err(e)
+        } else {
+            // SAFETY: a descriptor openat just returned, owned by nothing else.
+            Ok(unsafe { std::fs::File::from_raw_fd(fd) })
+        };
+        let mut file = regular(opened, &shown)?;
         let mut bytes = Vec::new();
         file.read_to_end(&mut bytes)
             .with_context(|| format!("reading {}", shown.display()))?;
@@ -191,17 +180,23 @@ pub struct Refused(pub String);
 /// pipe, device or folder is refused before anything is read (the open does not block).
 pub fn open_regular(path: &Path) -> anyhow::Result<std::fs::File> {
     use std::os::unix::fs::OpenOptionsExt;
-    let file = std::fs::OpenOptions::new()
+    let opened = std::fs::OpenOptions::new()
         .read(true)
         .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
-        .open(path)
-        .map_err(|e| match e.raw_os_error() {
-            Some(libc::ELOOP) => Refused(format!(
-                "{}: a symbolic link; refused (it could lead outside the folder)",
-                path.display()
-            )),
-            _ => Refused(format!("{}: cannot open: {e}", path.display())),
-        })?;
+        .open(path);
+    regular(opened, path)
+}
+
+/// The file an open of `path` that did not follow a final link gave, where it is a regular file:
+/// a link (the open's ELOOP), a failed open, or a pipe, device or folder is refused.
+fn regular(opened: std::io::Result<std::fs::File>, path: &Path) -> anyhow::Result<std::fs::File> {
+    let file = opened.map_err(|e| match e.raw_os_error() {
+        Some(libc::ELOOP) => Refused(format!(
+            "{}: a symbolic link; refused (it could lead outside the folder)",
+            path.display()
+        )),
+        _ => Refused(format!("{}: cannot open: {e}", path.display())),
+    })?;
     let kind = file
         .metadata()
         .with_context(|| format!("{}: cannot read its metadata", path.display()))?

@@ -43,12 +43,8 @@ impl SettingsPlaces {
     /// The error of a build of `name` refused with `e` (on `what`: a mesh, a scene), at the
     /// place of `name`'s settings; `e` itself where `name` is not compared here.
     pub fn refused(&self, name: &str, what: &str, e: anyhow::Error) -> anyhow::Error {
-        match self.0.get(name) {
-            Some(place) => ConfigError {
-                message: format!("{what}: {e:#}"),
-                ..place.clone()
-            }
-            .into(),
+        match self.error(name, format!("{what}: {e:#}")) {
+            Some(located) => located.into(),
             None => e,
         }
     }

@@ -30,6 +30,15 @@ pub(crate) fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
+/// The first entry of `dir` by name (`what` it must hold, for the message where it is empty).
+pub(crate) fn first_file(dir: &Path, what: &str) -> PathBuf {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .min()
+        .unwrap_or_else(|| panic!("{}: no {what}", dir.display()))
+}
+
 /// A scratch tree: `root/a/b/work` is the working folder (so `../../x` stays inside `root`),
 /// holding the experiment as `exp.toml` and earlier results of experiment `name` (of the kind
 /// the text declares) in `results/NAME`.
@@ -1162,11 +1171,7 @@ fn an_edited_sweep_journal_is_refused_not_resumed() {
     let (code, stderr) = s.run(&["exp.toml"]);
     assert_eq!(code, 0, "{stderr}");
     let home = s.work.join("results/tiny");
-    let runs = std::fs::read_dir(home.join(".journal"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .min()
-        .expect("a journaled unit");
+    let runs = first_file(&home.join(".journal"), "a journaled unit");
     let good = std::fs::read_to_string(&runs).unwrap();
     let digit = good.rfind(|c: char| c.is_ascii_digit() && c != '7').unwrap();
     let mut edited = good.clone();

@@ -3,7 +3,7 @@
 //! Every case ends with the command's own exit status (never a panic's 101), says why where
 //! standard error can still take it, and changes nothing outside the output folder.
 
-use crate::hostile_input::{snapshot, tiny, Scratch};
+use crate::hostile_input::{first_file, snapshot, tiny, Scratch};
 use std::fs::File;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -110,11 +110,7 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
     assert!(!journal(&backup).is_empty(), "the run keeps a journal");
     // A cached ground truth whose name the run will write again (its content no longer reads
     // as one: a cache miss) shares its inode with a file outside the folder.
-    let cached = std::fs::read_dir(results.join("cache"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .min()
-        .expect("a cached ground truth");
+    let cached = first_file(&results.join("cache"), "a cached ground truth");
     let outside = s.root.join("outside");
     std::fs::write(&outside, b"not a ground truth").unwrap();
     std::fs::remove_file(&cached).unwrap();
@@ -196,11 +192,7 @@ fn a_folder_at_a_cached_ground_truths_name_is_refused_before_rendering() {
     let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
     assert_eq!(code, 0, "{stderr}");
     let home = s.work.join("results/tiny");
-    let cached = std::fs::read_dir(home.join("cache"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .min()
-        .expect("a cached ground truth");
+    let cached = first_file(&home.join("cache"), "a cached ground truth");
     std::fs::remove_file(&cached).unwrap();
     std::fs::create_dir(&cached).unwrap();
     let before = snapshot(&s.root);

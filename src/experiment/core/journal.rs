@@ -96,20 +96,14 @@ impl UnitJournal {
     /// bytes of its file ([`UnitJournal::parse`]).
     fn read_held<O: DeserializeOwned>(&self, key: &str) -> anyhow::Result<Option<(O, Vec<u8>)>> {
         let path = self.path(key);
-        let damaged = |why: String| {
-            BadInput(format!(
-                "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
-                path.display()
-            ))
-        };
         let Some(bytes) = self
             .folder
             .read(&Self::name(key))
-            .map_err(|e| damaged(format!("cannot be read ({e:#})")))?
+            .map_err(|e| damaged(&path, &format!("cannot be read ({e:#})")))?
         else {
             return Ok(None);
         };
-        let text = std::str::from_utf8(&bytes).map_err(|_| damaged("is not UTF-8 text".into()))?;
+        let text = std::str::from_utf8(&bytes).map_err(|_| damaged(&path, "is not UTF-8 text"))?;
         Ok(Some((Self::parse(&path, text, key)?, bytes)))
     }
 
@@ -120,12 +114,8 @@ impl UnitJournal {
         if std::fs::symlink_metadata(path).is_err() {
             return Ok(None);
         }
-        let text = crate::files::read_regular_text(path).map_err(|e| {
-            BadInput(format!(
-                "{}: a journaled unit cannot be read ({e:#}); remove the file to measure the unit again, or rerun with --fresh",
-                path.display()
-            ))
-        })?;
+        let text =
+            crate::files::read_regular_text(path).map_err(|e| damaged(path, &format!("cannot be read ({e:#})")))?;
         Self::parse(path, &text, key).map(Some)
     }
 
@@ -133,19 +123,13 @@ impl UnitJournal {
     /// the file a run wrote (its first line, `# fnv1a HASH`, hashes the rest as written: an
     /// edited, cut or foreign file would otherwise be taken as measured).
     fn parse<O: DeserializeOwned>(path: &Path, text: &str, key: &str) -> anyhow::Result<O> {
-        let damaged = |why: &str| {
-            BadInput(format!(
-                "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
-                path.display()
-            ))
-        };
         let (check, body) = text.split_once('\n').unwrap_or((text, ""));
         if check.strip_prefix(CHECK) != Some(&format!("{:016x}", fnv1a(body.as_bytes()))) {
-            return Err(damaged("has changed since it was written (its checksum does not match)").into());
+            return Err(damaged(path, "has changed since it was written (its checksum does not match)").into());
         }
-        let j: Journaled<O> = toml::from_str(body).map_err(|e| damaged(&format!("does not parse ({e})")))?;
+        let j: Journaled<O> = toml::from_str(body).map_err(|e| damaged(path, &format!("does not parse ({e})")))?;
         if j.key != key {
-            return Err(damaged(&format!("holds unit {} under another unit's name", j.key)).into());
+            return Err(damaged(path, &format!("holds unit {} under another unit's name", j.key)).into());
         }
         Ok(j.outcome)
     }
@@ -161,6 +145,15 @@ impl UnitJournal {
         die_after_journaled();
         Ok(())
     }
+}
+
+/// The refusal of the journaled unit at `path` that `why` (cannot be read, has changed, ...):
+/// bad input, with the two ways on.
+fn damaged(path: &Path, why: &str) -> BadInput {
+    BadInput(format!(
+        "{}: a journaled unit {why}; remove the file to measure the unit again, or rerun with --fresh",
+        path.display()
+    ))
 }
 
 /// Test hooks after each journaled unit, so tests interrupt or change a run at a known point
