@@ -34,6 +34,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     result.with_context(|| format!("writing {}", path.display()))
 }
 
+/// The folders missing on the way to `path`, `path` first: those a `create_dir_all(path)` would
+/// make, and a failed run should take away again ([`remove_empty`]).
+pub fn missing_folders(path: &Path) -> Vec<std::path::PathBuf> {
+    path.ancestors()
+        .take_while(|p| !p.as_os_str().is_empty() && std::fs::symlink_metadata(p).is_err())
+        .map(Path::to_path_buf)
+        .collect()
+}
+
+/// Removes `folders` (innermost first) that are empty, stopping at the first that is not.
+pub fn remove_empty(folders: &[std::path::PathBuf]) {
+    for p in folders {
+        if std::fs::remove_dir(p).is_err() {
+            break;
+        }
+    }
+}
+
 /// A folder a run writes into, held open for the run: every file is created and replaced
 /// through the handle (`openat` and `renameat`, never following a link), so a folder swapped for
 /// a link to somewhere else while the run goes is never written through; [`Folder::check_held`]
@@ -42,6 +60,8 @@ pub struct Folder {
     path: std::path::PathBuf,
     handle: std::fs::File,
     identity: (u64, u64),
+    /// The folders `create` made, innermost first.
+    made: Vec<std::path::PathBuf>,
 }
 
 impl Folder {
@@ -50,6 +70,7 @@ impl Folder {
     pub fn create(path: &Path) -> anyhow::Result<Folder> {
         use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
         check_plain_folder(path)?;
+        let made = missing_folders(path);
         std::fs::create_dir_all(path).with_context(|| format!("creating {}", path.display()))?;
         let handle = std::fs::OpenOptions::new()
             .read(true)
@@ -61,7 +82,17 @@ impl Folder {
             path: path.to_path_buf(),
             handle,
             identity: (m.dev(), m.ino()),
+            made,
         })
+    }
+
+    /// Removes the folders `create` made (the folder and the parents it had to make) where
+    /// they are still empty and the folder is still the one held: what a failed step leaves
+    /// when it wrote nothing (anything written stays, for a resume).
+    pub fn remove_if_made_and_empty(&self) {
+        if self.check_held().is_ok() {
+            remove_empty(&self.made);
+        }
     }
 
     /// The path the folder was opened at.
@@ -167,6 +198,30 @@ impl Folder {
         file.read_to_end(&mut bytes)
             .with_context(|| format!("reading {}", shown.display()))?;
         Ok(Some(bytes))
+    }
+
+    /// Removes every file of the folder not named in `keep`, listed and unlinked through the
+    /// handle (a folder swapped while the run went is refused first); folders in it are left.
+    pub fn remove_all_but(&self, keep: &std::collections::HashSet<String>) -> anyhow::Result<()> {
+        use std::os::fd::AsRawFd;
+        use std::os::unix::ffi::OsStrExt;
+        self.check_held()?;
+        let fd = self.handle.as_raw_fd();
+        let listed = std::fs::read_dir(format!("/proc/self/fd/{fd}"))
+            .with_context(|| format!("listing {}", self.path.display()))?;
+        for entry in listed {
+            let entry = entry?;
+            if entry.file_type()?.is_dir() || entry.file_name().to_str().is_some_and(|n| keep.contains(n)) {
+                continue;
+            }
+            let name = std::ffi::CString::new(entry.file_name().as_bytes())?;
+            // SAFETY: unlinkat on the held descriptor with a NUL-terminated name.
+            if unsafe { libc::unlinkat(fd, name.as_ptr(), 0) } != 0 {
+                let e = std::io::Error::last_os_error();
+                return Err(e).with_context(|| format!("removing {}", self.path.join(entry.file_name()).display()));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -6,6 +6,7 @@ use crate::accel::settings::read_tables;
 use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Source};
 use crate::key_path;
+use crate::render::limit::{DeviceLimit, Part};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
@@ -33,13 +34,31 @@ pub struct Comparison {
 }
 
 /// Where each compared structure's settings are in the experiment file (its `[accel.NAME]`
-/// table, or its place in `structures` where it has none), so a build refused while the run
-/// goes is bad input located there: a kd-tree whose leaves outgrow the memory budget is known
-/// only while it builds, and the file's settings are what to change.
+/// table, or its place in `structures` where it has none), and the key that sets the frame's
+/// size, so a refusal known only while the run goes is bad input located there: a kd-tree whose
+/// leaves outgrow the memory budget is known only while it builds, a visibility field or frame
+/// past the device's binding limit only when it is uploaded, and the file's keys are what to
+/// change.
 #[derive(Clone, Debug, Default)]
-pub struct SettingsPlaces(BTreeMap<&'static str, ConfigError>);
+pub struct SettingsPlaces {
+    structures: BTreeMap<&'static str, ConfigError>,
+    frame: Option<ConfigError>,
+}
 
 impl SettingsPlaces {
+    /// Each structure's place, and the frame size's.
+    pub fn new(structures: BTreeMap<&'static str, ConfigError>, frame: Option<ConfigError>) -> SettingsPlaces {
+        SettingsPlaces { structures, frame }
+    }
+
+    /// These places, with the frame size's at `frame`.
+    pub fn with_frame(self, frame: ConfigError) -> SettingsPlaces {
+        SettingsPlaces {
+            frame: Some(frame),
+            ..self
+        }
+    }
+
     /// The error of a build of `name` refused with `e` (on `what`: a mesh, a scene), at the
     /// place of `name`'s settings; `e` itself where `name` is not compared here.
     pub fn refused(&self, name: &str, what: &str, e: anyhow::Error) -> anyhow::Error {
@@ -51,10 +70,27 @@ impl SettingsPlaces {
 
     /// The place of `name`'s settings, with `message`.
     pub fn error(&self, name: &str, message: String) -> Option<ConfigError> {
-        self.0.get(name).map(|place| ConfigError {
+        self.structures.get(name).map(|place| ConfigError {
             message,
             ..place.clone()
         })
+    }
+
+    /// `e` located where it is a device's refusal ([`DeviceLimit`]): a structure's at its
+    /// settings, a frame's at the frame size; any other error as it is.
+    pub fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        match DeviceLimit::part_of(&e) {
+            Some(Part::Structure(name)) => self.refused(name, "on this GPU", e),
+            Some(Part::Frame) => match &self.frame {
+                Some(place) => ConfigError {
+                    message: format!("{e:#}"),
+                    ..place.clone()
+                }
+                .into(),
+                None => e,
+            },
+            _ => e,
+        }
     }
 }
 
@@ -100,7 +136,7 @@ impl Comparison {
         Ok(Comparison {
             names,
             tables,
-            places: SettingsPlaces(places),
+            places: SettingsPlaces::new(places, None),
         })
     }
 }

@@ -50,17 +50,11 @@ pub fn run(cli: &Cli) -> anyhow::Result<()> {
     };
     // The folders this run makes for its results, innermost first: a failed run removes those
     // it left empty (a journal worth resuming keeps its folder).
-    let made: Vec<PathBuf> = out
-        .ancestors()
-        .take_while(|p| !p.as_os_str().is_empty() && !p.exists())
-        .map(|p| p.to_path_buf())
-        .collect();
+    let made = crate::files::missing_folders(&out);
     let home = resolve_home(&out).map_err(BadInput)?;
     let result = run_into(experiment.as_ref(), cli, choice, &home, started, started_utc, inputs);
     if result.is_err() {
-        for p in &made {
-            let _ = std::fs::remove_dir(p);
-        }
+        crate::files::remove_empty(&made);
     }
     result
 }
@@ -168,7 +162,12 @@ fn backend_for(experiment: &dyn Experiment, choice: BackendChoice) -> Result<Bac
 pub fn exit_status(result: &anyhow::Result<()>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.is::<BadInput>() || e.is::<crate::config::ConfigError>() || e.is::<crate::files::Refused>() => {
+        Err(e)
+            if e.is::<BadInput>()
+                || e.is::<crate::config::ConfigError>()
+                || e.is::<crate::files::Refused>()
+                || e.is::<crate::render::limit::DeviceLimit>() =>
+        {
             ExitCode::from(2)
         }
         Err(e) if e.is::<RunsFailed>() => ExitCode::from(3),

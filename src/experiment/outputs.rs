@@ -24,8 +24,9 @@ pub struct Outputs {
     home: PathBuf,
     staging: PathBuf,
     committed: bool,
-    /// Whether `staging` is a shard's own folder, which outlives the run and is never swapped in.
-    shard: bool,
+    /// Where `staging` is a shard's own folder, which outlives the run and is never swapped in:
+    /// the folders this run made for it (innermost first), taken away again if left empty.
+    shard: Option<Vec<PathBuf>>,
     /// The results folder (exclusively) or a shard's folder (with the results folder shared),
     /// open and locked for as long as this run writes there.
     _locks: Vec<File>,
@@ -178,7 +179,7 @@ impl Outputs {
             home: home.to_path_buf(),
             staging,
             committed: false,
-            shard: false,
+            shard: None,
             _locks: vec![lock],
         })
     }
@@ -196,6 +197,7 @@ impl Outputs {
         for kept in ["cache", "shards"] {
             check_plain_folder(&home.join(kept))?;
         }
+        let made = crate::files::missing_folders(dir);
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         check_kept(dir)?;
         let dir_lock = lock(dir, Hold::Alone, "another run is writing this shard; wait for it")?;
@@ -203,7 +205,7 @@ impl Outputs {
             home: home.to_path_buf(),
             staging: dir.to_path_buf(),
             committed: false,
-            shard: true,
+            shard: Some(made),
             _locks: vec![home_lock, dir_lock],
         })
     }
@@ -231,7 +233,7 @@ impl Outputs {
     /// Replaces the results folder with the staged set, carrying over [`KEPT`] entries; if the
     /// swap fails, the carried entries go back where they were and the earlier set stays.
     pub fn commit(mut self) -> anyhow::Result<()> {
-        if self.shard {
+        if self.shard.is_some() {
             bail!(
                 "{}: a shard's folder is written in place, never swapped in",
                 self.staging.display()
@@ -273,8 +275,12 @@ impl Outputs {
 
 impl Drop for Outputs {
     fn drop(&mut self) {
-        if !self.committed && !self.shard {
-            let _ = std::fs::remove_dir_all(&self.staging);
+        match &self.shard {
+            Some(made) => crate::files::remove_empty(made),
+            None if !self.committed => {
+                let _ = std::fs::remove_dir_all(&self.staging);
+            }
+            None => {}
         }
     }
 }

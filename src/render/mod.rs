@@ -9,6 +9,7 @@ pub mod ambient;
 pub mod cpu;
 pub mod denoise;
 pub mod gpu;
+pub mod limit;
 pub mod mirror;
 pub mod plan;
 pub mod shading;

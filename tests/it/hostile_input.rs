@@ -821,7 +821,65 @@ fn cases() -> Vec<Case> {
         String::new(),
         &["not a regular file"],
     ));
+    #[cfg(feature = "test-hooks")]
+    v.extend(device_limit_cases(&sweep));
     v
+}
+
+/// Buffers past the device's binding limit (lowered by `PENUMBRA_TEST_BINDING_BYTES`, so any
+/// adapter reaches them): a visibility field's tile buffer is refused at its `[accel.vlf]`
+/// table, a frame's hit buffer at the measuring frame's `width`, both with exit 2 and nothing
+/// written.
+#[cfg(feature = "test-hooks")]
+fn device_limit_cases(sweep: &str) -> Vec<Case> {
+    let ao = format!(
+        r#"kind = "ao"
+name = "ao-ci"
+backend = "gpu"
+width = 8
+height = 8
+rays = 33
+weighting = "plain"
+max_distance = 4.0
+structures = ["bvh", "vlf"]
+
+[timing]
+warmup = 0
+repeats = 6
+
+[tuning]
+width = 8
+height = 8
+repeats = 6
+
+[claim]
+subject = "vlf"
+baseline = "bvh"
+
+[accel.vlf]
+depth = 2
+
+[[meshes]]
+name = "cow"
+path = "{}"
+"#,
+        common::repo("assets/meshes/cow.off").display()
+    );
+    let mut field = case(
+        "a visibility field past the device's binding limit",
+        "ao-ci",
+        ao,
+        &["exp.toml:24:", "accel.vlf", "tile buffer", "binding limit"],
+    );
+    field.env = vec![("PENUMBRA_TEST_BINDING_BYTES", "8000000")];
+    let mut frame = case(
+        "a frame past the device's binding limit",
+        "tiny",
+        format!("backend = \"gpu\"\n{sweep}"),
+        &["exp.toml:", "measure.width", "24x24 frame", "hit buffer"],
+    );
+    frame.env = vec![("PENUMBRA_TEST_BINDING_BYTES", "4096")];
+    vec![field, frame]
 }
 
 #[test]

@@ -33,6 +33,8 @@ mod points_file;
 mod readme_figures;
 mod realtime_experiment;
 mod receiver_masks;
+#[cfg(feature = "test-hooks")]
+mod refused_runs;
 mod regression;
 mod render_plan;
 mod report_words;

@@ -14,6 +14,7 @@ use super::layer::Layer;
 use super::{Split, VisibilityField};
 use crate::accel::{GpuStructure, GpuTri};
 use crate::geometry::LocalFrame;
+use crate::render::limit::{DeviceLimit, Part};
 
 /// Storage buffers `vlf.wgsl` declares at group 2.
 pub const GPU_BUFFERS: u32 = 9;
@@ -51,6 +52,11 @@ pub(super) fn bytes(field: &VisibilityField) -> usize {
         + 4 * (field.base.words.len().max(1) + overlay.1)
 }
 
+/// A field the GPU cannot bind: bad input at the field's settings.
+fn over_limit(message: String) -> anyhow::Error {
+    DeviceLimit::new(Part::Structure("vlf"), message).into()
+}
+
 /// The buffers `vlf.wgsl` binds at group 2, in binding order, or an error naming the array that
 /// does not fit.
 pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
@@ -71,24 +77,26 @@ pub(super) fn structure(field: &VisibilityField, frame: &LocalFrame) -> anyhow::
     let mut chunk_start = vec![0usize];
     for k in 0..dirs {
         let (a, b) = (word(k), word(k + 1));
-        anyhow::ensure!(
-            (b - a) * 4 <= CHUNK_BYTES,
-            "visibility field: direction {k}'s tile entries take {} bytes, over the {CHUNK_BYTES}-byte id chunk by {} bytes; use fewer tiles",
-            (b - a) * 4,
-            (b - a) * 4 - CHUNK_BYTES
-        );
+        if (b - a) * 4 > CHUNK_BYTES {
+            return Err(over_limit(format!(
+                "visibility field: direction {k}'s tile entries take {} bytes, over the {CHUNK_BYTES}-byte id chunk by {} bytes; use fewer tiles",
+                (b - a) * 4,
+                (b - a) * 4 - CHUNK_BYTES
+            )));
+        }
         if (b - chunk_start.last().unwrap()) * 4 > CHUNK_BYTES {
             chunk_start.push(a);
         }
         chunk_of.push(chunk_start.len() as u32 - 1);
     }
-    anyhow::ensure!(
-        chunk_start.len() <= ID_CHUNKS,
-        "visibility field: the id buffer takes {} bytes, over the {} bytes of {ID_CHUNKS} chunks the GPU binds by {} bytes; use fewer tiles or directions",
-        base.words.len() * 4,
-        ID_CHUNKS * CHUNK_BYTES,
-        (base.words.len() * 4).saturating_sub(ID_CHUNKS * CHUNK_BYTES)
-    );
+    if chunk_start.len() > ID_CHUNKS {
+        return Err(over_limit(format!(
+            "visibility field: the id buffer takes {} bytes, over the {} bytes of {ID_CHUNKS} chunks the GPU binds by {} bytes; use fewer tiles or directions",
+            base.words.len() * 4,
+            ID_CHUNKS * CHUNK_BYTES,
+            (base.words.len() * 4).saturating_sub(ID_CHUNKS * CHUNK_BYTES)
+        )));
+    }
     chunk_start.push(base.words.len());
 
     let mut head: Vec<u32> = Vec::with_capacity(HEADER + 10 * dirs);

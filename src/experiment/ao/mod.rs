@@ -41,6 +41,10 @@ impl Declaration for AoSpec {
         &self.header
     }
 
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        self.places.locate(e)
+    }
+
     fn inputs(&self) -> Vec<PathBuf> {
         let mut v = vec![self.path.clone()];
         v.extend(self.meshes.iter().map(|m| m.path.clone()));

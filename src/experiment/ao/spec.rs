@@ -222,6 +222,7 @@ impl AoSpec {
             tables: mut given,
             places,
         } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
+        let places = places.with_frame(source.error(&key_path!["width"], String::new()));
         let structures: Vec<(&'static str, Vec<AccelSettings>)> = names
             .into_iter()
             .map(|name| {

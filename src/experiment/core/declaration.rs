@@ -87,6 +87,13 @@ pub trait Declaration: Clone {
         None
     }
 
+    /// `e` located at the experiment's key where it is a refusal known only while the run
+    /// goes (a device's binding limit: [`crate::render::limit::DeviceLimit`]); kinds without
+    /// such places return it as it is, and it still exits with status 2.
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        e
+    }
+
     /// Measures one unit.
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<Self::Outcome>;
 

@@ -70,6 +70,41 @@ pub fn measure_whole<D: Declaration>(
 }
 
 impl<D: Declaration> Declared<D> {
+    /// Runs (a whole run, a shard or a merge) without locating refusals.
+    fn run_unlocated(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
+        let mut spec = self.filtered(&run.cli.filter)?;
+        if let Some(path) = &run.cli.tuning {
+            refuse_tuning_inside(path, run.home)?;
+            spec.reuse_tuning(path).map_err(BadInput)?;
+        }
+        spec.keep_state_in(run.home);
+        if let Some(shard) = run.cli.shard {
+            return self.run_shard(&spec, shard, run);
+        }
+        let measured = if run.cli.merge.is_empty() {
+            measure_whole(&spec, run.home, run.cli.fresh, run.backend, run.progress)?
+        } else {
+            let (measured, machines) = merge_units(&spec, run)?;
+            tracing::info!(
+                "merged {} units from shards run on: {}",
+                measured.outcomes.len(),
+                machines.join("; ")
+            );
+            measured
+        };
+        let (units, resumed, failed) = (measured.outcomes.len(), measured.resumed, measured.failed);
+        let mut details = spec.report(measured.outcomes, run)?;
+        // A unit taken from a journal was measured by an earlier process (its times too): the
+        // manifest says how many, so a rerun that measured nothing is not read as fresh timing.
+        details.insert("units".into(), toml::Value::Integer(units as i64));
+        details.insert("units_from_journal".into(), toml::Value::Integer(resumed as i64));
+        let table = format!("see the `error` column of {}", run.home.join(D::FAILURES).display());
+        Ok(Finished::Results {
+            details,
+            failed: Some((failed, table)),
+        })
+    }
+
     /// The declaration restricted by the command line's filters.
     fn filtered(&self, filters: &[Filter]) -> Result<D, BadInput> {
         let mut spec = self.0.clone();
@@ -190,36 +225,6 @@ impl<D: Declaration> Experiment for Declared<D> {
     }
 
     fn run(&self, run: &mut RunContext) -> anyhow::Result<Finished> {
-        let mut spec = self.filtered(&run.cli.filter)?;
-        if let Some(path) = &run.cli.tuning {
-            refuse_tuning_inside(path, run.home)?;
-            spec.reuse_tuning(path).map_err(BadInput)?;
-        }
-        spec.keep_state_in(run.home);
-        if let Some(shard) = run.cli.shard {
-            return self.run_shard(&spec, shard, run);
-        }
-        let measured = if run.cli.merge.is_empty() {
-            measure_whole(&spec, run.home, run.cli.fresh, run.backend, run.progress)?
-        } else {
-            let (measured, machines) = merge_units(&spec, run)?;
-            tracing::info!(
-                "merged {} units from shards run on: {}",
-                measured.outcomes.len(),
-                machines.join("; ")
-            );
-            measured
-        };
-        let (units, resumed, failed) = (measured.outcomes.len(), measured.resumed, measured.failed);
-        let mut details = spec.report(measured.outcomes, run)?;
-        // A unit taken from a journal was measured by an earlier process (its times too): the
-        // manifest says how many, so a rerun that measured nothing is not read as fresh timing.
-        details.insert("units".into(), toml::Value::Integer(units as i64));
-        details.insert("units_from_journal".into(), toml::Value::Integer(resumed as i64));
-        let table = format!("see the `error` column of {}", run.home.join(D::FAILURES).display());
-        Ok(Finished::Results {
-            details,
-            failed: Some((failed, table)),
-        })
+        self.run_unlocated(run).map_err(|e| self.0.locate(e))
     }
 }

@@ -49,25 +49,23 @@ const CHECK: &str = "# fnv1a ";
 /// link mid-run is never written or read through.
 pub(super) struct UnitJournal {
     folder: crate::files::Folder,
-    /// Whether this run made the folder (a refused run then takes it away again if empty).
-    created: bool,
+    /// Whether every unit is measured again (`--fresh`): nothing is read from the journal, and
+    /// what this run did not write is removed only when it succeeds, so a refused or failed
+    /// fresh run loses nothing journaled.
+    fresh: bool,
 }
 
 impl UnitJournal {
     pub(super) fn open(dir: &Path, fresh: bool) -> anyhow::Result<UnitJournal> {
-        crate::files::check_plain_folder(dir)?;
-        if fresh && dir.exists() {
-            std::fs::remove_dir_all(dir)?;
-        }
-        let created = std::fs::symlink_metadata(dir).is_err();
         Ok(UnitJournal {
             folder: crate::files::Folder::create(dir)?,
-            created,
+            fresh,
         })
     }
 
     /// Measures `units` into this journal ([`measure_all`]); a run that fails before it
-    /// journals anything leaves no journal folder it made behind.
+    /// journals anything leaves no journal folder it made behind, and a fresh run that
+    /// succeeds leaves only its own units.
     pub(super) fn measure<D: Declaration>(
         &self,
         spec: &D,
@@ -77,9 +75,13 @@ impl UnitJournal {
         progress: &Progress,
     ) -> anyhow::Result<Measured<D::Outcome>> {
         let measured = measure_all(spec, units, context, self, backend, progress);
-        if measured.is_err() && self.created && self.folder.check_held().is_ok() {
-            // Removes only an empty folder: whatever was journaled stays for a resume.
-            let _ = std::fs::remove_dir(self.folder.path());
+        match &measured {
+            Err(_) => self.folder.remove_if_made_and_empty(),
+            Ok(m) if self.fresh => {
+                let kept: std::collections::HashSet<String> = m.files.iter().map(|f| Self::name(&f.key)).collect();
+                self.folder.remove_all_but(&kept)?;
+            }
+            Ok(_) => {}
         }
         measured
     }
@@ -200,7 +202,11 @@ fn measure_all<D: Declaration>(
     let mut journaled = Vec::with_capacity(units.len());
     for unit in units {
         let key = unit_key(spec, context, backend.adapter(), unit);
-        let earlier = journal.read_held::<D::Outcome>(&key)?;
+        let earlier = if journal.fresh {
+            None
+        } else {
+            journal.read_held::<D::Outcome>(&key)?
+        };
         journaled.push((key, earlier.filter(|(o, _)| spec.failed(o) == 0)));
     }
     let bar = progress.bar("units", units.len() as u64);

@@ -66,6 +66,10 @@ impl Declaration for FramesSpec {
         &self.header
     }
 
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        self.places.locate(e)
+    }
+
     fn inputs(&self) -> Vec<PathBuf> {
         let mut v = vec![self.path.clone()];
         v.extend(self.reused.iter().map(|k| k.path.clone()));

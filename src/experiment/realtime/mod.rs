@@ -74,6 +74,10 @@ impl Declaration for Realtime {
         &self.spec.header
     }
 
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        self.spec.places.locate(e)
+    }
+
     fn gpu(&self) -> bool {
         true
     }

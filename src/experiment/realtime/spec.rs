@@ -2,6 +2,7 @@
 //! axes of a real-time shadow pipeline (scheme x rays x frames x accumulation x filter x seed).
 
 use crate::config::{ConfigError, Source};
+use crate::experiment::comparison::SettingsPlaces;
 use crate::experiment::header::Header;
 use crate::key_path;
 use crate::render::denoise::{Accumulation, Filter, FilterSettings};
@@ -9,6 +10,7 @@ use crate::sampling::DiskScheme;
 use crate::scene::{Light, Scene, Shape, MAX_SAMPLES};
 use glam::DVec3;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 crate::experiment_file! {
@@ -114,6 +116,9 @@ pub struct RealtimeSpec {
     pub scene_path: PathBuf,
     /// The scene.
     pub scene: Scene,
+    /// Where the scene's structure and the measuring frame's size are set, for refusals known
+    /// only when a frame is uploaded.
+    pub places: SettingsPlaces,
     /// Measuring camera and size.
     pub camera: String,
     /// Image width.
@@ -194,6 +199,13 @@ impl RealtimeSpec {
             .map_err(|e| source.error(&key_path!["scene"], format!("{}: {}", scene_path.display(), e.message)))?;
         let mut scene = Scene::from_source(&scene_source)?;
         let m = &f.measure;
+        let places = SettingsPlaces::new(
+            BTreeMap::from([(
+                scene.accel_settings.name,
+                scene_source.error(&key_path!["accelerator"], String::new()),
+            )]),
+            Some(source.error(&key_path!["measure", "width"], String::new())),
+        );
         if let Some(n) = m.lights {
             if n == 0 || n > scene.lights.len() {
                 return Err(source.error(
@@ -418,6 +430,7 @@ impl RealtimeSpec {
             path: path.to_path_buf(),
             scene_path,
             scene,
+            places,
             camera: m.camera.clone(),
             width: m.width,
             height: m.height,

@@ -72,7 +72,11 @@ impl Sweep {
             .clone()
             .unwrap_or_else(|| std::env::temp_dir().join("penumbra-cache"));
         let cache = crate::files::Folder::create(&cache)?;
-        let reference = Arc::new(Reference::build(&self.spec, backend, lights, radius, &cache, &context)?);
+        let built = Reference::build(&self.spec, backend, lights, radius, &cache, &context);
+        if built.is_err() {
+            cache.remove_if_made_and_empty();
+        }
+        let reference = Arc::new(built?);
         for warning in reference.warnings() {
             tracing::warn!("{warning}");
         }
@@ -124,6 +128,10 @@ impl Declaration for Sweep {
 
     fn header(&self) -> &Header {
         &self.spec.header
+    }
+
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        self.spec.places.locate(e)
     }
 
     fn gpu(&self) -> bool {
@@ -256,7 +264,7 @@ impl Declaration for Sweep {
             ([i], _) => {
                 let group = &expand(s)[*i];
                 let reference = self.reference(backend, group.head().lights, group.head().light_radius)?;
-                Ok(UnitOutcome::Group(measure_group(s, backend, group, &reference)))
+                Ok(UnitOutcome::Group(measure_group(s, backend, group, &reference)?))
             }
             (_, PICTURES) => {
                 let pictures = super::pictures::render_pictures(s, backend, s.verdict_radius())

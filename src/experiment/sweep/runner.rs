@@ -17,6 +17,7 @@ use crate::experiment::progress::Progress;
 use crate::metrics::throughput::rays_per_second;
 use crate::metrics::{BiasVariance, RadialProfile};
 use crate::output::table::{csv_text, f32_hex};
+use crate::render::limit::DeviceLimit;
 use crate::render::{AdapterInfo, Backend, RenderPlan};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -100,8 +101,14 @@ pub struct Outcome {
 }
 
 /// Renders and measures every seed of `group` against `reference`; a failed render becomes a
-/// failed record and the group goes on.
-pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, reference: &Reference) -> GroupOutcome {
+/// failed record and the group goes on, except a frame the device cannot bind
+/// ([`DeviceLimit`]): bad input, which every later run would meet too.
+pub fn measure_group(
+    spec: &Spec,
+    backend: &mut dyn Backend,
+    group: &Group,
+    reference: &Reference,
+) -> anyhow::Result<GroupOutcome> {
     let context = context_key(spec, backend.adapter());
     let mut records = Vec::new();
     let mut images = Vec::new();
@@ -111,6 +118,7 @@ pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, refe
                 records.push(record);
                 images.push(image);
             }
+            Err(e) if DeviceLimit::part_of(&e).is_some() => return Err(e),
             Err(e) => {
                 tracing::error!("run failed ({} seed={}): {e:#}", run.config(), run.seed);
                 records.push(failed_record(spec, backend, run, &context, &format!("{e:#}")));
@@ -120,11 +128,11 @@ pub fn measure_group(spec: &Spec, backend: &mut dyn Backend, group: &Group, refe
     let figure = (group.head().samples == spec.figure_samples())
         .then(|| figure_of(reference, &images))
         .flatten();
-    GroupOutcome {
+    Ok(GroupOutcome {
         records,
         split: BiasVariance::measure(&images, &reference.ground_truth, &reference.mask),
         figure,
-    }
+    })
 }
 
 /// The timing unit: every configuration of the sweep at a timed ray count (`[timed]`), and the

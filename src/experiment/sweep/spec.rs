@@ -4,6 +4,7 @@
 pub use super::axes::Axes;
 use crate::accel::Accelerator;
 use crate::config::{ConfigError, Source};
+use crate::experiment::comparison::SettingsPlaces;
 use crate::experiment::header::Header;
 use crate::key_path;
 use crate::render::{BackendChoice, RenderPlan, View};
@@ -135,6 +136,9 @@ pub struct Spec {
     pub verdict: (DiskScheme, DiskScheme),
     /// The ray counts timed (`[timed]`; default every swept count).
     pub timed_samples: Vec<u32>,
+    /// Where each swept structure and the measuring frame's size are set, for refusals known
+    /// only when a frame is uploaded.
+    pub places: SettingsPlaces,
 }
 
 impl Spec {
@@ -210,6 +214,7 @@ impl Spec {
             ));
         }
         let mut structures = BTreeMap::new();
+        let mut places = BTreeMap::new();
         for (i, name) in axes.accelerators.iter().enumerate() {
             let Some(r) = crate::accel::registered(name) else {
                 return Err(err(
@@ -228,7 +233,9 @@ impl Spec {
                     .map_err(|e| err(&key_path!["sweep", "accelerators", i], format!("{e:#}")))?
             };
             structures.insert(name.clone(), built);
+            places.insert(r.name, err(&key_path!["sweep", "accelerators", i], String::new()));
         }
+        let places = SettingsPlaces::new(places, Some(err(&key_path!["measure", "width"], String::new())));
         if scene.triangles.positions.is_empty() {
             // Nothing for a structure to index: every structure would render the same frames,
             // and rows would name a structure that answered no ray.
@@ -424,6 +431,7 @@ impl Spec {
             structures,
             ground_truth: f.ground_truth,
             figures: f.figures,
+            places,
         })
     }
 

@@ -13,6 +13,7 @@
 use super::axes::Config;
 use super::run::{Group, Run};
 use super::spec::Spec;
+use crate::render::limit::DeviceLimit;
 use crate::render::{Backend, Sampling, View};
 use crate::timing::{decide, median_interval, Comparison, Decided, Estimate, Looks, Pair, RoundDone};
 use std::collections::BTreeMap;
@@ -202,6 +203,7 @@ pub fn time_groups(
                     failed[slot] = true;
                     Ok(f64::NAN)
                 }
+                Err(e) if DeviceLimit::part_of(&e).is_some() => Err(e),
                 Err(e) => {
                     tracing::error!("timing {} failed; left untimed: {e:#}", run.config());
                     failed[slot] = true;

@@ -20,6 +20,7 @@ mod pipelines;
 mod resources;
 mod timing;
 
+use super::limit::{DeviceLimit, Part};
 use super::plan::{Pass, RenderPlan, MAX_LIGHTS};
 use super::{AdapterInfo, Backend, Frame, RayCounts, Sampling, Timing, View, NO_HIT};
 use anyhow::{anyhow, bail, Context};
@@ -174,37 +175,47 @@ impl GpuBackend {
             structure,
             limits.max_storage_buffers_per_shader_stage,
         )?;
-        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let max =
+            crate::render::limit::binding_bytes(limits.max_storage_buffer_binding_size.min(limits.max_buffer_size));
+        let lights = packed.lights.len().max(1) as u64;
+        let pixels = view.pixels() as u64;
         let mut buffers = vec![
-            ("hit buffer", view.pixels() as u64 * HIT_BYTES),
+            (Part::Frame, "hit buffer", pixels * HIT_BYTES),
+            (Part::Frame, "visibility buffer", pixels * lights * 4),
+            (Part::Frame, "light sums buffer", pixels * lights * 4),
             (
-                "visibility buffer",
-                (view.pixels() * packed.lights.len().max(1)) as u64 * 4,
-            ),
-            (
-                "light sums buffer",
-                (view.pixels() * packed.lights.len().max(1)) as u64 * 4,
-            ),
-            (
+                Part::Scene,
                 "mesh triangle buffer",
                 std::mem::size_of_val(packed.mesh_tris.as_slice()) as u64,
             ),
-            ("ambient-occlusion buffer", view.pixels() as u64 * 8),
+            (Part::Frame, "ambient-occlusion buffer", pixels * 8),
         ];
         if plan.passes.iter().any(|p| matches!(p, Pass::Mirror { .. })) {
-            buffers.push(("mirror chain buffer", view.pixels() as u64 * layout::CHAIN_BYTES));
+            buffers.push((Part::Frame, "mirror chain buffer", pixels * layout::CHAIN_BYTES));
         }
-        if let Some((_, s)) = &packed.accel {
-            buffers.extend(s.buffers.iter().map(|(label, b)| (*label, b.len() as u64)));
+        if let Some((name, s)) = &packed.accel {
+            buffers.extend(
+                s.buffers
+                    .iter()
+                    .map(|(label, b)| (Part::Structure(name), *label, b.len() as u64)),
+            );
         }
-        for (what, bytes) in buffers {
+        for (part, what, bytes) in buffers {
             if bytes > max {
-                bail!(
-                    "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's max_storage_buffer_binding_size / max_buffer_size of {max} bytes by {} bytes",
-                    view.width,
-                    view.height,
-                    bytes - max
-                );
+                let by = bytes - max;
+                let message = match part {
+                    Part::Frame => format!(
+                        "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes; render a smaller frame",
+                        view.width, view.height
+                    ),
+                    Part::Scene => format!(
+                        "this scene's meshes need a {what} of {bytes} bytes on the GPU, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes; use fewer triangles"
+                    ),
+                    Part::Structure(name) => format!(
+                        "`{name}` needs a {what} of {bytes} bytes, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes"
+                    ),
+                };
+                return Err(DeviceLimit::new(part, message).into());
             }
         }
         Ok(())

@@ -1,0 +1,98 @@
+//! What a refused run leaves: nothing it made, and everything an earlier run journaled. A
+//! device's binding limit (lowered by the `test-hooks` feature's `PENUMBRA_TEST_BINDING_BYTES`)
+//! refuses the tiny sweep's first ground truth, after the journal and the cache are open.
+
+use crate::common;
+use crate::hostile_input::snapshot;
+use std::ffi::OsStr;
+use std::path::Path;
+
+/// The tiny sweep on the GPU in `dir`, its results into `dir/out`.
+fn tiny_on_gpu(dir: &Path) -> std::path::PathBuf {
+    common::tiny_experiment(dir, |t| format!("backend = \"gpu\"\n{t}"))
+}
+
+/// Runs the sweep with `env` set; the exit status and standard error.
+fn run(args: &[&OsStr], env: &[(&str, &str)]) -> (i32, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+const LIMITED: [(&str, &str); 1] = [("PENUMBRA_TEST_BINDING_BYTES", "4096")];
+
+fn units_from_journal(home: &Path) -> i64 {
+    let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    manifest["details"]["units_from_journal"].as_integer().unwrap()
+}
+
+/// A first run refused leaves no results folder, no journal, no cache; a refused `--shard`
+/// leaves no `shards` folder.
+#[test]
+fn a_refused_first_run_or_shard_leaves_no_folder_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = tiny_on_gpu(dir.path());
+    let out = dir.path().join("results/tiny");
+    let (o, e) = (OsStr::new("--out"), exp.as_os_str());
+    let (code, err) = run(&[e, o, out.as_os_str()], &LIMITED);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("measure.width") && err.contains("hit buffer"), "{err}");
+    assert!(
+        !dir.path().join("results").exists(),
+        "left {:?}",
+        snapshot(dir.path()).keys()
+    );
+    std::fs::create_dir_all(&out).unwrap();
+    let (code, err) = run(
+        &[e, o, out.as_os_str(), OsStr::new("--shard"), OsStr::new("1/2")],
+        &LIMITED,
+    );
+    assert_eq!(code, 2, "{err}");
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "the refused shard left {left:?}");
+}
+
+/// `--fresh` measures every unit again, but a refused fresh run keeps every journaled unit
+/// (byte for byte), and only a fresh run that succeeds drops the units it did not write.
+#[test]
+fn a_refused_fresh_run_keeps_the_journal_and_a_finished_one_replaces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = tiny_on_gpu(dir.path());
+    let out = dir.path().join("out");
+    let (o, e) = (OsStr::new("--out"), exp.as_os_str());
+    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    assert_eq!(code, 0, "{err}");
+    let journal = out.join(".journal");
+    let stale = journal.join("0000000000000000.toml");
+    std::fs::write(&stale, "# a unit no run of this experiment wrote\n").unwrap();
+    let before = snapshot(&journal);
+    assert!(before.len() > 2, "nothing journaled: {:?}", before.keys());
+
+    let fresh = OsStr::new("--fresh");
+    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &LIMITED);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(snapshot(&journal), before, "the refused fresh run changed the journal");
+
+    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &[]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        units_from_journal(&out),
+        0,
+        "a fresh run takes nothing from the journal"
+    );
+    assert!(!stale.exists(), "the fresh run kept a unit it did not write");
+    let after = snapshot(&journal);
+    assert_eq!(after.len(), before.len() - 1, "{:?}", after.keys());
+}
