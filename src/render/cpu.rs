@@ -250,6 +250,7 @@ impl Backend for CpuBackend {
             rays: RayCounts::default(),
             work: Work::ZERO,
             counted: true,
+            mirror_bounces: 0,
         };
         let mut receivers: Vec<Option<Receiver>> = vec![];
         let mut irradiance = vec![0f64; pixels];
@@ -299,6 +300,11 @@ impl Backend for CpuBackend {
                         .collect();
                     let (chains, work) = split_work(chains);
                     frame.work += work;
+                    frame.mirror_bounces = chains
+                        .iter()
+                        .flatten()
+                        .map(|c| c.reflection_rays as u32)
+                        .fold(1, u32::max);
                     for (pixel, c) in chains.iter().enumerate() {
                         if let Some(c) = c {
                             reflected[pixel] = c.radiance;

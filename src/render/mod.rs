@@ -106,6 +106,9 @@ pub struct Frame {
     pub work: crate::accel::work::Work,
     /// Whether `work` was counted.
     pub counted: bool,
+    /// Bounces the mirror pass ran (0 without the pass): the longest chain's reflected rays,
+    /// at least one. The GPU dispatches no bounce past it, whatever the depth limit.
+    pub mirror_bounces: u32,
 }
 
 impl Frame {

@@ -41,10 +41,14 @@ pub const FRAME_TIMEOUT: Duration = Duration::from_secs(300);
 /// u32 words of the counters buffer: per light, shadow rays as (low, high) words; the count of
 /// invocations whose loops were cut short; then as (low, high) words ambient-occlusion rays,
 /// reflection rays, and the work of frames that count it (queries, nodes, primitive tests); the
-/// count of reflected rays whose closest-hit walk was cut short (no smaller chunk helps those).
-pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 12;
+/// count of reflected rays whose closest-hit walk was cut short (no smaller chunk helps those);
+/// the mirror chains still live after a bounce (the gate's, reset as it reads them) and the
+/// bounces after the first that the gate let run.
+pub(crate) const COUNTER_WORDS: usize = 2 * MAX_LIGHTS + 14;
 /// Word of the counters buffer that counts invocations cut short (`cut_short` in render.wgsl).
 const CUT_SHORT_SLOT: usize = 2 * MAX_LIGHTS;
+/// Word of the counters buffer that counts the mirror bounces after the first that ran.
+const MIRROR_BOUNCES_SLOT: usize = CUT_SHORT_SLOT + 13;
 
 /// The 64-bit counter at words (`slot`, `slot + 1`) of a counters read-back.
 fn wide(counters: &[u32], slot: usize) -> u64 {
@@ -244,33 +248,67 @@ impl GpuBackend {
             // The primary pass ignores group 1; a shadow pass runs one dispatch per sample chunk;
             // the direct pass runs the shadow kernel (without occlusion tests) over every light's
             // chunks; the mirror pass, per bounce, a trace, every light's chunks and a step, then
-            // its finish (each dispatch sees the previous one's writes).
+            // its finish (each dispatch sees the previous one's writes). Bounces after the first
+            // take their workgroups from the gate run after the bounce before: none once every
+            // chain has ended.
             let every_light = || r.passes.iter().flatten();
-            let steps: Vec<(&wgpu::ComputePipeline, &wgpu::BindGroup)> = match pass {
-                Pass::Primary { .. } => vec![(&p.primary, &r.passes[0][0])],
-                Pass::Shadow { light, .. } => r.passes[*light].iter().map(|c| (&p.shadow, c)).collect(),
-                Pass::Direct { .. } => every_light().map(|c| (&p.shadow, c)).collect(),
+            let frame = |pipeline, info| Dispatch::Frame(pipeline, info);
+            let steps: Vec<Dispatch> = match pass {
+                Pass::Primary { .. } => vec![frame(&p.primary, &r.passes[0][0])],
+                Pass::Shadow { light, .. } => r.passes[*light].iter().map(|c| frame(&p.shadow, c)).collect(),
+                Pass::Direct { .. } => every_light().map(|c| frame(&p.shadow, c)).collect(),
                 Pass::Mirror { .. } => {
                     let m = &p.mirror;
+                    let (gate, args) = r.mirror_gate.as_ref().expect("made with the mirror pass");
                     let mut steps = Vec::new();
-                    for bounce in &r.mirror_passes {
-                        steps.push((&m.trace, bounce));
-                        steps.extend(every_light().map(|c| (&m.shade, c)));
-                        steps.push((&m.step, bounce));
+                    for (bounce, info) in r.mirror_passes.iter().enumerate() {
+                        let run = |pipeline| match bounce {
+                            0 => Dispatch::Frame(pipeline, info),
+                            _ => Dispatch::Indirect(pipeline, info, args),
+                        };
+                        if bounce > 0 {
+                            steps.push(Dispatch::Gate(&m.gate, gate));
+                        }
+                        steps.push(run(&m.trace));
+                        steps.extend(every_light().map(|c| match bounce {
+                            0 => Dispatch::Frame(&m.shade, c),
+                            _ => Dispatch::Indirect(&m.shade, c, args),
+                        }));
+                        steps.push(run(&m.step));
                     }
-                    steps.push((&m.finish, &r.passes[0][0]));
+                    steps.push(frame(&m.finish, &r.passes[0][0]));
                     steps
                 }
-                Pass::Ambient { .. } => r.ambient_passes.iter().map(|c| (&p.ambient, c)).collect(),
+                Pass::Ambient { .. } => r.ambient_passes.iter().map(|c| frame(&p.ambient, c)).collect(),
             };
-            cp.set_bind_group(0, &r.bind0, &[]);
-            if r.accel != NO_ACCEL {
-                cp.set_bind_group(2, &r.accel_group, &[]);
-            }
-            for (pipeline, info) in &steps {
-                cp.set_pipeline(pipeline);
-                cp.set_bind_group(1, *info, &[]);
-                cp.dispatch_workgroups(groups.0, groups.1, 1);
+            let bind_frame = |cp: &mut wgpu::ComputePass| {
+                cp.set_bind_group(0, &r.bind0, &[]);
+                if r.accel != NO_ACCEL {
+                    cp.set_bind_group(2, &r.accel_group, &[]);
+                }
+            };
+            bind_frame(&mut cp);
+            for (i, step) in steps.iter().enumerate() {
+                match *step {
+                    Dispatch::Frame(pipeline, info) => {
+                        cp.set_pipeline(pipeline);
+                        cp.set_bind_group(1, info, &[]);
+                        cp.dispatch_workgroups(groups.0, groups.1, 1);
+                    }
+                    Dispatch::Indirect(pipeline, info, args) => {
+                        cp.set_pipeline(pipeline);
+                        cp.set_bind_group(1, info, &[]);
+                        cp.dispatch_workgroups_indirect(args, 0);
+                    }
+                    Dispatch::Gate(pipeline, group) => {
+                        cp.set_pipeline(pipeline);
+                        cp.set_bind_group(0, group, &[]);
+                        cp.dispatch_workgroups(1, 1, 1);
+                        if i + 1 < steps.len() {
+                            bind_frame(&mut cp);
+                        }
+                    }
+                }
             }
             self.dispatches.set(self.dispatches.get() + steps.len() as u64);
         }
@@ -359,6 +397,14 @@ impl GpuBackend {
             ),
         }
     }
+}
+
+/// One dispatch of a pass: a render kernel over the whole frame, a render kernel over the
+/// workgroups the mirror gate wrote, or the mirror gate itself (its own group 0).
+enum Dispatch<'a> {
+    Frame(&'a wgpu::ComputePipeline, &'a wgpu::BindGroup),
+    Indirect(&'a wgpu::ComputePipeline, &'a wgpu::BindGroup, &'a wgpu::Buffer),
+    Gate(&'a wgpu::ComputePipeline, &'a wgpu::BindGroup),
 }
 
 /// Whether the kernels' storage buffers (the frame layout's `frame` and structure `(name,
@@ -461,6 +507,10 @@ impl Backend for GpuBackend {
                 primitives: wide(&counters, CUT_SHORT_SLOT + 9),
             },
             counted: self.count_work,
+            mirror_bounces: match plan.passes.iter().any(|p| matches!(p, Pass::Mirror { .. })) {
+                true => 1 + counters[MIRROR_BOUNCES_SLOT],
+                false => 0,
+            },
         })
     }
 

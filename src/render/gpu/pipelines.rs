@@ -42,6 +42,9 @@ pub(super) struct Layouts {
     /// Storage buffers in the frame's layout (every binding but the parameters' uniform).
     pub frame_storage: u32,
     pub pass: wgpu::BindGroupLayout,
+    /// The mirror gate's own group: the counters and the next bounce's dispatch arguments,
+    /// which no render kernel binds (they are read as indirect arguments).
+    pub gate: wgpu::BindGroupLayout,
     #[cfg(feature = "test-hooks")]
     pub hooks: wgpu::BindGroupLayout,
 }
@@ -51,6 +54,9 @@ pub(super) struct MirrorPipelines {
     pub trace: wgpu::ComputePipeline,
     pub shade: wgpu::ComputePipeline,
     pub step: wgpu::ComputePipeline,
+    /// Between bounces: the next bounce's workgroups, none once every chain has ended
+    /// (mirror_gate.wgsl).
+    pub gate: wgpu::ComputePipeline,
     pub finish: wgpu::ComputePipeline,
 }
 
@@ -121,6 +127,7 @@ impl Layouts {
             frame_storage: entries.len() as u32 - 1,
             frame: layout("frame", &entries),
             pass: layout("pass", &[uniform(0)]),
+            gate: layout("mirror gate", &[storage(0, false), storage(1, false)]),
             #[cfg(feature = "test-hooks")]
             hooks: layout("test hooks", &[storage(0, true)]),
         }
@@ -217,6 +224,28 @@ fn module(device: &wgpu::Device, name: &'static str, cut_short_slot: usize, extr
     })
 }
 
+/// The mirror gate's kernel, with the counter slots render.wgsl's mirror pass uses.
+fn gate(device: &wgpu::Device, layouts: &Layouts, cut_short_slot: usize) -> wgpu::ComputePipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("mirror gate"),
+        source: wgpu::ShaderSource::Wgsl(
+            format!(
+                "const MIRROR_LIVE_SLOT: u32 = {}u;\nconst MIRROR_BOUNCES_SLOT: u32 = {}u;\n{}",
+                cut_short_slot + 12,
+                cut_short_slot + 13,
+                include_str!("shaders/mirror_gate.wgsl")
+            )
+            .into(),
+        ),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("mirror gate"),
+        bind_group_layouts: &[Some(&layouts.gate)],
+        immediate_size: 0,
+    });
+    entry(device, &module, "mirror_gate", &layout)
+}
+
 fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_short_slot: usize) -> Pipelines {
     let buffers = accel::registered(name).map_or(0, |r| r.gpu_buffers);
     let module = module(device, name, cut_short_slot, "");
@@ -242,6 +271,7 @@ fn compile(device: &wgpu::Device, layouts: &Layouts, name: &'static str, cut_sho
             trace: entry(device, &module, "mirror_trace", &layout),
             shade: entry(device, &module, "mirror_shade", &layout),
             step: entry(device, &module, "mirror_step", &layout),
+            gate: gate(device, layouts, cut_short_slot),
             finish: entry(device, &module, "mirror_finish", &layout),
         },
         ambient: entry(device, &module, "ambient", &layout),

@@ -47,6 +47,8 @@ pub(super) struct FrameResources {
     pub light_sums: wgpu::Buffer,
     /// One bind group per bounce of the mirror pass (none without the pass).
     pub mirror_passes: Vec<wgpu::BindGroup>,
+    /// The mirror gate's group and the indirect arguments it writes (with the pass only).
+    pub mirror_gate: Option<(wgpu::BindGroup, wgpu::Buffer)>,
     /// Per pixel, the AO pass's (unoccluded, total) weights.
     pub ambient: wgpu::Buffer,
     /// One bind group per dispatch of the AO pass's rays (none without the pass).
@@ -249,6 +251,29 @@ impl GpuBackend {
         let mirror_passes = (0..depth.unwrap_or(0))
             .map(|bounce| self.pass_info(MIRROR_PASS, bounce, 0))
             .collect();
+        let mirror_gate = depth.map(|_| {
+            let groups = (view.width.div_ceil(8), view.height.div_ceil(8));
+            let args = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mirror bounce dispatch"),
+                contents: bytemuck::cast_slice(&[groups.0, groups.1, 1, groups.0, groups.1]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+            });
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("mirror gate"),
+                layout: &self.layouts.gate,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: counters.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: args.as_entire_binding(),
+                    },
+                ],
+            });
+            (group, args)
+        });
         let queries = self.timestamps.then(|| {
             let count = 2 * plan.passes.len().max(1) as u32;
             let set = self.device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -272,6 +297,7 @@ impl GpuBackend {
             radiance,
             light_sums,
             mirror_passes,
+            mirror_gate,
             ambient,
             ambient_passes,
             counters,

@@ -93,6 +93,10 @@ const QUERIES_SLOT: u32 = CUT_SHORT_SLOT + 5u;
 const NODES_SLOT: u32 = CUT_SHORT_SLOT + 7u;
 const PRIMS_SLOT: u32 = CUT_SHORT_SLOT + 9u;
 const MIRROR_CUT_SLOT: u32 = CUT_SHORT_SLOT + 11u;
+// Chains still live after a bounce's step (read and reset by `mirror_gate`), and the bounces
+// that ran (mirror_gate.wgsl).
+const MIRROR_LIVE_SLOT: u32 = CUT_SHORT_SLOT + 12u;
+const MIRROR_BOUNCES_SLOT: u32 = CUT_SHORT_SLOT + 13u;
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
@@ -378,7 +382,9 @@ fn shadow(@builtin(global_invocation_id) gid: vec3<u32>) {
 // `mirror_step` folds it into the chain and turns the ray; `mirror_finish` adds what the chain
 // brought back. Radiance leaving a vertex is (1 - m) x diffuse + m x reflected; a chain cut at
 // the depth limit or leaving the scene brings back nothing more. The chain lives in `chains`
-// between the dispatches; `pass_info.first_sample` is the bounce.
+// between the dispatches; `pass_info.first_sample` is the bounce. `mirror_step` counts the
+// chains still live, and between bounces `mirror_gate` (mirror_gate.wgsl) turns that count into
+// the next bounce's workgroups: none once every chain has ended.
 const CHAIN_NONE: u32 = 0u;
 const CHAIN_LIVE: u32 = 1u;
 const CHAIN_ENDED: u32 = 2u;
@@ -484,6 +490,8 @@ fn mirror_step(@builtin(global_invocation_id) gid: vec3<u32>) {
     c.dir = normalize(reflect(c.dir, c.at.normal));
     if (c.at.mirror == 0.0) {
         c.state = CHAIN_ENDED;
+    } else {
+        atomicAdd(&counters[MIRROR_LIVE_SLOT], 1u);
     }
     chains[pixel] = c;
 }
