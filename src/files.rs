@@ -78,12 +78,52 @@ impl Folder {
             .open(path)
             .map_err(|e| Refused(format!("{}: cannot hold it as a folder: {e}", path.display())))?;
         let m = handle.metadata()?;
-        Ok(Folder {
+        let folder = Folder {
             path: path.to_path_buf(),
             handle,
             identity: (m.dev(), m.ino()),
             made,
-        })
+        };
+        folder.remove_dead_temporaries()?;
+        Ok(folder)
+    }
+
+    /// Removes the temporary files that runs of this host killed mid-write left here (their
+    /// processes are gone); another host's, or a live process's, stay.
+    fn remove_dead_temporaries(&self) -> anyhow::Result<()> {
+        let host = host();
+        let dead = self.names()?.into_iter().filter(|n| dead_temporary(n, &host));
+        for name in dead {
+            self.unlink(&name)?;
+        }
+        Ok(())
+    }
+
+    /// The names of the folder's files (not folders) with UTF-8 names, listed through the handle.
+    fn names(&self) -> anyhow::Result<Vec<String>> {
+        use std::os::fd::AsRawFd;
+        let listed = std::fs::read_dir(format!("/proc/self/fd/{}", self.handle.as_raw_fd()))
+            .with_context(|| format!("listing {}", self.path.display()))?;
+        let mut names = Vec::new();
+        for entry in listed {
+            let entry = entry?;
+            if !entry.file_type()?.is_dir() {
+                names.extend(entry.file_name().to_str().map(str::to_string));
+            }
+        }
+        Ok(names)
+    }
+
+    /// Removes the folder's file `name` through the handle.
+    fn unlink(&self, name: &str) -> anyhow::Result<()> {
+        use std::os::fd::AsRawFd;
+        let c = self.component(name)?;
+        // SAFETY: unlinkat on the held descriptor with a NUL-terminated name.
+        if unsafe { libc::unlinkat(self.handle.as_raw_fd(), c.as_ptr(), 0) } != 0 {
+            let e = std::io::Error::last_os_error();
+            return Err(e).with_context(|| format!("removing {}", self.path.join(name).display()));
+        }
+        Ok(())
     }
 
     /// Removes the folders `create` made (the folder and the parents it had to make) where
@@ -109,9 +149,17 @@ impl Folder {
             .filter(|m| m.file_type().is_dir())
             .map(|m| (m.dev(), m.ino()));
         if now != Some(self.identity) {
+            use std::os::fd::AsRawFd;
+            // Where the held folder is now: renamed (it or a folder above it), or deleted.
+            let moved = std::fs::read_link(format!("/proc/self/fd/{}", self.handle.as_raw_fd()))
+                .ok()
+                .filter(|p| p.exists() && *p != self.path);
+            let what = match moved {
+                Some(p) => format!("moved to {} (it or a folder above it was renamed)", p.display()),
+                None => "replaced (by a link, or another folder)".to_string(),
+            };
             return Err(Refused(format!(
-                "{}: replaced (by a link, or another folder) while the run was writing into it; \
-                 refused, and nothing was written through it",
+                "{}: {what} while the run was writing into it; refused, and nothing was written into what is there now",
                 self.path.display()
             ))
             .into());
@@ -201,24 +249,13 @@ impl Folder {
     }
 
     /// Removes every file of the folder not named in `keep`, listed and unlinked through the
-    /// handle (a folder swapped while the run went is refused first); folders in it are left.
+    /// handle (a folder swapped while the run went is refused first); folders in it, and files
+    /// whose names are not UTF-8, are left.
     pub fn remove_all_but(&self, keep: &std::collections::HashSet<String>) -> anyhow::Result<()> {
-        use std::os::fd::AsRawFd;
-        use std::os::unix::ffi::OsStrExt;
         self.check_held()?;
-        let fd = self.handle.as_raw_fd();
-        let listed = std::fs::read_dir(format!("/proc/self/fd/{fd}"))
-            .with_context(|| format!("listing {}", self.path.display()))?;
-        for entry in listed {
-            let entry = entry?;
-            if entry.file_type()?.is_dir() || entry.file_name().to_str().is_some_and(|n| keep.contains(n)) {
-                continue;
-            }
-            let name = std::ffi::CString::new(entry.file_name().as_bytes())?;
-            // SAFETY: unlinkat on the held descriptor with a NUL-terminated name.
-            if unsafe { libc::unlinkat(fd, name.as_ptr(), 0) } != 0 {
-                let e = std::io::Error::last_os_error();
-                return Err(e).with_context(|| format!("removing {}", self.path.join(entry.file_name()).display()));
+        for name in self.names()? {
+            if !keep.contains(&name) {
+                self.unlink(&name)?;
             }
         }
         Ok(())
@@ -368,13 +405,35 @@ pub fn shown(word: &str) -> String {
     }
 }
 
+/// This host's name, as temporary files carry it.
+fn host() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map_or_else(|| "host".to_string(), |h| h.trim().to_string())
+}
+
+/// Whether `name` is a temporary file ([`temporary`]) of a process of this host that is gone:
+/// what a killed run left half-written.
+fn dead_temporary(name: &str, host: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let mut parts = rest.rsplitn(3, '.');
+    let (Some(started), Some(pid), Some(before)) = (parts.next(), parts.next(), parts.next()) else {
+        return false;
+    };
+    u128::from_str_radix(started, 16).is_ok()
+        && before.ends_with(&format!(".{host}"))
+        && pid
+            .parse::<u32>()
+            .is_ok_and(|pid| pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists())
+}
+
 /// This host's and process's temporary file for `path`, beside it.
 fn temporary(path: &Path) -> std::path::PathBuf {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
-    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .ok()
-        .or_else(|| std::env::var("HOSTNAME").ok())
-        .map_or_else(|| "host".to_string(), |h| h.trim().to_string());
+    let host = host();
     // The process's start time tells apart processes of one host name and id (containers).
     static STARTED: std::sync::OnceLock<u128> = std::sync::OnceLock::new();
     let started = STARTED.get_or_init(|| {
@@ -388,6 +447,34 @@ fn temporary(path: &Path) -> std::path::PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_killed_runs_temporaries_are_removed_and_no_one_elses() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("journal");
+        std::fs::create_dir(&root).unwrap();
+        let host = host();
+        // No process has the largest id; this one is alive.
+        let dead = format!(".unit.toml.{host}.{}.1f.tmp", u32::MAX);
+        let kept = [
+            format!(".unit.toml.{host}.{}.1f.tmp", std::process::id()),
+            format!(".unit.toml.another-{host}.{}.1f.tmp", u32::MAX),
+            format!(".unit.toml.{host}.{}.not-hex.tmp", u32::MAX),
+            "unit.toml".to_string(),
+        ];
+        for name in kept.iter().chain([&dead]) {
+            std::fs::write(root.join(name), b"x").unwrap();
+        }
+        Folder::create(&root).unwrap();
+        let mut left: Vec<String> = std::fs::read_dir(&root)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        left.sort();
+        let mut expected = kept.to_vec();
+        expected.sort();
+        assert_eq!(left, expected);
+    }
 
     #[test]
     fn replaces_whole_file_and_leaves_no_temporary() {

@@ -28,8 +28,8 @@ pub struct Outputs {
     /// the folders this run made for it (innermost first), taken away again if left empty.
     shard: Option<Vec<PathBuf>>,
     /// The results folder (exclusively) or a shard's folder (with the results folder shared),
-    /// open and locked for as long as this run writes there.
-    _locks: Vec<File>,
+    /// open and locked for as long as this run writes there; the first is the results folder.
+    locks: Vec<File>,
 }
 
 /// The results folder a run will replace, as the real path its swap acts on: created if
@@ -180,7 +180,7 @@ impl Outputs {
             staging,
             committed: false,
             shard: None,
-            _locks: vec![lock],
+            locks: vec![lock],
         })
     }
 
@@ -206,7 +206,7 @@ impl Outputs {
             staging: dir.to_path_buf(),
             committed: false,
             shard: Some(made),
-            _locks: vec![home_lock, dir_lock],
+            locks: vec![home_lock, dir_lock],
         })
     }
 
@@ -239,6 +239,7 @@ impl Outputs {
                 self.staging.display()
             );
         }
+        self.check_home_held()?;
         if self.home.is_dir() {
             let mut moved = Vec::new();
             let carried = (|| -> anyhow::Result<()> {
@@ -269,6 +270,30 @@ impl Outputs {
                 .with_context(|| format!("moving {} to {}", self.staging.display(), self.home.display()))?;
         }
         self.committed = true;
+        Ok(())
+    }
+}
+
+impl Outputs {
+    /// Refuses a results folder whose path no longer names the folder this run locked (moved,
+    /// or replaced by another folder or a link while the run went): nothing is swapped into
+    /// what is there now, and the staged results stay where they are, named.
+    fn check_home_held(&mut self) -> anyhow::Result<()> {
+        use std::os::unix::fs::MetadataExt;
+        let locked = self.locks[0].metadata()?;
+        let now = std::fs::symlink_metadata(&self.home)
+            .ok()
+            .filter(|m| m.is_dir())
+            .map(|m| (m.dev(), m.ino()));
+        if now != Some((locked.dev(), locked.ino())) {
+            self.committed = true;
+            return Err(crate::files::Refused(format!(
+                "{}: moved or replaced while the run went (it is not the folder this run locked); nothing was swapped in, and this run's results are left in {}",
+                self.home.display(),
+                self.staging.display()
+            ))
+            .into());
+        }
         Ok(())
     }
 }
@@ -400,6 +425,34 @@ mod tests {
         assert!(shard.contains("a whole run or a merge"), "{shard}");
         drop(merge);
         Outputs::begin_shard(&home, &two).unwrap();
+    }
+
+    #[test]
+    fn a_results_folder_replaced_during_the_run_gets_nothing_and_the_new_set_stays_staged() {
+        let dir = tempfile::tempdir().unwrap();
+        let home = dir.path().join("r");
+        std::fs::create_dir_all(&home).unwrap();
+        std::fs::write(home.join("old.csv"), b"old").unwrap();
+        let out = Outputs::begin(&home).unwrap();
+        std::fs::write(out.path("new.csv").unwrap(), b"new").unwrap();
+        let staging = out.dir().to_path_buf();
+        std::fs::rename(&home, dir.path().join("r-moved")).unwrap();
+        std::fs::create_dir(&home).unwrap();
+        std::fs::write(home.join("theirs"), b"theirs").unwrap();
+        let e = out.commit().unwrap_err().to_string();
+        assert!(e.contains("moved or replaced while the run went"), "{e}");
+        assert!(e.contains(&staging.display().to_string()), "{e}");
+        let names: Vec<_> = std::fs::read_dir(&home)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["theirs"], "swapped into the folder put there");
+        assert_eq!(
+            std::fs::read(staging.join("new.csv")).unwrap(),
+            b"new",
+            "the new set is kept"
+        );
+        assert_eq!(std::fs::read(dir.path().join("r-moved/old.csv")).unwrap(), b"old");
     }
 
     #[test]

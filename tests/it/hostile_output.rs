@@ -138,21 +138,26 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
     );
 }
 
-/// A results folder's `.journal` or `cache` swapped for a link to a folder elsewhere while the
-/// run goes (paused after its first journaled unit): the run never writes through the link,
-/// ends with status 2 naming the swapped folder, and the earlier results stay whole.
+/// A results folder's `.journal` or `cache` swapped for a link to a folder elsewhere, or for
+/// another plain folder, while the run goes (paused after its first journaled unit, before the
+/// second ground truth): the run never writes into the folder put there, ends with status 2
+/// naming the swapped folder, and the earlier results stay whole.
 #[cfg(feature = "test-hooks")]
 #[test]
 fn a_folder_swapped_for_a_link_mid_run_is_never_written_through() {
     let two_radii = tiny().replace("light_radii = [0.02]", "light_radii = [0.02, 0.04]");
-    for swapped in [".journal", "cache"] {
+    for (swapped, link) in [
+        (".journal", true),
+        ("cache", true),
+        (".journal", false),
+        ("cache", false),
+    ] {
         let s = Scratch::new(&two_radii, "tiny");
         let home = s.work.join("results/tiny");
         let earlier = std::fs::read(home.join("runs.csv")).unwrap();
         let (foreign, pause) = (s.root.join("foreign"), s.root.join("pause"));
         std::fs::create_dir(&foreign).unwrap();
         std::fs::write(foreign.join("theirs"), b"theirs").unwrap();
-        let before = snapshot(&foreign);
         let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
             .current_dir(&s.work)
             .args(["exp.toml", "--fresh"])
@@ -172,15 +177,75 @@ fn a_folder_swapped_for_a_link_mid_run_is_never_written_through() {
         let target = home.join(swapped);
         assert!(target.is_dir(), "{swapped} is there while the run goes");
         std::fs::rename(&target, home.join(format!("{swapped}-moved"))).unwrap();
-        std::os::unix::fs::symlink(&foreign, &target).unwrap();
+        let foreign = if link {
+            std::os::unix::fs::symlink(&foreign, &target).unwrap();
+            foreign
+        } else {
+            std::fs::create_dir(&target).unwrap();
+            std::fs::write(target.join("theirs"), b"theirs").unwrap();
+            target
+        };
+        let before = snapshot(&foreign);
         std::fs::remove_file(&pause).unwrap();
         let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{swapped}: {stderr}");
         assert!(stderr.contains(&format!("tiny/{swapped}")), "{swapped}: {stderr}");
-        assert_eq!(snapshot(&foreign), before, "{swapped}: written through the link");
+        assert_eq!(
+            snapshot(&foreign),
+            before,
+            "{swapped}: written into the folder put there"
+        );
         assert_eq!(std::fs::read(home.join("runs.csv")).unwrap(), earlier, "{swapped}");
     }
+}
+
+/// The results folder itself moved away and replaced by another folder after the last unit
+/// is journaled: nothing is written or swapped into the folder put there, the run ends with
+/// status 2 saying where the folder went, and the moved folder keeps the earlier results.
+#[cfg(feature = "test-hooks")]
+#[test]
+fn a_results_folder_replaced_before_the_swap_gets_nothing() {
+    let s = Scratch::new(&tiny(), "tiny");
+    let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
+    assert_eq!(code, 0, "{stderr}");
+    let home = s.work.join("results/tiny");
+    let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let units = manifest["details"]["units"].as_integer().unwrap();
+    let earlier = std::fs::read(home.join("runs.csv")).unwrap();
+    let pause = s.root.join("pause");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .current_dir(&s.work)
+        .args(["exp.toml", "--fresh"])
+        .env("PENUMBRA_TEST_PAUSE_AFTER", format!("{units}:{}", pause.display()))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !pause.exists() {
+        assert!(start.elapsed().as_secs() < 300, "the run never paused");
+        assert!(child.try_wait().unwrap().is_none(), "the run ended before pausing");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let moved = s.work.join("results/tiny-moved");
+    std::fs::rename(&home, &moved).unwrap();
+    std::fs::create_dir(&home).unwrap();
+    std::fs::write(home.join("theirs"), b"theirs").unwrap();
+    let before = snapshot(&home);
+    std::fs::remove_file(&pause).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    // The journal's read-back of the last unit finds its folder moved first.
+    assert!(
+        stderr.contains("results/tiny/.journal: moved to") && stderr.contains("results/tiny-moved/.journal"),
+        "{stderr}"
+    );
+    assert_eq!(snapshot(&home), before, "outputs swapped into the folder put there");
+    assert_eq!(std::fs::read(moved.join("runs.csv")).unwrap(), earlier);
 }
 
 /// A folder where a cached ground truth's file belongs is refused when the run reads the cache,

@@ -45,6 +45,9 @@ pub struct Sweep {
     pub spec: Spec,
     /// Where ground truths are cached (`cache/` under the results folder), once known.
     cache: Option<PathBuf>,
+    /// The cache folder, held from the first ground truth on: one swapped for another folder
+    /// or a link between two ground truths is refused, not written through.
+    held: Arc<Mutex<Option<Arc<crate::files::Folder>>>>,
     /// References made on first use.
     references: References,
 }
@@ -55,6 +58,7 @@ impl Sweep {
         Sweep {
             spec,
             cache: None,
+            held: Default::default(),
             references: Default::default(),
         }
     }
@@ -67,11 +71,7 @@ impl Sweep {
             return Ok(r.clone());
         }
         let context = context_key(&self.spec, backend.adapter());
-        let cache = self
-            .cache
-            .clone()
-            .unwrap_or_else(|| std::env::temp_dir().join("penumbra-cache"));
-        let cache = crate::files::Folder::create(&cache)?;
+        let cache = self.cache_folder()?;
         let built = Reference::build(&self.spec, backend, lights, radius, &cache, &context);
         if built.is_err() {
             cache.remove_if_made_and_empty();
@@ -85,6 +85,23 @@ impl Sweep {
             .expect("not poisoned")
             .insert(key, reference.clone());
         Ok(reference)
+    }
+
+    /// The ground-truth cache, created and held on first use, and checked to be the folder held
+    /// on every later one.
+    fn cache_folder(&self) -> anyhow::Result<Arc<crate::files::Folder>> {
+        let mut held = self.held.lock().expect("not poisoned");
+        if let Some(folder) = held.as_ref() {
+            folder.check_held()?;
+            return Ok(folder.clone());
+        }
+        let path = self
+            .cache
+            .clone()
+            .unwrap_or_else(|| std::env::temp_dir().join("penumbra-cache"));
+        let folder = Arc::new(crate::files::Folder::create(&path)?);
+        *held = Some(folder.clone());
+        Ok(folder)
     }
 
     /// Rays one frame of `lights` lights at `samples` rays each traces at most: the unit of
@@ -250,6 +267,7 @@ impl Declaration for Sweep {
 
     fn keep_state_in(&mut self, home: &Path) {
         self.cache = Some(home.join("cache"));
+        self.held = Default::default();
     }
 
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<UnitOutcome> {
