@@ -316,7 +316,31 @@ pub fn read_regular(path: &Path) -> anyhow::Result<Vec<u8>> {
 /// The text of the regular file `path` ([`open_regular`]); bytes that are not UTF-8 are refused
 /// naming the offset of the first.
 pub fn read_regular_text(path: &Path) -> anyhow::Result<String> {
-    String::from_utf8(read_regular(path)?).map_err(|e| {
+    read_regular_text_at_most(path, u64::MAX)
+}
+
+/// [`read_regular_text`] of a file of at most `max` bytes: a longer one is refused from its
+/// length, before anything is read (and one that grows while it is read, at `max`).
+pub fn read_regular_text_at_most(path: &Path, max: u64) -> anyhow::Result<String> {
+    let file = open_regular(path)?;
+    let length = file.metadata()?.len();
+    let too_long = |length: u64| {
+        Refused(format!(
+            "{}: {length} bytes, over the {max} bytes a text here may take; refused",
+            path.display()
+        ))
+    };
+    if length > max {
+        return Err(too_long(length).into());
+    }
+    let mut bytes = Vec::new();
+    file.take(max.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("reading {}", path.display()))?;
+    if bytes.len() as u64 > max {
+        return Err(too_long(bytes.len() as u64).into());
+    }
+    String::from_utf8(bytes).map_err(|e| {
         Refused(format!(
             "{}: not UTF-8 text (byte {} starts an invalid sequence); refused",
             path.display(),

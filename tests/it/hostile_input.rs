@@ -1366,3 +1366,56 @@ fn walk(root: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+/// Texts the page embeds past its limit (a sparse 8 GiB CSV, report.md and a plot) are refused
+/// from their length, exit 2 naming the file, before any is read; a file the page would show
+/// whose name is not UTF-8 is refused naming it, not skipped.
+#[test]
+fn page_refuses_a_text_past_its_limit_and_a_name_it_cannot_write() {
+    use std::os::unix::ffi::OsStrExt;
+    for (file, long) in [
+        ("runs.csv", true),
+        ("report.md", true),
+        ("plots/a.svg", true),
+        ("a CSV named bad-\\xff.csv", false),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = dir.path().join("r");
+        std::fs::create_dir_all(folder.join("plots")).unwrap();
+        std::fs::write(folder.join("report.md"), "# a report\n").unwrap();
+        let path = if long {
+            let path = folder.join(file);
+            std::fs::write(&path, "a,b\n").unwrap();
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&path)
+                .unwrap()
+                .set_len(8 << 30)
+                .unwrap();
+            path
+        } else {
+            let name = std::ffi::OsStr::from_bytes(b"bad-\xff.csv");
+            let path = folder.join(name);
+            std::fs::write(&path, "a,b\n1,2\n").unwrap();
+            path
+        };
+        let sorted = |d: &Path| {
+            let mut v = walk(d);
+            v.sort();
+            v
+        };
+        let before = sorted(&folder);
+        let mut page = Command::new(env!("CARGO_BIN_EXE_page"));
+        page.arg(&folder);
+        let (code, stderr) = output_within_a_minute(page);
+        assert_eq!(code, 2, "{file}: {stderr}");
+        let named = path.file_name().unwrap().to_string_lossy().into_owned();
+        let why = if long {
+            "8589934592 bytes, over the"
+        } else {
+            "not UTF-8"
+        };
+        assert!(stderr.contains(&named) && stderr.contains(why), "{file}: {stderr}");
+        assert_eq!(sorted(&folder), before, "{file}: wrote something");
+    }
+}

@@ -176,8 +176,8 @@ fn write_stored(dir: &Path, page: &Page, half: &[bool]) -> anyhow::Result<()> {
             tables.push(data::linked(&t));
             continue;
         }
-        let text =
-            crate::files::read_regular_text(&dir.join(&t)).with_context(|| format!("reading {t} for the page"))?;
+        let text = crate::files::read_regular_text_at_most(&dir.join(&t), MAX_TEXT_BYTES)
+            .with_context(|| format!("reading {t} for the page"))?;
         tables.push(data::table(&t, &text)?);
     }
     let plots = plots_in(dir)?;
@@ -242,6 +242,11 @@ fn check(galleries: &[Gallery]) -> anyhow::Result<()> {
 
 /// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`; such a name
 /// that is not a regular file (a link, pipe or folder) is refused with its path.
+/// The most bytes of one text (a CSV, an SVG plot, report.md) the page embeds: 40 times the
+/// largest an experiment here writes (a sweep's runs.csv, 1.7 MB), so a planted or runaway file
+/// is refused from its length instead of filling memory.
+pub const MAX_TEXT_BYTES: u64 = 64 << 20;
+
 fn files_in(dir: &Path, sub: &str, suffix: &str) -> anyhow::Result<Vec<String>> {
     crate::files::check_plain_folder(&dir.join(sub))?;
     let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
@@ -249,7 +254,20 @@ fn files_in(dir: &Path, sub: &str, suffix: &str) -> anyhow::Result<Vec<String>> 
     };
     let mut names = Vec::new();
     for e in entries.filter_map(Result::ok) {
-        let Ok(n) = e.file_name().into_string() else { continue };
+        let n = match e.file_name().into_string() {
+            Ok(n) => n,
+            Err(raw) => {
+                use std::os::unix::ffi::OsStrExt;
+                if raw.as_bytes().ends_with(suffix.as_bytes()) {
+                    return Err(crate::files::Refused(format!(
+                        "{}: a file name that is not UTF-8, which the page cannot name; rename or remove it",
+                        e.path().display()
+                    ))
+                    .into());
+                }
+                continue;
+            }
+        };
         if !n.ends_with(suffix) {
             continue;
         }

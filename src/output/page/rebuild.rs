@@ -7,8 +7,9 @@
 //! shown at the exposure of its first frame, as the frames kind drew their PNGs, and set against
 //! the next strip of its size and length. A missing PNG beside an EXR is drawn from it.
 
+use super::MAX_TEXT_BYTES;
 use super::{files_in, write_stored, Gallery, Page, Shot, Tone};
-use crate::files::{read_regular_text, Refused};
+use crate::files::{read_regular_text_at_most, Refused};
 use crate::output::images::{exposure, write_png};
 use anyhow::Context;
 use std::path::Path;
@@ -31,7 +32,7 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
         // picture is drawn.
         if matches!(suffix, ".csv" | ".svg") {
             for file in &listed {
-                read_regular_text(&dir.join(file))?;
+                read_regular_text_at_most(&dir.join(file), MAX_TEXT_BYTES)?;
             }
         }
     }
@@ -44,7 +45,7 @@ pub fn rebuild(dir: &Path) -> anyhow::Result<()> {
             .into());
         }
     }
-    let report = read_regular_text(&dir.join("report.md"))?;
+    let report = read_regular_text_at_most(&dir.join("report.md"), MAX_TEXT_BYTES)?;
     let mut galleries: Vec<Gallery> = Vec::new();
     // Numbers in file names in their order (frame 8 before frame 16).
     let mut exrs = files_in(dir, "images", ".exr")?;
