@@ -5,6 +5,16 @@
 
 use super::{registered, AccelSettings};
 
+/// `n` bytes in words that tell apart the sizes a refusal compares: "1.5 GB", "16.0 MB",
+/// "900 bytes" (a budget of 16 MB is not "0.0 GB").
+pub fn bytes(n: u64) -> String {
+    match n {
+        0..1_000_000 => format!("{n} bytes"),
+        1_000_000..1_000_000_000 => format!("{:.1} MB", n as f64 / 1e6),
+        _ => format!("{:.1} GB", n as f64 / 1e9),
+    }
+}
+
 /// The memory a process may still take, and the limit that says so.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Budget {
@@ -22,7 +32,7 @@ impl Budget {
 
     /// "the 4.0 GB that LIMIT leaves", for refusals.
     pub fn describe(&self) -> String {
-        format!("the {:.1} GB that {} leaves", self.bytes as f64 / 1e9, self.limit)
+        format!("the {} that {} leaves", bytes(self.bytes), self.limit)
     }
 }
 
@@ -116,10 +126,10 @@ pub fn check(settings: &AccelSettings, triangles: usize, available: Option<Budge
     let need = estimate(settings, triangles);
     match available {
         Some(budget) if need > budget.bytes => Err(format!(
-            "`{}` ({}) over {triangles} triangles needs at least {:.1} GB, more than {}",
+            "`{}` ({}) over {triangles} triangles needs at least {}, more than {}",
             settings.name,
             settings.describe(),
-            need as f64 / 1e9,
+            bytes(need),
             budget.describe()
         )),
         _ => Ok(()),

@@ -2,6 +2,7 @@
 //! structure's own lower bound, before anything is generated or built.
 
 use super::scenes::Generator;
+use crate::accel::memory::bytes;
 use crate::accel::AccelSettings;
 use crate::config::{ConfigError, Seg, Source};
 use crate::key_path;
@@ -60,10 +61,10 @@ pub fn check_memory(
             return Err(source.error(
                     &at,
                     format!(
-                        "{n} triangles with every structure built over them need at least {:.1} GB ({:.1} GB of scene copies, {:.1} GB of structures), more than {}",
-                        (scene + structures) as f64 / 1e9,
-                        scene as f64 / 1e9,
-                        structures as f64 / 1e9,
+                        "{n} triangles with every structure built over them need at least {} ({} of scene copies, {} of structures), more than {}",
+                        bytes(scene + structures),
+                        bytes(scene),
+                        bytes(structures),
                         budget.describe()
                     ),
                 ));

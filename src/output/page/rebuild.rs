@@ -224,9 +224,9 @@ fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
         let need = stored + w * h * (4 + 4);
         if let Some(budget) = crate::accel::memory::available().filter(|b| need > b.bytes) {
             return Err(Refused(format!(
-                "{}: a {w} x {h} image needs {:.1} GB to read, more than {}; refused before reading",
+                "{}: a {w} x {h} image needs {} to read, more than {}; refused before reading",
                 path.display(),
-                need as f64 / 1e9,
+                crate::accel::memory::bytes(need),
                 budget.describe()
             ))
             .into());
