@@ -26,6 +26,7 @@ mod hostile_input;
 mod hostile_output;
 mod kdtree;
 mod kdtree_sah;
+mod kdtree_work_counts;
 mod kinds_on_the_core;
 mod mesh_scene;
 mod pages;
