@@ -84,19 +84,39 @@ impl Folder {
             identity: (m.dev(), m.ino()),
             made,
         };
-        folder.remove_dead_temporaries()?;
+        folder.remove_dead_temporaries();
         Ok(folder)
     }
 
     /// Removes the temporary files that runs of this host killed mid-write left here (their
-    /// processes are gone); another host's, or a live process's, stay.
-    fn remove_dead_temporaries(&self) -> anyhow::Result<()> {
+    /// processes are gone, and the file has not changed for [`DEAD_TEMPORARY_AGE`]); another
+    /// host's, or a live process's, stay. Best effort: shards opening one cache at once race to
+    /// remove the same file, and a leftover never stops a run.
+    fn remove_dead_temporaries(&self) {
         let host = host();
-        let dead = self.names()?.into_iter().filter(|n| dead_temporary(n, &host));
-        for name in dead {
-            self.unlink(&name)?;
+        let Ok(names) = self.names() else { return };
+        for name in names.into_iter().filter(|n| dead_temporary(n, &host)) {
+            let old = self
+                .metadata(&name)
+                .and_then(|m| m.modified().ok())
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age > DEAD_TEMPORARY_AGE);
+            if old {
+                let _ = self.unlink(&name);
+            }
         }
-        Ok(())
+    }
+
+    /// The metadata of the folder's entry `name` (not followed if a link), through the handle.
+    fn metadata(&self, name: &str) -> Option<std::fs::Metadata> {
+        use std::os::fd::AsRawFd;
+        std::fs::symlink_metadata(format!("/proc/self/fd/{}/{name}", self.handle.as_raw_fd())).ok()
+    }
+
+    /// Whether the folder's entry `name` is a folder (not a link to one): what
+    /// [`Folder::write_atomic`] cannot rename a file over.
+    pub fn holds_folder(&self, name: &str) -> bool {
+        self.metadata(name).is_some_and(|m| m.is_dir())
     }
 
     /// The names of the folder's files (not folders) with UTF-8 names, listed through the handle.
@@ -114,13 +134,16 @@ impl Folder {
         Ok(names)
     }
 
-    /// Removes the folder's file `name` through the handle.
+    /// Removes the folder's file `name` through the handle; one already gone is no error.
     fn unlink(&self, name: &str) -> anyhow::Result<()> {
         use std::os::fd::AsRawFd;
         let c = self.component(name)?;
         // SAFETY: unlinkat on the held descriptor with a NUL-terminated name.
         if unsafe { libc::unlinkat(self.handle.as_raw_fd(), c.as_ptr(), 0) } != 0 {
             let e = std::io::Error::last_os_error();
+            if e.raw_os_error() == Some(libc::ENOENT) {
+                return Ok(());
+            }
             return Err(e).with_context(|| format!("removing {}", self.path.join(name).display()));
         }
         Ok(())
@@ -437,6 +460,12 @@ fn host() -> String {
         .map_or_else(|| "host".to_string(), |h| h.trim().to_string())
 }
 
+/// How long a temporary file of a process that is gone must have been left unchanged before it
+/// is taken for a killed run's: a process of this host name in another PID namespace (a
+/// container sharing the host's name) is not in this `/proc`, yet writes and renames its
+/// temporary within seconds.
+const DEAD_TEMPORARY_AGE: std::time::Duration = std::time::Duration::from_secs(3600);
+
 /// Whether `name` is a temporary file ([`temporary`]) of a process of this host that is gone:
 /// what a killed run left half-written.
 fn dead_temporary(name: &str, host: &str) -> bool {
@@ -486,9 +515,16 @@ mod tests {
             format!(".unit.toml.{host}.{}.not-hex.tmp", u32::MAX),
             "unit.toml".to_string(),
         ];
+        // Every file but this one was left two hours ago; a process not in this `/proc` that
+        // wrote it just now may be alive in another PID namespace.
+        let just_written = format!(".other.toml.{host}.{}.1f.tmp", u32::MAX);
+        let long_ago = std::time::SystemTime::now() - 2 * DEAD_TEMPORARY_AGE;
         for name in kept.iter().chain([&dead]) {
-            std::fs::write(root.join(name), b"x").unwrap();
+            let f = std::fs::File::create(root.join(name)).unwrap();
+            f.set_modified(long_ago).unwrap();
         }
+        std::fs::write(root.join(&just_written), b"x").unwrap();
+        let kept = [kept.as_slice(), &[just_written]].concat();
         Folder::create(&root).unwrap();
         let mut left: Vec<String> = std::fs::read_dir(&root)
             .unwrap()

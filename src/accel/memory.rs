@@ -9,8 +9,9 @@ use super::{registered, AccelSettings};
 /// "900 bytes" (a budget of 16 MB is not "0.0 GB").
 pub fn bytes(n: u64) -> String {
     match n {
-        0..1_000_000 => format!("{n} bytes"),
-        1_000_000..1_000_000_000 => format!("{:.1} MB", n as f64 / 1e6),
+        // Bounds at what rounds to 1.0 MB and 1.0 GB, so no size reads "1000.0 MB".
+        0..999_950 => format!("{n} bytes"),
+        999_950..999_950_000 => format!("{:.1} MB", n as f64 / 1e6),
         _ => format!("{:.1} GB", n as f64 / 1e9),
     }
 }

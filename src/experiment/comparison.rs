@@ -34,29 +34,32 @@ pub struct Comparison {
 }
 
 /// Where each compared structure's settings are in the experiment file (its `[accel.NAME]`
-/// table, or its place in `structures` where it has none), and the key that sets the frame's
-/// size, so a refusal known only while the run goes is bad input located there: a kd-tree whose
-/// leaves outgrow the memory budget is known only while it builds, a visibility field or frame
-/// past the device's binding limit only when it is uploaded, and the file's keys are what to
-/// change.
+/// table, or its place in `structures` where it has none), and the keys that set the sizes of
+/// the frames it renders, so a refusal known only while the run goes is bad input located there:
+/// a kd-tree whose leaves outgrow the memory budget is known only while it builds, a visibility
+/// field or frame past the device's binding limit only when it is uploaded, and the file's keys
+/// are what to change.
 #[derive(Clone, Debug, Default)]
 pub struct SettingsPlaces {
     structures: BTreeMap<&'static str, ConfigError>,
-    frame: Option<ConfigError>,
+    /// Each frame size rendered, with the key that sets it (the first where two keys set one
+    /// size): a frame refused is located at the key of its own size, not at another frame's.
+    frames: Vec<((u32, u32), ConfigError)>,
 }
 
 impl SettingsPlaces {
-    /// Each structure's place, and the frame size's.
-    pub fn new(structures: BTreeMap<&'static str, ConfigError>, frame: Option<ConfigError>) -> SettingsPlaces {
-        SettingsPlaces { structures, frame }
+    /// Each structure's place, and each frame size's ([`SettingsPlaces::with_frame`]).
+    pub fn new(
+        structures: BTreeMap<&'static str, ConfigError>,
+        frames: Vec<((u32, u32), ConfigError)>,
+    ) -> SettingsPlaces {
+        SettingsPlaces { structures, frames }
     }
 
-    /// These places, with the frame size's at `frame`.
-    pub fn with_frame(self, frame: ConfigError) -> SettingsPlaces {
-        SettingsPlaces {
-            frame: Some(frame),
-            ..self
-        }
+    /// These places, with frames of `size` (width, height) set at `place`.
+    pub fn with_frame(mut self, size: (u32, u32), place: ConfigError) -> SettingsPlaces {
+        self.frames.push((size, place));
+        self
     }
 
     /// The error of a build of `name` refused with `e` (on `what`: a mesh, a scene), at the
@@ -77,12 +80,12 @@ impl SettingsPlaces {
     }
 
     /// `e` located where it is a device's refusal ([`DeviceLimit`]): a structure's at its
-    /// settings, a frame's at the frame size; any other error as it is.
+    /// settings, a frame's at the key that set its size; any other error as it is.
     pub fn locate(&self, e: anyhow::Error) -> anyhow::Error {
         match DeviceLimit::part_of(&e) {
             Some(Part::Structure(name)) => self.refused(name, "on this GPU", e),
-            Some(Part::Frame) => match &self.frame {
-                Some(place) => ConfigError {
+            Some(Part::Frame { width, height }) => match self.frames.iter().find(|(s, _)| *s == (width, height)) {
+                Some((_, place)) => ConfigError {
                     message: format!("{e:#}"),
                     ..place.clone()
                 }
@@ -136,7 +139,7 @@ impl Comparison {
         Ok(Comparison {
             names,
             tables,
-            places: SettingsPlaces::new(places, None),
+            places: SettingsPlaces::new(places, vec![]),
         })
     }
 }

@@ -6,9 +6,10 @@
 /// What the device could not bind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Part {
-    /// A per-frame buffer (hits, visibility, mirror chains): sized by the frame's width and
-    /// height and the scene's lights.
-    Frame,
+    /// A per-frame buffer (hits, visibility, mirror chains) of a frame this wide and high:
+    /// sized by the frame's width and height and the scene's lights. The size tells apart the
+    /// keys that set one (a sweep's `[measure]` and `[figures]`, an ao's frame and `[tuning]`).
+    Frame { width: u32, height: u32 },
     /// The scene's geometry on the GPU (its meshes' triangles): sized by the meshes.
     Scene,
     /// A buffer of the named registered structure: sized by its settings.

@@ -832,38 +832,14 @@ fn cases() -> Vec<Case> {
 /// written.
 #[cfg(feature = "test-hooks")]
 fn device_limit_cases(sweep: &str) -> Vec<Case> {
-    let ao = format!(
-        r#"kind = "ao"
-name = "ao-ci"
-backend = "gpu"
-width = 8
-height = 8
-rays = 33
-weighting = "plain"
-max_distance = 4.0
-structures = ["bvh", "vlf"]
-
-[timing]
-warmup = 0
-repeats = 6
-
-[tuning]
-width = 8
-height = 8
-repeats = 6
-
-[claim]
-subject = "vlf"
-baseline = "bvh"
-
-[accel.vlf]
-depth = 2
-
-[[meshes]]
-name = "cow"
-path = "{}"
-"#,
-        common::repo("assets/meshes/cow.off").display()
+    let cow = common::repo("assets/meshes/cow.off");
+    let ao = common::small_ao(
+        "ao-ci",
+        "gpu",
+        "vlf",
+        8,
+        "[accel.vlf]\ndepth = 2\n",
+        ("cow", &cow.display().to_string()),
     );
     let mut field = case(
         "a visibility field past the device's binding limit",
@@ -1268,36 +1244,15 @@ fn a_kd_tree_outgrowing_its_budget_mid_run_is_refused_at_its_settings() {
     }
     obj += "v 1.6 1.3 0\nv 1.61 1.3 0\nv 1.6 1.31 0\n";
     obj += &format!("f {} {} {}\n", 3 * n + 1, 3 * n + 2, 3 * n + 3);
-    let text = r#"kind = "ao"
-name = "ao-ci"
-width = 8
-height = 8
-rays = 33
-weighting = "plain"
-max_distance = 4.0
-structures = ["bvh", "kdtree"]
-
-[timing]
-warmup = 0
-repeats = 6
-
-[tuning]
-width = 8
-height = 8
-repeats = 6
-
-[claim]
-subject = "kdtree"
-baseline = "bvh"
-
-[accel.kdtree]
-max_depth = 20
-
-[[meshes]]
-name = "slivers"
-path = "slivers.obj"
-"#;
-    let s = Scratch::new(text, "ao-ci");
+    let text = common::small_ao(
+        "ao-ci",
+        "cpu",
+        "kdtree",
+        8,
+        "[accel.kdtree]\nmax_depth = 20\n",
+        ("slivers", "slivers.obj"),
+    );
+    let s = Scratch::new(&text, "ao-ci");
     std::fs::write(s.work.join("slivers.obj"), obj).unwrap();
     let before = snapshot(&s.root);
     // 16 MB: the plan's estimate of each structure fits; a quarter of it, a million leaf
@@ -1305,7 +1260,7 @@ path = "slivers.obj"
     let (code, stderr) = s.run_with(&["exp.toml"], &[("PENUMBRA_MEMORY_BYTES", "16000000")]);
     assert_eq!(code, 2, "{stderr}");
     for part in [
-        "exp.toml:23:",
+        "exp.toml:24:",
         "accel.kdtree",
         "mesh `slivers`",
         "triangle entries",

@@ -96,3 +96,84 @@ fn a_refused_fresh_run_keeps_the_journal_and_a_finished_one_replaces_it() {
     let after = snapshot(&journal);
     assert_eq!(after.len(), before.len() - 1, "{:?}", after.keys());
 }
+
+/// A frame past the binding limit is located at the key that set its size, not at another
+/// frame's: the sweep's figures (after its measured groups fit) at `figures.width`, the ao
+/// kind's tuning frames at `tuning.width`; the earlier results stay as they were.
+#[test]
+fn a_refused_frame_is_located_at_the_key_of_its_own_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let figures =
+        "\n[figures]\ncamera = \"measure\"\nwidth = 64\nheight = 64\nsamples = 16\nground_truth_samples = 64\n";
+    let exp = common::tiny_experiment(dir.path(), |t| format!("backend = \"gpu\"\n{t}{figures}"));
+    let out = dir.path().join("out");
+    let (o, e) = (OsStr::new("--out"), exp.as_os_str());
+    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    assert_eq!(code, 0, "{err}");
+    let before = snapshot(&out);
+    // The measured 24 x 24 frames' hit buffers (27,648 bytes) fit; the figures' 64 x 64 one
+    // (196,608 bytes) does not.
+    let limited = [("PENUMBRA_TEST_BINDING_BYTES", "100000")];
+    let fresh = OsStr::new("--fresh");
+    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &limited);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("tiny.toml:") && err.contains("figures.width") && err.contains("64x64 frame"),
+        "{err}"
+    );
+    assert_eq!(snapshot(&out), before, "the refused run changed the results");
+
+    let ao = dir.path().join("ao.toml");
+    std::fs::write(
+        &ao,
+        common::small_ao(
+            "ao-tuned",
+            "gpu",
+            "kdtree",
+            128,
+            "[accel.kdtree]\nmax_depth = [8, 22]\nleaf_size = 8\n",
+            ("cow", &common::repo("assets/meshes/cow.off").display().to_string()),
+        ),
+    )
+    .unwrap();
+    // The 8 x 8 frames fit, the 128 x 128 tuning frames' hit buffers (786,432 bytes) do not.
+    let ao_out = dir.path().join("ao-out");
+    let (code, err) = run(
+        &[ao.as_os_str(), o, ao_out.as_os_str()],
+        &[("PENUMBRA_TEST_BINDING_BYTES", "700000")],
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("ao.toml:") && err.contains("tuning.width") && err.contains("128x128 frame"),
+        "{err}"
+    );
+    assert!(!ao_out.exists(), "the refused run left {}", ao_out.display());
+}
+
+/// A folder where one of this run's units belongs is refused by a fresh run before anything is
+/// measured (the run reads nothing there, and could not rename the unit over it), exit 2 naming
+/// it; the journal stays as it was.
+#[test]
+fn a_fresh_run_refuses_a_folder_at_a_units_name_before_measuring() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = common::tiny_experiment(dir.path(), |t| t);
+    let out = dir.path().join("out");
+    let (o, e) = (OsStr::new("--out"), exp.as_os_str());
+    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    assert_eq!(code, 0, "{err}");
+    let journal = out.join(".journal");
+    let unit = crate::hostile_input::first_file(&journal, "journaled unit");
+    std::fs::remove_file(&unit).unwrap();
+    std::fs::create_dir(&unit).unwrap();
+    std::fs::write(unit.join("theirs"), b"theirs").unwrap();
+    let before = snapshot(&journal);
+    let (code, err) = run(&[e, o, out.as_os_str(), OsStr::new("--fresh")], &[]);
+    assert_eq!(code, 2, "{err}");
+    let named = unit.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        err.contains(&named) && err.contains("a folder where a journaled unit belongs"),
+        "{err}"
+    );
+    assert!(!err.contains("units:"), "measured before refusing: {err}");
+    assert_eq!(snapshot(&journal), before);
+}

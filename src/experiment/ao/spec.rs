@@ -222,7 +222,12 @@ impl AoSpec {
             tables: mut given,
             places,
         } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
-        let places = places.with_frame(source.error(&key_path!["width"], String::new()));
+        let places = places
+            .with_frame((f.width, f.height), source.error(&key_path!["width"], String::new()))
+            .with_frame(
+                (t.width, t.height),
+                source.error(&key_path!["tuning", "width"], String::new()),
+            );
         let structures: Vec<(&'static str, Vec<AccelSettings>)> = names
             .into_iter()
             .map(|name| {

@@ -90,6 +90,19 @@ impl UnitJournal {
         format!("{key}.toml")
     }
 
+    /// Refuses, in a fresh run, a folder where `key`'s file belongs: the run reads nothing
+    /// there, but could not rename its unit over a folder, which it would find only when the
+    /// unit is written, after measuring it.
+    fn check_replaceable(&self, key: &str) -> Result<(), BadInput> {
+        if self.folder.holds_folder(&Self::name(key)) {
+            return Err(BadInput(format!(
+                "{}: a folder where a journaled unit belongs, which --fresh cannot replace; remove it",
+                self.path(key).display()
+            )));
+        }
+        Ok(())
+    }
+
     pub(super) fn path(&self, key: &str) -> PathBuf {
         self.folder.path().join(Self::name(key))
     }
@@ -203,6 +216,7 @@ fn measure_all<D: Declaration>(
     for unit in units {
         let key = unit_key(spec, context, backend.adapter(), unit);
         let earlier = if journal.fresh {
+            journal.check_replaceable(&key)?;
             None
         } else {
             journal.read_held::<D::Outcome>(&key)?

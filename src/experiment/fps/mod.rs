@@ -49,6 +49,10 @@ impl Declaration for FpsSpec {
         &self.header
     }
 
+    fn locate(&self, e: anyhow::Error) -> anyhow::Error {
+        self.places.locate(e)
+    }
+
     fn gpu(&self) -> bool {
         true
     }

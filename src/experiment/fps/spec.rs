@@ -1,6 +1,7 @@
 //! The frame-rate experiment file: scenes x light counts x resolutions, timed at one sampling.
 
 use crate::config::{ConfigError, Source};
+use crate::experiment::comparison::SettingsPlaces;
 use crate::experiment::header::{plain_name, Header};
 use crate::key_path;
 use crate::render::Sampling;
@@ -69,6 +70,9 @@ pub struct FpsSpec {
     pub resolutions: Vec<[u32; 2]>,
     /// Scenes.
     pub scenes: Vec<FpsScene>,
+    /// Where each resolution and each scene's structure are set, for refusals known only when
+    /// a frame is uploaded.
+    pub places: SettingsPlaces,
 }
 
 impl FpsSpec {
@@ -137,6 +141,7 @@ impl FpsSpec {
         }
         let mut scenes = Vec::new();
         let mut scene_paths = Vec::new();
+        let mut structures = std::collections::BTreeMap::new();
         for (i, e) in f.scenes.iter().enumerate() {
             plain_name(&e.name).map_err(|m| source.error(&key_path!["scenes", i, "name"], m))?;
             if f.scenes[..i].iter().any(|o| o.name == e.name) {
@@ -150,6 +155,9 @@ impl FpsSpec {
                 )
             })?;
             let scene = Scene::from_source(&scene_source)?;
+            structures
+                .entry(scene.accel_settings.name)
+                .or_insert_with(|| scene_source.error(&key_path!["accelerator"], String::new()));
             scene_paths.push(scene_path);
             if !scene.cameras.contains_key(&e.camera) {
                 return Err(source.error(
@@ -218,6 +226,14 @@ impl FpsSpec {
                 seed: 1,
                 frame: 0,
             },
+            places: SettingsPlaces::new(
+                structures,
+                f.resolutions
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| ((r[0], r[1]), source.error(&key_path!["resolutions", i], String::new())))
+                    .collect(),
+            ),
             resolutions: f.resolutions,
             scenes,
         })

@@ -198,7 +198,7 @@ impl FramesSpec {
             tables: given,
             places,
         } = Comparison::read(source, &f.structures, &f.accel, &f.claim, true)?;
-        let places = places.with_frame(source.error(&key_path!["width"], String::new()));
+        let places = places.with_frame((f.width, f.height), source.error(&key_path!["width"], String::new()));
         let candidates = candidates(names, &given);
         let structures: Vec<AccelSettings> = candidates.iter().map(|c| c[0].clone()).collect();
         let tuning = FramesTuning::read(source, f.tuning, &candidates, f.path.block)?;

@@ -204,7 +204,10 @@ impl RealtimeSpec {
                 scene.accel_settings.name,
                 scene_source.error(&key_path!["accelerator"], String::new()),
             )]),
-            Some(source.error(&key_path!["measure", "width"], String::new())),
+            vec![(
+                (m.width, m.height),
+                source.error(&key_path!["measure", "width"], String::new()),
+            )],
         );
         if let Some(n) = m.lights {
             if n == 0 || n > scene.lights.len() {

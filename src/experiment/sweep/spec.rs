@@ -136,8 +136,9 @@ pub struct Spec {
     pub verdict: (DiskScheme, DiskScheme),
     /// The ray counts timed (`[timed]`; default every swept count).
     pub timed_samples: Vec<u32>,
-    /// Where each swept structure and the measuring frame's size are set, for refusals known
-    /// only when a frame is uploaded.
+    /// Where each swept structure (and the scene's own, which renders the ground truths) and
+    /// the measured and figures' frame sizes are set, for refusals known only when a frame is
+    /// uploaded.
     pub places: SettingsPlaces,
 }
 
@@ -158,6 +159,8 @@ impl Spec {
         let scene_source = Source::read(&scene_path)
             .map_err(|e| err(&key_path!["scene"], format!("{}: {}", scene_path.display(), e.message)))?;
         let scene = Scene::from_source(&scene_source)?;
+        // The ground truths and the figures' reference render with the scene's own structure.
+        let scene_structure = scene_source.error(&key_path!["accelerator"], String::new());
         let scene_text = scene_source.text;
         let m = &f.measure;
         match scene.cameras.get(&m.camera) {
@@ -235,7 +238,15 @@ impl Spec {
             structures.insert(name.clone(), built);
             places.insert(r.name, err(&key_path!["sweep", "accelerators", i], String::new()));
         }
-        let places = SettingsPlaces::new(places, Some(err(&key_path!["measure", "width"], String::new())));
+        places.entry(scene.accel_settings.name).or_insert(scene_structure);
+        let mut frames = vec![((m.width, m.height), err(&key_path!["measure", "width"], String::new()))];
+        if let Some(fig) = &f.figures {
+            frames.push((
+                (fig.width, fig.height),
+                err(&key_path!["figures", "width"], String::new()),
+            ));
+        }
+        let places = SettingsPlaces::new(places, frames);
         if scene.triangles.positions.is_empty() {
             // Nothing for a structure to index: every structure would render the same frames,
             // and rows would name a structure that answered no ray.

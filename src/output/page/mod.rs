@@ -240,13 +240,14 @@ fn check(galleries: &[Gallery]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`; such a name
-/// that is not a regular file (a link, pipe or folder) is refused with its path.
 /// The most bytes of one text (a CSV, an SVG plot, report.md) the page embeds: 40 times the
 /// largest an experiment here writes (a sweep's runs.csv, 1.7 MB), so a planted or runaway file
 /// is refused from its length instead of filling memory.
 pub const MAX_TEXT_BYTES: u64 = 64 << 20;
 
+/// The files of `dir`/`sub` whose names end in `suffix`, sorted, relative to `dir`; such a name
+/// that is not a regular file (a link, pipe or folder), or that is not UTF-8, is refused with its
+/// path.
 fn files_in(dir: &Path, sub: &str, suffix: &str) -> anyhow::Result<Vec<String>> {
     crate::files::check_plain_folder(&dir.join(sub))?;
     let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {

@@ -169,9 +169,16 @@ impl GpuBackend {
         self.scene.as_ref().map_or(1, |s| s.chunk_divisor)
     }
 
-    /// Checks every buffer a frame needs against the adapter's binding and buffer limits, naming
-    /// the buffer and the excess.
-    fn check_limits(&self, packed: &layout::Packed, view: View, plan: &RenderPlan) -> anyhow::Result<()> {
+    /// Checks every buffer a frame of `scene` needs against the adapter's binding and buffer
+    /// limits, naming the buffer and the excess (and for the meshes' buffer, the meshes: no kind
+    /// has one key for them to be located at).
+    fn check_limits(
+        &self,
+        scene: &crate::scene::Scene,
+        packed: &layout::Packed,
+        view: View,
+        plan: &RenderPlan,
+    ) -> anyhow::Result<()> {
         let limits = self.device.limits();
         let structure = packed.accel.as_ref().map(|(name, s)| (*name, s.buffers.len() as u32));
         storage_buffers_fit(
@@ -183,19 +190,23 @@ impl GpuBackend {
             crate::render::limit::binding_bytes(limits.max_storage_buffer_binding_size.min(limits.max_buffer_size));
         let lights = packed.lights.len().max(1) as u64;
         let pixels = view.pixels() as u64;
+        let frame = Part::Frame {
+            width: view.width,
+            height: view.height,
+        };
         let mut buffers = vec![
-            (Part::Frame, "hit buffer", pixels * HIT_BYTES),
-            (Part::Frame, "visibility buffer", pixels * lights * 4),
-            (Part::Frame, "light sums buffer", pixels * lights * 4),
+            (frame, "hit buffer", pixels * HIT_BYTES),
+            (frame, "visibility buffer", pixels * lights * 4),
+            (frame, "light sums buffer", pixels * lights * 4),
             (
                 Part::Scene,
                 "mesh triangle buffer",
                 std::mem::size_of_val(packed.mesh_tris.as_slice()) as u64,
             ),
-            (Part::Frame, "ambient-occlusion buffer", pixels * 8),
+            (frame, "ambient-occlusion buffer", pixels * 8),
         ];
         if plan.passes.iter().any(|p| matches!(p, Pass::Mirror { .. })) {
-            buffers.push((Part::Frame, "mirror chain buffer", pixels * layout::CHAIN_BYTES));
+            buffers.push((frame, "mirror chain buffer", pixels * layout::CHAIN_BYTES));
         }
         if let Some((name, s)) = &packed.accel {
             buffers.extend(
@@ -208,13 +219,18 @@ impl GpuBackend {
             if bytes > max {
                 let by = bytes - max;
                 let message = match part {
-                    Part::Frame => format!(
+                    Part::Frame { .. } => format!(
                         "a {}x{} frame of this scene needs a {what} of {bytes} bytes, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes; render a smaller frame",
                         view.width, view.height
                     ),
-                    Part::Scene => format!(
-                        "this scene's meshes need a {what} of {bytes} bytes on the GPU, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes; use fewer triangles"
-                    ),
+                    Part::Scene => {
+                        let mut meshes: Vec<&str> = scene.meshes().map(|m| m.source.as_str()).collect();
+                        meshes.dedup();
+                        format!(
+                            "this scene's meshes ({}) need a {what} of {bytes} bytes on the GPU, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes; use fewer triangles",
+                            meshes.join(", ")
+                        )
+                    }
                     Part::Structure(name) => format!(
                         "`{name}` needs a {what} of {bytes} bytes, over this adapter's binding limit (max_storage_buffer_binding_size / max_buffer_size) of {max} bytes by {by} bytes"
                     ),
@@ -445,7 +461,7 @@ impl Backend for GpuBackend {
         let plan = RenderPlan::new(scene, view)?;
         let mut packed = pack(scene, view, sampling)?;
         packed.params.stats = self.count_work as u32;
-        self.check_limits(&packed, view, &plan)?;
+        self.check_limits(scene, &packed, view, &plan)?;
         let lights = scene.lights.len();
         let (r, counters) = loop {
             let r = self.resources(&packed, view, &plan, 0)?;
@@ -524,7 +540,7 @@ impl Backend for GpuBackend {
     ) -> anyhow::Result<Timing> {
         let plan = RenderPlan::new(scene, view)?;
         let packed = pack(scene, view, sampling)?;
-        self.check_limits(&packed, view, &plan)?;
+        self.check_limits(scene, &packed, view, &plan)?;
         loop {
             let r = self.resources(&packed, view, &plan, 0)?;
             let timing = self.time_frames(&r, view, &plan, warmup, repeats)?;

@@ -81,6 +81,43 @@ pub fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
 }
 
+/// A small ambient-occlusion experiment `name` on `backend` over one mesh (`mesh`: its name and
+/// path): 8 x 8 frames of 33 rays, `bvh` against the claim's `subject`, tuned at `tuning` pixels
+/// a side, with `accel` (the `[accel.NAME]` tables, which start on line 24) before the mesh.
+pub fn small_ao(name: &str, backend: &str, subject: &str, tuning: u32, accel: &str, mesh: (&str, &str)) -> String {
+    format!(
+        r#"kind = "ao"
+name = "{name}"
+backend = "{backend}"
+width = 8
+height = 8
+rays = 33
+weighting = "plain"
+max_distance = 4.0
+structures = ["bvh", "{subject}"]
+
+[timing]
+warmup = 0
+repeats = 6
+
+[tuning]
+width = {tuning}
+height = {tuning}
+repeats = 6
+
+[claim]
+subject = "{subject}"
+baseline = "bvh"
+
+{accel}
+[[meshes]]
+name = "{}"
+path = "{}"
+"#,
+        mesh.0, mesh.1
+    )
+}
+
 /// A tiny experiment over the sphere scene, written into `dir` with the scene beside it;
 /// `edit` may change the experiment text first. Returns the experiment path.
 pub fn tiny_experiment(dir: &std::path::Path, edit: impl Fn(String) -> String) -> PathBuf {
