@@ -288,7 +288,7 @@ impl Outputs {
         if now != Some((locked.dev(), locked.ino())) {
             self.committed = true;
             return Err(crate::files::Refused(format!(
-                "{}: moved or replaced while the run went (it is not the folder this run locked); nothing was swapped in, and this run's results are left in {}",
+                "{}: moved or replaced while the run went (it is not the folder this run locked); nothing was swapped in, and this run's results are left in {} (move them away before another run into this folder, which clears a killed run's staging folder)",
                 self.home.display(),
                 self.staging.display()
             ))
