@@ -41,7 +41,8 @@ pub struct Cli {
     /// results/NAME--FILTERS, so a subset never replaces the whole sweep's results).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Discard the journal of an interrupted sweep and redo every run; replace a results folder
+    /// Redo every unit, reading nothing from the journal (a run that succeeds drops the units it
+    /// did not write; one that fails leaves the journal as it was); replace a results folder
     /// that holds another experiment's results.
     #[arg(long)]
     pub fresh: bool,
