@@ -1281,12 +1281,7 @@ fn page_refuses_an_image_longer_than_its_header_declares() {
     std::fs::write(folder.join("report.md"), "# a report\n").unwrap();
     let image = folder.join("images/a.exr");
     penumbra::output::images::write_exr(&image, &[0.5; 16], 4, 4).unwrap();
-    std::fs::OpenOptions::new()
-        .write(true)
-        .open(&image)
-        .unwrap()
-        .set_len(8 << 30)
-        .unwrap();
+    lengthen_sparsely(&image);
     // Names only: the image's 8 GiB are not read here either.
     let names = |d: &Path| -> Vec<PathBuf> {
         let mut v: Vec<PathBuf> = walk(d);
@@ -1310,6 +1305,16 @@ fn page_refuses_an_image_longer_than_its_header_declares() {
 }
 
 /// Every path under `root`.
+/// Makes `path` 8 GiB long without writing the bytes (a sparse file: nothing on disk).
+fn lengthen_sparsely(path: &Path) {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(path)
+        .unwrap()
+        .set_len(8 << 30)
+        .unwrap();
+}
+
 fn walk(root: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(root).unwrap().flatten() {
@@ -1341,12 +1346,7 @@ fn page_refuses_a_text_past_its_limit_and_a_name_it_cannot_write() {
         let path = if long {
             let path = folder.join(file);
             std::fs::write(&path, "a,b\n").unwrap();
-            std::fs::OpenOptions::new()
-                .write(true)
-                .open(&path)
-                .unwrap()
-                .set_len(8 << 30)
-                .unwrap();
+            lengthen_sparsely(&path);
             path
         } else {
             let name = std::ffi::OsStr::from_bytes(b"bad-\xff.csv");

@@ -138,6 +138,26 @@ fn a_hard_linked_backup_is_never_changed_by_a_resumed_run() {
     );
 }
 
+/// A fresh run of the scratch tree's experiment, paused (`PENUMBRA_TEST_PAUSE_AFTER`) after its
+/// `units`-th journaled unit: returned once `pause` exists, the run waiting until it is removed.
+#[cfg(feature = "test-hooks")]
+fn fresh_run_paused_after(s: &Scratch, units: i64, pause: &Path) -> std::process::Child {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
+        .current_dir(&s.work)
+        .args(["exp.toml", "--fresh"])
+        .env("PENUMBRA_TEST_PAUSE_AFTER", format!("{units}:{}", pause.display()))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !pause.exists() {
+        assert!(start.elapsed().as_secs() < 300, "the run never paused");
+        assert!(child.try_wait().unwrap().is_none(), "the run ended before pausing");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child
+}
+
 /// A results folder's `.journal` or `cache` swapped for a link to a folder elsewhere, or for
 /// another plain folder, while the run goes (paused after its first journaled unit, before the
 /// second ground truth): the run never writes into the folder put there, ends with status 2
@@ -158,22 +178,7 @@ fn a_folder_swapped_for_a_link_mid_run_is_never_written_through() {
         let (foreign, pause) = (s.root.join("foreign"), s.root.join("pause"));
         std::fs::create_dir(&foreign).unwrap();
         std::fs::write(foreign.join("theirs"), b"theirs").unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
-            .current_dir(&s.work)
-            .args(["exp.toml", "--fresh"])
-            .env("PENUMBRA_TEST_PAUSE_AFTER", format!("1:{}", pause.display()))
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let start = std::time::Instant::now();
-        while !pause.exists() {
-            assert!(start.elapsed().as_secs() < 300, "{swapped}: the run never paused");
-            assert!(
-                child.try_wait().unwrap().is_none(),
-                "{swapped}: the run ended before pausing"
-            );
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
+        let child = fresh_run_paused_after(&s, 1, &pause);
         let target = home.join(swapped);
         assert!(target.is_dir(), "{swapped} is there while the run goes");
         std::fs::rename(&target, home.join(format!("{swapped}-moved"))).unwrap();
@@ -210,26 +215,10 @@ fn a_results_folder_replaced_before_the_swap_gets_nothing() {
     let (code, stderr) = s.run(&["exp.toml", "--fresh"]);
     assert_eq!(code, 0, "{stderr}");
     let home = s.work.join("results/tiny");
-    let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
-        .unwrap()
-        .parse()
-        .unwrap();
-    let units = manifest["details"]["units"].as_integer().unwrap();
+    let units = crate::common::manifest_count(&home, "units");
     let earlier = std::fs::read(home.join("runs.csv")).unwrap();
     let pause = s.root.join("pause");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sweep"))
-        .current_dir(&s.work)
-        .args(["exp.toml", "--fresh"])
-        .env("PENUMBRA_TEST_PAUSE_AFTER", format!("{units}:{}", pause.display()))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = std::time::Instant::now();
-    while !pause.exists() {
-        assert!(start.elapsed().as_secs() < 300, "the run never paused");
-        assert!(child.try_wait().unwrap().is_none(), "the run ended before pausing");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let child = fresh_run_paused_after(&s, units, &pause);
     let moved = s.work.join("results/tiny-moved");
     std::fs::rename(&home, &moved).unwrap();
     std::fs::create_dir(&home).unwrap();

@@ -113,13 +113,7 @@ fn whole_sharded_and_resumed_agree(experiment: &Path, tables: &[&str]) {
         err.contains("1 of") && err.contains("units taken from the journal"),
         "{err}"
     );
-    let from_journal = |home: &Path| {
-        let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
-            .unwrap()
-            .parse()
-            .unwrap();
-        manifest["details"]["units_from_journal"].as_integer().unwrap()
-    };
+    let from_journal = |home: &Path| common::manifest_count(home, "units_from_journal");
     assert_eq!(from_journal(&killed), 1, "the manifest counts the unit resumed");
     assert_eq!(from_journal(&full), 0);
 

@@ -12,28 +12,7 @@ fn tiny_on_gpu(dir: &Path) -> std::path::PathBuf {
     common::tiny_experiment(dir, |t| format!("backend = \"gpu\"\n{t}"))
 }
 
-/// Runs the sweep with `env` set; the exit status and standard error.
-fn run(args: &[&OsStr], env: &[(&str, &str)]) -> (i32, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
-        .args(args)
-        .envs(env.iter().copied())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 const LIMITED: [(&str, &str); 1] = [("PENUMBRA_TEST_BINDING_BYTES", "4096")];
-
-fn units_from_journal(home: &Path) -> i64 {
-    let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
-        .unwrap()
-        .parse()
-        .unwrap();
-    manifest["details"]["units_from_journal"].as_integer().unwrap()
-}
 
 /// A first run refused leaves no results folder, no journal, no cache; a refused `--shard`
 /// leaves no `shards` folder.
@@ -43,7 +22,7 @@ fn a_refused_first_run_or_shard_leaves_no_folder_behind() {
     let exp = tiny_on_gpu(dir.path());
     let out = dir.path().join("results/tiny");
     let (o, e) = (OsStr::new("--out"), exp.as_os_str());
-    let (code, err) = run(&[e, o, out.as_os_str()], &LIMITED);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str()], &LIMITED);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("measure.width") && err.contains("hit buffer"), "{err}");
     assert!(
@@ -52,7 +31,7 @@ fn a_refused_first_run_or_shard_leaves_no_folder_behind() {
         snapshot(dir.path()).keys()
     );
     std::fs::create_dir_all(&out).unwrap();
-    let (code, err) = run(
+    let (code, err) = common::sweep_with(
         &[e, o, out.as_os_str(), OsStr::new("--shard"), OsStr::new("1/2")],
         &LIMITED,
     );
@@ -72,7 +51,7 @@ fn a_refused_fresh_run_keeps_the_journal_and_a_finished_one_replaces_it() {
     let exp = tiny_on_gpu(dir.path());
     let out = dir.path().join("out");
     let (o, e) = (OsStr::new("--out"), exp.as_os_str());
-    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str()], &[]);
     assert_eq!(code, 0, "{err}");
     let journal = out.join(".journal");
     let stale = journal.join("0000000000000000.toml");
@@ -81,14 +60,14 @@ fn a_refused_fresh_run_keeps_the_journal_and_a_finished_one_replaces_it() {
     assert!(before.len() > 2, "nothing journaled: {:?}", before.keys());
 
     let fresh = OsStr::new("--fresh");
-    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &LIMITED);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str(), fresh], &LIMITED);
     assert_eq!(code, 2, "{err}");
     assert_eq!(snapshot(&journal), before, "the refused fresh run changed the journal");
 
-    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &[]);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str(), fresh], &[]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(
-        units_from_journal(&out),
+        common::manifest_count(&out, "units_from_journal"),
         0,
         "a fresh run takes nothing from the journal"
     );
@@ -108,14 +87,14 @@ fn a_refused_frame_is_located_at_the_key_of_its_own_size() {
     let exp = common::tiny_experiment(dir.path(), |t| format!("backend = \"gpu\"\n{t}{figures}"));
     let out = dir.path().join("out");
     let (o, e) = (OsStr::new("--out"), exp.as_os_str());
-    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str()], &[]);
     assert_eq!(code, 0, "{err}");
     let before = snapshot(&out);
     // The measured 24 x 24 frames' hit buffers (27,648 bytes) fit; the figures' 64 x 64 one
     // (196,608 bytes) does not.
     let limited = [("PENUMBRA_TEST_BINDING_BYTES", "100000")];
     let fresh = OsStr::new("--fresh");
-    let (code, err) = run(&[e, o, out.as_os_str(), fresh], &limited);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str(), fresh], &limited);
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("tiny.toml:") && err.contains("figures.width") && err.contains("64x64 frame"),
@@ -138,7 +117,7 @@ fn a_refused_frame_is_located_at_the_key_of_its_own_size() {
     .unwrap();
     // The 8 x 8 frames fit, the 128 x 128 tuning frames' hit buffers (786,432 bytes) do not.
     let ao_out = dir.path().join("ao-out");
-    let (code, err) = run(
+    let (code, err) = common::sweep_with(
         &[ao.as_os_str(), o, ao_out.as_os_str()],
         &[("PENUMBRA_TEST_BINDING_BYTES", "700000")],
     );
@@ -159,7 +138,7 @@ fn a_fresh_run_refuses_a_folder_at_a_units_name_before_measuring() {
     let exp = common::tiny_experiment(dir.path(), |t| t);
     let out = dir.path().join("out");
     let (o, e) = (OsStr::new("--out"), exp.as_os_str());
-    let (code, err) = run(&[e, o, out.as_os_str()], &[]);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str()], &[]);
     assert_eq!(code, 0, "{err}");
     let journal = out.join(".journal");
     let unit = crate::hostile_input::first_file(&journal, "journaled unit");
@@ -167,7 +146,7 @@ fn a_fresh_run_refuses_a_folder_at_a_units_name_before_measuring() {
     std::fs::create_dir(&unit).unwrap();
     std::fs::write(unit.join("theirs"), b"theirs").unwrap();
     let before = snapshot(&journal);
-    let (code, err) = run(&[e, o, out.as_os_str(), OsStr::new("--fresh")], &[]);
+    let (code, err) = common::sweep_with(&[e, o, out.as_os_str(), OsStr::new("--fresh")], &[]);
     assert_eq!(code, 2, "{err}");
     let named = unit.file_name().unwrap().to_string_lossy().into_owned();
     assert!(

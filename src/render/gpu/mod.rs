@@ -278,19 +278,16 @@ impl GpuBackend {
                     let (gate, args) = r.mirror_gate.as_ref().expect("made with the mirror pass");
                     let mut steps = Vec::new();
                     for (bounce, info) in r.mirror_passes.iter().enumerate() {
-                        let run = |pipeline| match bounce {
-                            0 => Dispatch::Frame(pipeline, info),
-                            _ => Dispatch::Indirect(pipeline, info, args),
+                        let run = |pipeline, group| match bounce {
+                            0 => Dispatch::Frame(pipeline, group),
+                            _ => Dispatch::Indirect(pipeline, group, args),
                         };
                         if bounce > 0 {
                             steps.push(Dispatch::Gate(&m.gate, gate));
                         }
-                        steps.push(run(&m.trace));
-                        steps.extend(every_light().map(|c| match bounce {
-                            0 => Dispatch::Frame(&m.shade, c),
-                            _ => Dispatch::Indirect(&m.shade, c, args),
-                        }));
-                        steps.push(run(&m.step));
+                        steps.push(run(&m.trace, info));
+                        steps.extend(every_light().map(|c| run(&m.shade, c)));
+                        steps.push(run(&m.step, info));
                     }
                     steps.push(frame(&m.finish, &r.passes[0][0]));
                     steps

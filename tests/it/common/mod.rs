@@ -174,14 +174,30 @@ pub fn run_experiment(exp: &std::path::Path, out: &std::path::Path, args: &[&str
 
 /// Runs the `sweep` binary; returns (exit code, stderr).
 pub fn sweep(args: &[&std::ffi::OsStr]) -> (i32, String) {
+    sweep_with(args, &[])
+}
+
+/// [`sweep`] with `env` set (a test hook, a memory share).
+pub fn sweep_with(args: &[&std::ffi::OsStr], env: &[(&str, &str)]) -> (i32, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_sweep"))
         .args(args)
+        .envs(env.iter().copied())
         .output()
         .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// The count `key` (`units`, `units_from_journal`) of the kind's table in the manifest of the
+/// results folder `home`.
+pub fn manifest_count(home: &std::path::Path, key: &str) -> i64 {
+    let manifest: toml::Table = std::fs::read_to_string(home.join("manifest.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    manifest["details"][key].as_integer().unwrap()
 }
 
 /// Scene TOML for the receiver every test scene shares: the ground plane z = 0 and a one-sided
