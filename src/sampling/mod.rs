@@ -6,10 +6,13 @@
 //! sample at a time so that the GPU can do the same; the schemes arranged over the screen read
 //! tables the GPU gets as a buffer ([`tables`]).
 //!
-//! Adding a scheme: a variant in [`DiskScheme`] with its name in [`DiskScheme::ALL`], its point
-//! function in [`DiskScheme::point`], and the same function in
-//! `render/gpu/shaders/sampling.wgsl` under the matching `SCHEME_*` id. The property tests in
-//! `tests/it/sampling_properties.rs` and the CPU/GPU agreement test then cover it.
+//! Adding a scheme: a variant in [`DiskScheme`] with its name appended to [`DiskScheme::ALL`]
+//! (a built-in's WGSL id is its place there, so appending keeps the others' ids; the points id
+//! follows the list), its point function in [`DiskScheme::point`], and the same function in
+//! `render/gpu/shaders/sampling.wgsl` under the matching `SCHEME_*` id; a scheme that reads
+//! tables says so in [`DiskScheme::uses_tables`] and gets its region in [`tables::pack`]. The
+//! property tests in `tests/it/sampling_properties.rs` and the CPU/GPU agreement test then
+//! cover it.
 //!
 //! A user's own point set needs no code: a `points:NAME` scheme reads it from a file
 //! ([`points`]), and both backends sample it from the tables buffer.
@@ -19,6 +22,7 @@ pub mod pmj02;
 pub mod points;
 pub mod rng;
 pub mod sobol;
+pub mod stbn;
 pub mod tables;
 
 use glam::DVec2;
@@ -68,6 +72,11 @@ pub enum DiskScheme {
     SobolBluenoise,
     /// A user's own pattern, `points:NAME`, read from a points file ([`points`]).
     Points(points::PointsId),
+    /// The shared (0,2) set of [`DiskScheme::BluenoiseCp`] Cranley-Patterson rotated by the
+    /// pixel's offset from spatiotemporal blue-noise masks (Wolfe et al. 2022): frame f reads the
+    /// masks' slice f (modulo their depth), so the offset changes over frames along each pixel's
+    /// blue-noise sequence in time rather than by R2 steps ([`stbn::offset`]).
+    StbnCp,
 }
 
 /// Where one pixel's samples come from: its random stream, and, for the schemes arranged over
@@ -111,7 +120,7 @@ impl Site {
 
 impl DiskScheme {
     /// Every scheme, in report order.
-    pub const ALL: [DiskScheme; 9] = [
+    pub const ALL: [DiskScheme; 10] = [
         DiskScheme::Uniform,
         DiskScheme::Paper,
         DiskScheme::PaperLiteral,
@@ -121,6 +130,7 @@ impl DiskScheme {
         DiskScheme::Pmj02,
         DiskScheme::BluenoiseCp,
         DiskScheme::SobolBluenoise,
+        DiskScheme::StbnCp,
     ];
 
     /// The name used in experiment files and CSV columns.
@@ -135,6 +145,7 @@ impl DiskScheme {
             DiskScheme::Pmj02 => "pmj02",
             DiskScheme::BluenoiseCp => "bluenoise-cp",
             DiskScheme::SobolBluenoise => "sobol-bluenoise",
+            DiskScheme::StbnCp => "stbn-cp",
             DiskScheme::Points(id) => id.label(),
         }
     }
@@ -161,6 +172,9 @@ impl DiskScheme {
             DiskScheme::SobolBluenoise => {
                 "Owen-scrambled Sobol' with blue-noise arranged scrambles (after Heitz et al. 2019)"
             }
+            DiskScheme::StbnCp => {
+                "spatiotemporal blue-noise masks (Wolfe et al. 2022) rotating a shared (0,2) set per frame (Cranley-Patterson)"
+            }
         };
         built_in.into()
     }
@@ -169,7 +183,11 @@ impl DiskScheme {
     pub fn uses_tables(self) -> bool {
         matches!(
             self,
-            DiskScheme::Pmj02 | DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise | DiskScheme::Points(_)
+            DiskScheme::Pmj02
+                | DiskScheme::BluenoiseCp
+                | DiskScheme::SobolBluenoise
+                | DiskScheme::StbnCp
+                | DiskScheme::Points(_)
         )
     }
 
@@ -211,8 +229,9 @@ impl DiskScheme {
     /// progressive sequences (Sobol', pmj02, blue-noise Sobol') continue at index f n + k under
     /// the same scramble or shift, so F frames of n are the sequence's first F n points; the
     /// per-pixel random schemes draw from a fresh stream ([`Stream::at_frame`]); bluenoise-cp
-    /// moves its offsets by f R2 steps ([`bluenoise::offset_at`]); a points set's tile seed is
-    /// re-keyed like a stream ([`rng::at_frame`]). Frame 0 is the single frame, unchanged.
+    /// moves its offsets by f R2 steps ([`bluenoise::offset_at`]); stbn-cp reads its masks' slice
+    /// f ([`stbn::offset`]); a points set's tile seed is re-keyed like a stream
+    /// ([`rng::at_frame`]). Frame 0 is the single frame, unchanged.
     pub fn point(self, n: u32, k: u32, site: Site) -> DVec2 {
         debug_assert!(k < n);
         // The re-seeded schemes' stream, and the progressive ones' index (wrapping, as on the GPU).
@@ -273,6 +292,13 @@ impl DiskScheme {
             DiskScheme::Points(id) => {
                 let tile_seed = rng::at_frame(site.tile_seed, site.frame);
                 id.loaded().point(k, site.pixel, tile_seed)
+            }
+            DiskScheme::StbnCp => {
+                let [x, y] = site.pixel;
+                let (ox, oy) = stbn::offset(x, y, site.frame, site.tile_seed);
+                let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
+                let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
+                concentric(wrap(sx, ox), wrap(sy, oy))
             }
         }
     }
@@ -531,6 +557,13 @@ mod tests {
                 let (a, b) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
                 concentric(rng::to_unit(a), rng::to_unit(b))
             }
+            // Newer than frames: its single frame is frame 0 of the stack.
+            DiskScheme::StbnCp => {
+                let (ox, oy) = stbn::offset(x, y, 0, site.tile_seed);
+                let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
+                let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
+                concentric(wrap(sx, ox), wrap(sy, oy))
+            }
             DiskScheme::Points(_) => unreachable!("not a built-in"),
         }
     }
@@ -572,7 +605,8 @@ mod tests {
     }
 
     /// The re-seeded schemes draw frame f from the stream's frame-f key, bluenoise-cp moves its
-    /// offset by f R2 steps; frame 1 differs from frame 0 for every built-in scheme.
+    /// offset by f R2 steps (stbn-cp's frames: [`stbn_cp_reads_the_frames_slice`]); frame 1
+    /// differs from frame 0 for every built-in scheme.
     #[test]
     fn other_frames_reseed_or_move() {
         use DiskScheme::{Jittered, Paper, PaperLiteral, Spiral, Uniform};
@@ -594,6 +628,39 @@ mod tests {
         let (r1, r2) = bluenoise::R2_STEP;
         let moved = ((ox + 5 * r1) & 0x00ff_ffff, (oy + 5 * r2) & 0x00ff_ffff);
         assert_eq!(bluenoise::offset_at(40, 7, bluenoise::tile_seed(8, 2), 5), moved);
+    }
+
+    /// stbn-cp rotates bluenoise-cp's shared set by the STBN offset of the site's frame: frames
+    /// wrap with the masks' depth (a 32-bit frame counter's wrap included), and a pixel's offsets
+    /// over one period are not all alike.
+    #[test]
+    fn stbn_cp_reads_the_frames_slice() {
+        let site = |frame| Site::pixel(8, 2, [40, 7], 488, frame);
+        let n = 16;
+        for f in [0u32, 1, 5, 31, 77] {
+            let (ox, oy) = stbn::offset(40, 7, f, bluenoise::tile_seed(8, 2));
+            for k in 0..n {
+                let (sx, sy) = (sobol::sobol_dim0(k) >> 8, sobol::sobol_dim1(k) >> 8);
+                let u = rng::to_unit(((sx + ox) & 0x00ff_ffff) << 8);
+                let v = rng::to_unit(((sy + oy) & 0x00ff_ffff) << 8);
+                assert_eq!(
+                    DiskScheme::StbnCp.point(n, k, site(f)),
+                    concentric(u, v),
+                    "frame {f} k={k}"
+                );
+            }
+            let depth = stbn::DEPTH as u32;
+            assert_eq!(
+                DiskScheme::StbnCp.points(n, site(f + depth)),
+                DiskScheme::StbnCp.points(n, site(f))
+            );
+        }
+        let last = DiskScheme::StbnCp.points(n, site(u32::MAX));
+        assert_eq!(last, DiskScheme::StbnCp.points(n, site(stbn::DEPTH as u32 - 1)));
+        let firsts: std::collections::BTreeSet<[u64; 2]> = (0..stbn::DEPTH as u32)
+            .map(|f| DiskScheme::StbnCp.point(n, 0, site(f)).to_array().map(f64::to_bits))
+            .collect();
+        assert_eq!(firsts.len(), stbn::DEPTH, "one slice per frame");
     }
 
     #[test]

@@ -35,6 +35,7 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
             (DiskScheme::Pmj02, Pattern::PerPixel),
             (DiskScheme::BluenoiseCp, Pattern::PerPixel),
             (DiskScheme::SobolBluenoise, Pattern::PerPixel),
+            (DiskScheme::StbnCp, Pattern::PerPixel),
         ] {
             let view = View {
                 camera: &scene.cameras[camera],
@@ -88,7 +89,8 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
 }
 
 /// The WGSL sampler returns the points the Rust sampler does, to f32 rounding, for every
-/// scheme and several counts including n = 1 and n = 2, in frames 0, 1 and 5.
+/// scheme and several counts including n = 1 and n = 2, in frames 0, 1, 5 and 37 (past the STBN
+/// masks' 32 slices, so stbn-cp wraps in time).
 /// The tests that call the GPU's test hooks (here, in gpu_resources.rs, mesh_scene.rs and
 /// accelerators.rs) exist only with the `test-hooks` feature, which scripts/test.sh enables:
 /// without it this test fails rather than letting them vanish.
@@ -104,7 +106,7 @@ fn wgsl_samplers_match_rust() {
     let Some(mut gpu) = common::gpu() else { return };
     for scheme in DiskScheme::ALL {
         for n in [1u32, 2, 3, 7, 16, 64, 257] {
-            for frame in [0u32, 1, 5] {
+            for frame in [0u32, 1, 5, 37] {
                 let (seed, pixel) = (1234, 77);
                 let g = gpu.disk_points_at(scheme, n, seed, pixel, frame).unwrap();
                 let c = scheme.points(n, common::hook_site(seed, pixel, frame));

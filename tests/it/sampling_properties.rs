@@ -88,26 +88,38 @@ fn area_uniform_schemes_pass_chi_square() {
 /// what makes its estimator unbiased (the tile's per-seed shift and, for the rotated set, the
 /// per-seed Cranley-Patterson shift). A scheme that forgot either would put a pixel's sample k
 /// at one place for every seed. sobol-bluenoise draws from the tile's 4096 scrambles, so 3000
-/// seeds see few repeats.
+/// seeds see few repeats. The rotated sets are checked in a later frame too (bluenoise-cp's
+/// offsets moved by R2 steps, stbn-cp's read from another slice of its masks).
 #[test]
 fn screen_arranged_samples_are_uniform_over_seeds() {
-    for scheme in [DiskScheme::Pmj02, DiskScheme::BluenoiseCp, DiskScheme::SobolBluenoise] {
-        for pixel in [[0u32, 0], [63, 0], [1000, 777]] {
-            for (n, k) in [(1u32, 0u32), (16, 5), (16, 15)] {
-                let pts: Vec<DVec2> = (0..3000u32)
-                    .map(|seed| {
-                        scheme.point(
-                            n,
-                            k,
-                            Site::pixel(seed.wrapping_mul(0x9e37_79b9) ^ 0x5eed, 1, pixel, 7, 0),
-                        )
-                    })
-                    .collect();
-                let (x2, dof) = chi_square(&pts, 4, 8);
-                assert!(
-                    x2 < chi_square_bound(dof),
-                    "{scheme} pixel {pixel:?} k={k} of {n}: chi2 = {x2:.1} on {dof} dof"
-                );
+    for scheme in [
+        DiskScheme::Pmj02,
+        DiskScheme::BluenoiseCp,
+        DiskScheme::SobolBluenoise,
+        DiskScheme::StbnCp,
+    ] {
+        let frames: &[u32] = match scheme {
+            DiskScheme::BluenoiseCp | DiskScheme::StbnCp => &[0, 13],
+            _ => &[0],
+        };
+        for &frame in frames {
+            for pixel in [[0u32, 0], [63, 0], [1000, 777]] {
+                for (n, k) in [(1u32, 0u32), (16, 5), (16, 15)] {
+                    let pts: Vec<DVec2> = (0..3000u32)
+                        .map(|seed| {
+                            scheme.point(
+                                n,
+                                k,
+                                Site::pixel(seed.wrapping_mul(0x9e37_79b9) ^ 0x5eed, 1, pixel, 7, frame),
+                            )
+                        })
+                        .collect();
+                    let (x2, dof) = chi_square(&pts, 4, 8);
+                    assert!(
+                        x2 < chi_square_bound(dof),
+                        "{scheme} frame {frame} pixel {pixel:?} k={k} of {n}: chi2 = {x2:.1} on {dof} dof"
+                    );
+                }
             }
         }
     }

@@ -20,6 +20,7 @@ use crate::scene::{Light, Scene};
 use crate::timing::{median_interval, Estimate};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// One pipeline at one frame count and seed: a row of runs.csv, the pipeline's columns then the
 /// run's ([`Row::columns`]).
@@ -58,6 +59,10 @@ pub struct Run {
     /// RMS change from the previous frame's output over the penumbra where the exact image did
     /// not change (NaN at one frame).
     pub stability: f64,
+    /// Flicker: the RMS over the exact penumbra of each pixel's temporal standard deviation over
+    /// the last [`FLICKER_FRAMES`] frames, where the exact image is the same at both ends of
+    /// them (NaN before the last frame).
+    pub flicker: f64,
     /// Shadow rays per frame.
     pub shadow_rays: u64,
     /// Filter taps per pixel with a receiver (every surface the view sees).
@@ -68,15 +73,43 @@ pub struct Run {
     pub driver: String,
 }
 
-/// A moving run's error after the occluder stops, one value per frame: what lag is read from.
+/// A moving run after the occluder stops, one value per frame (frames stop + 1, ..., the last):
+/// what lag and ghosting are read from.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Series {
     /// The pipeline on the moving variant, through the last frame.
     pub pipeline: Pipeline,
     /// Seed of the sequence.
     pub seed: u32,
-    /// RMSE at frames stop, stop + 1, ..., the last.
+    /// RMSE over the current penumbra.
     pub rmse: Vec<f64>,
+    /// 10-90 % width across the current contour over the exact one's.
+    pub width: Vec<f64>,
+    /// Mean squared error over the swept region: the union of the exact penumbrae of every
+    /// scene state the occluder passed through, where its ghost lies.
+    pub swept: Vec<f64>,
+}
+
+/// Frames over which flicker is read, ending at the last.
+pub const FLICKER_FRAMES: u32 = 8;
+
+/// Per pixel, whether frame `f`'s surface differs from frame `f - 1`'s (another object or
+/// triangle, or a depth change over 0.1 %): a disocclusion, whose history is dropped.
+fn disoccluded(
+    before: &[Option<Receiver>],
+    now: &[Option<Receiver>],
+    depth_before: &[f32],
+    depth_now: &[f32],
+) -> Vec<bool> {
+    (0..now.len())
+        .map(|i| match (&before[i], &now[i]) {
+            (Some(a), Some(b)) => {
+                (a.object, a.triangle) != (b.object, b.triangle)
+                    || (depth_now[i] - depth_before[i]).abs() > 1e-3 * depth_before[i].abs()
+            }
+            (a, b) => a.is_some() != b.is_some(),
+        })
+        .collect()
 }
 
 /// An output image kept for the page (first seed, first accumulation): at the fewest rays after
@@ -199,6 +232,10 @@ pub fn measure(
         Variant::Static => u32::MAX,
     };
     let penumbra = spec.filters.contains(&Filter::Penumbra);
+    let swept = match variant {
+        Variant::Moving => Some(swept_region(spec, refs, stop, backend)?),
+        Variant::Static => None,
+    };
     let (mut rows, mut series, mut pictures) = (Vec::new(), Vec::new(), Vec::new());
     let bar = progress.bar(
         &format!("{} {scheme} {rays} rays", variant.name()),
@@ -210,7 +247,7 @@ pub fn measure(
             .iter()
             .map(|&a| History {
                 accumulation: a,
-                image: Accumulator::new(a, (w * h) as usize),
+                image: Accumulator::new(a, w, h),
                 blockers: spec
                     .scene
                     .lights
@@ -219,9 +256,14 @@ pub fn measure(
                     .collect(),
             })
             .collect();
-        // Per (accumulation, filter): the previous frame's output and the errors after the stop.
-        let mut previous: Vec<Option<Vec<f32>>> = vec![None; histories.len() * spec.filters.len()];
-        let mut after_stop: Vec<Vec<f64>> = vec![vec![]; histories.len() * spec.filters.len()];
+        // Per (accumulation, filter): the previous frame's output, what is measured after the stop
+        // and the flicker window's per-pixel sums.
+        let slots = histories.len() * spec.filters.len();
+        let mut previous: Vec<Option<Vec<f32>>> = vec![None; slots];
+        let mut after_stop = vec![Settling::default(); slots];
+        let mut window: Vec<(Vec<f64>, Vec<f64>)> =
+            vec![(vec![0.0; (w * h) as usize], vec![0.0; (w * h) as usize]); slots];
+        let flicker_from = last.saturating_sub(FLICKER_FRAMES);
         for f in 0..last {
             let frames = f + 1;
             let scene = RealtimeSpec::with_rays(&spec.scene_at(variant, f), rays);
@@ -241,6 +283,21 @@ pub fn measure(
                 .with_context(|| format!("frame {f}"))?;
             let image = shadow_image(&frame.visibility);
             let guides = refs.guides(spec, variant, f)?;
+            if f > 0 {
+                let before = refs.guides(spec, variant, f - 1)?;
+                if !Arc::ptr_eq(&before, &guides) {
+                    let changed = disoccluded(
+                        &before.receivers,
+                        &guides.receivers,
+                        &before.gbuffer.depth,
+                        &guides.gbuffer.depth,
+                    );
+                    for hist in &mut histories {
+                        hist.image.forget(&changed);
+                        hist.blockers.iter_mut().for_each(|b| b.forget(&changed));
+                    }
+                }
+            }
             let blocker = match penumbra {
                 true => blockers(&scene, &guides.receivers, sampling, rays, w),
                 false => vec![vec![f64::NAN; image.len()]; scene.lights.len()],
@@ -254,7 +311,8 @@ pub fn measure(
             let judged = spec.frames.contains(&frames);
             let before_judged = spec.frames.contains(&(frames + 1)) && frames >= 1;
             let settled = frames > stop;
-            if !(judged || before_judged || settled) {
+            let flickering = f >= flicker_from;
+            if !(judged || before_judged || settled || flickering) {
                 bar.inc(1);
                 continue;
             }
@@ -265,7 +323,7 @@ pub fn measure(
                 let variance = hist.image.variance_or_spatial(w, h);
                 let sigma = match penumbra {
                     true => pixel_sigma(spec, &scene, &guides.gbuffer, &hist.blockers),
-                    false => vec![0.0; accumulated.len()],
+                    false => vec![[0.0; 2]; accumulated.len()],
                 };
                 for (k, &filter) in spec.filters.iter().enumerate() {
                     let input = Input {
@@ -284,7 +342,16 @@ pub fn measure(
                     let measured = on_receivers(&out.image, &reference);
                     let rmse = ErrorMetrics::measure(&measured, &reference.image, &reference.mask).rmse;
                     if settled {
-                        after_stop[slot].push(rmse);
+                        let s = &mut after_stop[slot];
+                        s.rmse.push(rmse);
+                        s.width.push(reference.edge.width_10_90(&measured) / reference.width_px);
+                        s.swept.push(swept_error(&measured, &reference, swept.as_deref()));
+                    }
+                    if flickering {
+                        let (s1, s2) = &mut window[slot];
+                        for (i, &v) in measured.iter().enumerate() {
+                            (s1[i], s2[i]) = (s1[i] + v as f64, s2[i] + (v as f64).powi(2));
+                        }
                     }
                     let pipeline = Pipeline::new(variant, scheme, rays, frames, hist.accumulation, filter);
                     if judged {
@@ -315,6 +382,13 @@ pub fn measure(
                                 area_ratio,
                                 lost_share,
                                 stability,
+                                flicker: match frames == last {
+                                    true => {
+                                        let start = refs.reference(spec, variant, flicker_from, backend)?;
+                                        flicker(&window[slot], last - flicker_from, &reference, &start)
+                                    }
+                                    false => f64::NAN,
+                                },
                                 shadow_rays: frame.rays.shadow_total(),
                                 taps_per_pixel: out.taps as f64 / receiving.max(1) as f64,
                                 adapter: backend.adapter().name.clone(),
@@ -345,10 +419,13 @@ pub fn measure(
         if variant == Variant::Moving {
             for (a, hist) in histories.iter().enumerate() {
                 for (k, &filter) in spec.filters.iter().enumerate() {
+                    let s = std::mem::take(&mut after_stop[a * spec.filters.len() + k]);
                     series.push(Series {
                         pipeline: Pipeline::new(variant, scheme, rays, last, hist.accumulation, filter),
                         seed,
-                        rmse: std::mem::take(&mut after_stop[a * spec.filters.len() + k]),
+                        rmse: s.rmse,
+                        width: s.width,
+                        swept: s.swept,
                     });
                 }
             }
@@ -358,25 +435,77 @@ pub fn measure(
     Ok(Outcome::Measured { rows, series, pictures })
 }
 
-/// The penumbra filter's per-pixel sigma: the widest any light's blocker estimate asks for.
-fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<f32> {
-    let mut sigma = vec![0f32; gbuffer.depth.len()];
+/// The penumbra filter's per-pixel sigmas: the widest any light's blocker estimate asks for.
+fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<[f32; 2]> {
+    let mut sigma = vec![[0f32; 2]; gbuffer.depth.len()];
     for (light, acc) in scene.lights.iter().zip(blockers) {
         let Light::Disk(d) = light else { continue };
-        let s = kernel_sigma(
-            acc.blocker(),
-            gbuffer,
-            d,
-            spec.width,
-            spec.height,
-            spec.settings.penumbra_scale,
-            spec.settings.penumbra_max_sigma,
-        );
+        let s = kernel_sigma(acc.blocker(), gbuffer, d, spec.width, spec.height, &spec.settings);
         for (a, b) in sigma.iter_mut().zip(s) {
-            *a = a.max(b);
+            *a = [a[0].max(b[0]), a[1].max(b[1])];
         }
     }
     sigma
+}
+
+/// What one pipeline measures after the stop, frame by frame ([`Series`]).
+#[derive(Clone, Default)]
+struct Settling {
+    rmse: Vec<f64>,
+    width: Vec<f64>,
+    swept: Vec<f64>,
+}
+
+/// The swept region of a moving variant: every pixel in the exact penumbra of some scene state
+/// up to the stop.
+fn swept_region(
+    spec: &RealtimeSpec,
+    refs: &References,
+    stop: u32,
+    backend: &mut dyn Backend,
+) -> anyhow::Result<Vec<usize>> {
+    let mut pixels = std::collections::BTreeSet::new();
+    for f in 0..=stop {
+        pixels.extend(
+            refs.reference(spec, Variant::Moving, f, backend)?
+                .mask
+                .pixels
+                .iter()
+                .copied(),
+        );
+    }
+    Ok(pixels.into_iter().collect())
+}
+
+/// Mean squared error of `image` against the reference over `region` (NaN without one).
+fn swept_error(image: &[f32], reference: &RefFrame, region: Option<&[usize]>) -> f64 {
+    match region {
+        Some(r) if !r.is_empty() => {
+            r.iter()
+                .map(|&i| (image[i] as f64 - reference.image[i] as f64).powi(2))
+                .sum::<f64>()
+                / r.len() as f64
+        }
+        _ => f64::NAN,
+    }
+}
+
+/// Flicker from a window's per-pixel sums over `frames` frames ([`Run::flicker`]).
+fn flicker(sums: &(Vec<f64>, Vec<f64>), frames: u32, reference: &RefFrame, start: &RefFrame) -> f64 {
+    let n = frames as f64;
+    let (mut sum, mut count) = (0.0, 0usize);
+    for &i in &reference.mask.pixels {
+        if reference.image[i] == start.image[i] && frames > 1 {
+            let mean = sums.0[i] / n;
+            sum += (sums.1[i] / n - mean * mean).max(0.0) * n / (n - 1.0);
+            count += 1;
+        }
+    }
+    if count == 0 {
+        f64::NAN
+    } else {
+        (sum / count as f64).sqrt()
+    }
 }
 
 /// RMS of the change between two outputs over the current penumbra where the exact image did not
@@ -409,7 +538,7 @@ pub fn time(
     let guides = refs.guides(spec, Variant::Static, 0)?;
     let rays0 = spec.rays[0];
     let scene0 = RealtimeSpec::with_rays(&spec.scene, rays0);
-    let mut image = Accumulator::new(Accumulation::Mean, (w * h) as usize);
+    let mut image = Accumulator::new(Accumulation::Mean, w, h);
     let mut blocker_accs = vec![];
     for f in 0..4 {
         let sampling = Sampling {

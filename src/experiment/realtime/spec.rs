@@ -53,6 +53,9 @@ struct SweepTable {
     frames: Vec<u32>,
     accumulations: Vec<String>,
     ema_alpha: f64,
+    /// The clamped history's gamma ([`Accumulation::Clamped`]).
+    #[serde(default = "default_gamma")]
+    clamp_gamma: f64,
     filters: Vec<String>,
     seeds: Vec<u32>,
 }
@@ -67,8 +70,15 @@ struct ReferenceTable {
 #[serde(deny_unknown_fields)]
 struct VerdictTable {
     width_tolerance: Option<f64>,
-    lag_fraction: Option<f64>,
+    lag_tolerance: Option<f64>,
+    max_lag: Option<u32>,
     budget_schemes: Option<Vec<(DiskScheme, u32)>>,
+}
+
+/// Variance clipping's usual gamma: the history within one standard deviation of the
+/// neighbourhood's mean (Salvi 2016).
+fn default_gamma() -> f64 {
+    1.0
 }
 
 /// The frame-time budgets when the file names none: one raw frame of the paper's 16 rays, and of
@@ -149,10 +159,12 @@ pub struct RealtimeSpec {
     pub reference_samples: u32,
     /// Largest |width / exact width - 1| a pipeline may show and stay eligible (the 2 %).
     pub width_tolerance: f64,
-    /// Lag: frames after the occluder stops until the moving run's excess error (over the same
-    /// pipeline's static error at the last frame count) is down to this fraction of its excess
-    /// at the stop (0.5: the ghost's half-life).
-    pub lag_fraction: f64,
+    /// Lag: frames after the occluder stops until the moving run's penumbra width is within this
+    /// share of the exact width (0.05).
+    pub lag_tolerance: f64,
+    /// Most frames of lag a pipeline may show and still answer a budget, where the moving
+    /// variant runs: moving scenes decide as much as still ones.
+    pub max_lag: u32,
     /// The frame-time budgets: (scheme, rays) whose raw single frame sets each.
     pub budgets: Vec<(DiskScheme, u32)>,
 }
@@ -350,6 +362,12 @@ impl RealtimeSpec {
                 format!("must be in (0, 1], got {}", s.ema_alpha),
             ));
         }
+        if !(s.clamp_gamma.is_finite() && s.clamp_gamma >= 0.0 && s.clamp_gamma <= 100.0) {
+            return Err(source.error(
+                &key_path!["sweep", "clamp_gamma"],
+                format!("must be in [0, 100], got {}", s.clamp_gamma),
+            ));
+        }
         let mut accumulations = Vec::new();
         for (i, a) in s.accumulations.iter().enumerate() {
             let parsed = a
@@ -357,6 +375,10 @@ impl RealtimeSpec {
                 .map_err(|e| source.error(&key_path!["sweep", "accumulations", i], e))?;
             let parsed = match parsed {
                 Accumulation::Ema(_) => Accumulation::Ema(s.ema_alpha),
+                Accumulation::Clamped { .. } => Accumulation::Clamped {
+                    alpha: s.ema_alpha,
+                    gamma: s.clamp_gamma,
+                },
                 m => m,
             };
             if accumulations.contains(&parsed) {
@@ -398,13 +420,14 @@ impl RealtimeSpec {
         if !(width_tolerance > 0.0 && width_tolerance < 1.0) {
             return Err(source.error(&key_path!["verdict", "width_tolerance"], "must be in (0, 1)"));
         }
-        let lag_fraction = v.and_then(|v| v.lag_fraction).unwrap_or(0.5);
-        if !(lag_fraction > 0.0 && lag_fraction < 1.0) {
+        let lag_tolerance = v.and_then(|v| v.lag_tolerance).unwrap_or(0.05);
+        if !(lag_tolerance > 0.0 && lag_tolerance < 1.0) {
             return Err(source.error(
-                &key_path!["verdict", "lag_fraction"],
-                format!("must be in (0, 1), got {lag_fraction}"),
+                &key_path!["verdict", "lag_tolerance"],
+                format!("must be in (0, 1), got {lag_tolerance}"),
             ));
         }
+        let max_lag = v.and_then(|v| v.max_lag).unwrap_or(4);
         let swept = |&(scheme, rays): &(DiskScheme, u32)| s.schemes.contains(&scheme) && s.rays.contains(&rays);
         // The defaults are the paper's 16 raw rays and uniform at 4, where swept; a file that
         // names its budgets must sweep them.
@@ -449,7 +472,8 @@ impl RealtimeSpec {
             seeds: s.seeds.clone(),
             reference_samples,
             width_tolerance,
-            lag_fraction,
+            lag_tolerance,
+            max_lag,
             budgets,
         })
     }

@@ -1,7 +1,7 @@
 //! The filters in f64: the reference the WGSL kernels (`gpu/shaders/denoise.wgsl`) follow line
 //! for line in f32; change both together.
 
-use super::{gaussian_radius, Filter, Input, Output, B3, LUMINANCE_EPSILON, MIN_SIGMA};
+use super::{gaussian_radius, Filter, Input, Output, B3, DIRECTIONLESS, LUMINANCE_EPSILON, MIN_SIGMA};
 use rayon::prelude::*;
 
 /// Runs `filter` on `input`.
@@ -13,11 +13,11 @@ pub fn apply(filter: Filter, input: &Input) -> Output {
             per_pixel(input, |x, y| gaussian_at(input, x, y, sigma, false))
         }
         Filter::Penumbra => per_pixel(input, |x, y| {
-            let sigma = input.sigma[index(input, x, y)] as f64;
-            if sigma < MIN_SIGMA {
+            let [along, across] = input.sigma[index(input, x, y)].map(f64::from);
+            if along < MIN_SIGMA {
                 input.image[index(input, x, y)] as f64
             } else {
-                gaussian_at(input, x, y, sigma, true)
+                oriented_at(input, x, y, along, across)
             }
         }),
         Filter::Atrous => atrous(input),
@@ -72,6 +72,55 @@ fn gaussian_at(input: &Input, x: i32, y: i32, sigma: f64, guided: bool) -> f64 {
             sum += w * input.image[index(input, qx, qy)] as f64;
             weight += w;
         }
+    }
+    sum / weight
+}
+
+/// The penumbra filter at (x, y): a Gaussian of `along` pixels along the shadow's edge and
+/// `across` pixels across it, over the window of `along`, weighted by the geometry. The edge's
+/// normal is the weighted regression slope of the values over that window under an isotropic
+/// Gaussian of `along`, sum w (I_q - mean) (q - p), which noise averages out of; where it
+/// vanishes (a flat or symmetric neighbourhood) the kernel is the narrow isotropic one.
+fn oriented_at(input: &Input, x: i32, y: i32, along: f64, across: f64) -> f64 {
+    let r = gaussian_radius(along);
+    let slope = depth_slope(input, x, y);
+    let (sa, sn) = (along as f32 as f64, across as f32 as f64);
+    let taps = || {
+        (-r..=r)
+            .flat_map(move |dy| (-r..=r).map(move |dx| (dx, dy)))
+            .filter_map(move |(dx, dy)| {
+                let (qx, qy) = (x + dx, y + dy);
+                if !usable(input, qx, qy) {
+                    return None;
+                }
+                let (fx, fy) = (dx as f64, dy as f64);
+                let g = geometry_weight(input, x, y, qx, qy, slope, (fx * fx + fy * fy).sqrt());
+                Some((fx, fy, g, input.image[index(input, qx, qy)] as f64))
+            })
+    };
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for (fx, fy, g, v) in taps() {
+        let w = g * (-(fx * fx + fy * fy) / (2.0 * sa * sa)).exp();
+        (sum, weight) = (sum + w * v, weight + w);
+    }
+    let mean = sum / weight;
+    let (mut nx, mut ny) = (0.0, 0.0);
+    for (fx, fy, g, v) in taps() {
+        let w = g * (-(fx * fx + fy * fy) / (2.0 * sa * sa)).exp() * (v - mean);
+        (nx, ny) = (nx + w * fx, ny + w * fy);
+    }
+    let norm = (nx * nx + ny * ny).sqrt();
+    let oriented = norm > DIRECTIONLESS * weight;
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for (fx, fy, g, v) in taps() {
+        let e = if oriented {
+            let (n, t) = ((fx * nx + fy * ny) / norm, (fy * nx - fx * ny) / norm);
+            n * n / (2.0 * sn * sn) + t * t / (2.0 * sa * sa)
+        } else {
+            (fx * fx + fy * fy) / (2.0 * sn * sn)
+        };
+        let w = g * (-e).exp();
+        (sum, weight) = (sum + w * v, weight + w);
     }
     sum / weight
 }

@@ -31,9 +31,11 @@ pub enum Filter {
     /// Edge-avoiding a-trous wavelet filter guided by depth, normal and the temporal variance
     /// (Schied et al. 2017, SVGF, eqs. 1-5): 5 x 5 B3-spline taps at steps 1, 2, 4, ...
     Atrous,
-    /// A Gaussian whose per-pixel width follows the penumbra's estimated size from the shadow
+    /// An oriented Gaussian whose size follows the penumbra's estimated width from the shadow
     /// rays' blocker distances (Boksansky, Wimmer & Bittner 2019, "Ray Traced Shadows:
-    /// Maintaining Real-Time Frame Rates", Ray Tracing Gems ch. 13), depth- and normal-aware.
+    /// Maintaining Real-Time Frame Rates", Ray Tracing Gems ch. 13), depth- and normal-aware:
+    /// wide along the shadow's edge, where visibility does not change, and narrow across it, so
+    /// that it averages noise without widening the penumbra ([`penumbra`]).
     Penumbra,
 }
 
@@ -83,8 +85,14 @@ pub struct FilterSettings {
     pub atrous_sigma_depth: f64,
     /// SVGF's sigma_n: the exponent of the normals' cosine.
     pub atrous_sigma_normal: f64,
-    /// The penumbra filter's standard deviation as a share of the estimated penumbra width.
+    /// The penumbra filter's standard deviation along the edge, as a share of the estimated
+    /// penumbra width.
     pub penumbra_scale: f64,
+    /// Its standard deviation across the edge, as a share of the estimated width: a Gaussian of
+    /// s across a penumbra whose profile has standard deviation W / 4 (a disk's, [`penumbra`])
+    /// widens it by sqrt(1 + (4 s)^2) - 1, 0.7 % at the default 0.03 (on the pixel grid a little
+    /// more: pixels off the edge's line get some weight).
+    pub penumbra_across: f64,
     /// Largest standard deviation the penumbra filter uses, pixels.
     pub penumbra_max_sigma: f64,
 }
@@ -97,7 +105,8 @@ impl Default for FilterSettings {
             atrous_sigma_luminance: 4.0,
             atrous_sigma_depth: 1.0,
             atrous_sigma_normal: 128.0,
-            penumbra_scale: 0.25,
+            penumbra_scale: 0.5,
+            penumbra_across: 0.03,
             penumbra_max_sigma: 8.0,
         }
     }
@@ -118,6 +127,7 @@ impl FilterSettings {
         positive("atrous_sigma_depth", self.atrous_sigma_depth, 1e6)?;
         positive("atrous_sigma_normal", self.atrous_sigma_normal, 1e4)?;
         positive("penumbra_scale", self.penumbra_scale, 1e3)?;
+        positive("penumbra_across", self.penumbra_across, 1.0)?;
         positive("penumbra_max_sigma", self.penumbra_max_sigma, MAX_SIGMA)?;
         if !(1..=8).contains(&self.atrous_iterations) {
             return Err((
@@ -139,9 +149,14 @@ pub fn gaussian_radius(sigma: f64) -> i32 {
     (3.0f32 * sigma as f32).ceil() as i32
 }
 
-/// Below this standard deviation (pixels) the penumbra filter leaves a pixel as it is: a
-/// Gaussian that narrow puts over 99 % of its weight on the pixel itself.
+/// Below this standard deviation (pixels) along the edge the penumbra filter leaves a pixel as
+/// it is: a Gaussian that narrow puts over 99 % of its weight on the pixel itself.
 pub const MIN_SIGMA: f64 = 0.25;
+
+/// Below this length of the penumbra filter's regression slope (value change per pixel times the
+/// window's weight) a neighbourhood has no edge direction: a change of 1e-6 per pixel, far below
+/// any ray count's noise.
+pub const DIRECTIONLESS: f64 = 1e-6;
 
 /// What a filter reads: one accumulated image and its guides, all row-major over one view.
 #[derive(Clone, Copy, Debug)]
@@ -156,9 +171,10 @@ pub struct Input<'a> {
     pub variance: &'a [f32],
     /// Depth, normal and pixel footprint of the surface each pixel sees.
     pub gbuffer: &'a GBuffer,
-    /// Per-pixel standard deviation (pixels) of the penumbra filter's Gaussian, from the blocker
-    /// estimate ([`penumbra::kernel_sigma`]); 0 where no blocker was seen.
-    pub sigma: &'a [f32],
+    /// Per-pixel standard deviations (pixels) of the penumbra filter's Gaussian, along and across
+    /// the edge, from the blocker estimate ([`penumbra::kernel_sigma`]); 0 where no blocker was
+    /// seen nearby.
+    pub sigma: &'a [[f32; 2]],
     /// The filters' parameters.
     pub settings: FilterSettings,
 }
@@ -183,9 +199,10 @@ impl Input<'_> {
             Filter::None => 0,
             Filter::Gaussian => receivers * window(gaussian_radius(self.settings.gaussian_sigma)),
             Filter::Atrous => receivers * 25 * self.settings.atrous_iterations as u64,
+            // The window twice: once for the edge's direction, once to filter.
             Filter::Penumbra => (0..self.pixels())
-                .filter(|&i| self.receives(i) && self.sigma[i] as f64 >= MIN_SIGMA)
-                .map(|i| window(gaussian_radius(self.sigma[i] as f64)))
+                .filter(|&i| self.receives(i) && self.sigma[i][0] as f64 >= MIN_SIGMA)
+                .map(|i| 2 * window(gaussian_radius(self.sigma[i][0] as f64)))
                 .sum(),
         }
     }

@@ -4,7 +4,7 @@
 //! receiver, casts a penumbra 2 a d / (D - d) wide (similar triangles through the blocker's
 //! edge). In pixels, over the receiver's footprint, it sets the filter's standard deviation.
 
-use super::GBuffer;
+use super::{FilterSettings, GBuffer};
 use crate::render::shading::Receiver;
 use crate::render::NO_HIT;
 use crate::scene::{DiskLight, Scene};
@@ -38,47 +38,60 @@ pub fn blocker_distance(scene: &Scene, r: &Receiver, target: DVec3) -> Option<f6
     Some(analytic.min(mesh)).filter(|&t| t > 0.0 && t < len)
 }
 
-/// Per-pixel standard deviation (pixels) of the penumbra filter: `scale` times the penumbra's
-/// width over the pixel's footprint, from the blocker distance dilated over a 5 x 5 window
-/// (pixels of the penumbra's lit side see no blocker themselves), capped at `max_sigma`; 0 where
-/// no blocker was seen nearby.
+/// Narrowest standard deviation (pixels) across the edge: far below a pixel, where the kernel
+/// keeps only pixels on the edge's line, and above zero, where its exponent would divide by it.
+pub const MIN_ACROSS: f64 = 0.1;
+
+/// Per pixel, the penumbra filter's standard deviations (pixels) along and across the edge
+/// ([`FilterSettings::penumbra_scale`], [`FilterSettings::penumbra_across`] times the width,
+/// along capped at `penumbra_max_sigma`), from the penumbra width W (pixels, over the pixel's
+/// footprint) its blocker estimate gives; [0, 0] where no blocker was seen nearby. Pixels on a
+/// penumbra's lit side see no blocker themselves: each blocked pixel lends its W to the pixels
+/// around it, falling linearly to 0 at W + 1 pixels away, and a pixel takes the largest it is
+/// lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a
+/// seam.
 pub fn kernel_sigma(
     blocker: &[f64],
     gbuffer: &GBuffer,
     light: &DiskLight,
     width: u32,
     height: u32,
-    scale: f64,
-    max_sigma: f64,
-) -> Vec<f32> {
+    settings: &FilterSettings,
+) -> Vec<[f32; 2]> {
     let (w, h) = (width as i64, height as i64);
-    let mut sigma = vec![0f32; blocker.len()];
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            if gbuffer.footprint[i] <= 0.0 {
-                continue;
-            }
-            let (mut sum, mut n) = (0.0, 0u32);
-            for qy in (y - 2).max(0)..=(y + 2).min(h - 1) {
-                for qx in (x - 2).max(0)..=(x + 2).min(w - 1) {
-                    let b = blocker[(qy * w + qx) as usize];
-                    if b.is_finite() {
-                        sum += b;
-                        n += 1;
-                    }
+    // No tent reaches past the view.
+    let widest = (w + h) as f64;
+    let mut lent = vec![0f64; blocker.len()];
+    for (i, &b) in blocker.iter().enumerate() {
+        if gbuffer.footprint[i] <= 0.0 || !b.is_finite() {
+            continue;
+        }
+        let d_light = (light.center - gbuffer.point[i]).length();
+        let own = penumbra_width(light.radius, d_light, b) / gbuffer.footprint[i] as f64;
+        let own = own.min(widest);
+        let reach = own + 1.0;
+        let r = reach.floor() as i64;
+        let (x, y) = (i as i64 % w, i as i64 / w);
+        for qy in (y - r).max(0)..=(y + r).min(h - 1) {
+            for qx in (x - r).max(0)..=(x + r).min(w - 1) {
+                let d = (((qx - x).pow(2) + (qy - y).pow(2)) as f64).sqrt();
+                let q = (qy * w + qx) as usize;
+                if d < reach && gbuffer.footprint[q] > 0.0 {
+                    lent[q] = lent[q].max(own * (1.0 - d / reach));
                 }
             }
-            if n == 0 {
-                continue;
-            }
-            let d_light = (light.center - gbuffer.point[i]).length();
-            let width_m = penumbra_width(light.radius, d_light, sum / n as f64);
-            let s = scale * width_m / gbuffer.footprint[i] as f64;
-            sigma[i] = s.clamp(0.0, max_sigma) as f32;
         }
     }
-    sigma
+    lent.iter()
+        .map(|&width| {
+            if width <= 0.0 {
+                return [0.0; 2];
+            }
+            let along = (settings.penumbra_scale * width).min(settings.penumbra_max_sigma);
+            let across = (settings.penumbra_across * width).max(MIN_ACROSS);
+            [along as f32, across as f32]
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -86,33 +99,50 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_kernel_follows_the_penumbra_and_reaches_lit_neighbours() {
-        // A 9 x 1 floor row under a light 2 m up, 1 mm pixels; a blocker 0.5 m up is seen by
-        // pixel 4 only.
-        let mut g = GBuffer::flat(9, 2.0, 0.001);
-        g.point = (0..9).map(|i| DVec3::new(i as f64 * 0.001, 0.0, 0.0)).collect();
+    fn the_kernel_follows_the_penumbra_and_fades_to_lit_neighbours_without_a_seam() {
+        // A 41 x 1 floor row under a light 2 m up, 1 mm pixels; a blocker 0.5 m up is seen by
+        // pixel 20 only.
+        let n = 41;
+        let mut g = GBuffer::flat(n, 2.0, 0.001);
+        g.point = (0..n).map(|i| DVec3::new(i as f64 * 0.001, 0.0, 0.0)).collect();
         let light = DiskLight {
-            center: DVec3::new(0.004, 0.0, 2.0),
+            center: DVec3::new(0.020, 0.0, 2.0),
             normal: DVec3::NEG_Z,
             radius: 0.02,
             power: 1.0,
             samples: 1,
         };
-        let mut blocker = vec![f64::NAN; 9];
-        blocker[4] = 0.5;
-        let sigma = kernel_sigma(&blocker, &g, &light, 9, 1, 0.25, 8.0);
-        // 2 a b / (D - b) = 0.04 * 0.5 / 1.5 m = 13.3 px; a quarter of it.
-        assert!(
-            (sigma[4] as f64 - 0.25 * 0.04 * 0.5 / 1.5 / 0.001).abs() < 1e-4,
-            "{sigma:?}"
-        );
-        // The 5 x 5 dilation reaches two pixels each way, with the neighbour's own distance to
-        // the light; beyond it nothing.
-        assert!(sigma[2] > 3.0 && sigma[6] > 3.0, "{sigma:?}");
-        assert_eq!((sigma[1], sigma[7]), (0.0, 0.0));
-        // Capped.
-        let capped = kernel_sigma(&blocker, &g, &light, 9, 1, 10.0, 8.0);
-        assert_eq!(capped[4], 8.0);
+        let mut blocker = vec![f64::NAN; n];
+        blocker[20] = 0.5;
+        let settings = FilterSettings::default();
+        let sigma = kernel_sigma(&blocker, &g, &light, n as u32, 1, &settings);
+        // 2 a b / (D - b) = 0.04 * 0.5 / 1.5 m = 13.3 px.
+        let width = 0.04 * 0.5 / 1.5 / 0.001;
+        let expect = |d: f64| width * (1.0 - d / (width + 1.0));
+        for (i, s) in sigma.iter().enumerate() {
+            let d = (i as f64 - 20.0).abs();
+            let along = (settings.penumbra_scale * expect(d)).min(settings.penumbra_max_sigma);
+            if d < width + 1.0 {
+                assert!((s[0] as f64 - along).abs() < 1e-4, "pixel {i}: {s:?}, expected {along}");
+                let across = (settings.penumbra_across * expect(d)).max(MIN_ACROSS);
+                assert!((s[1] as f64 - across).abs() < 1e-5, "pixel {i}: {s:?}");
+            } else {
+                assert_eq!(*s, [0.0; 2], "pixel {i}");
+            }
+        }
+        // No seam: neighbours differ by at most the tent's slope.
+        let slope = settings.penumbra_scale * width / (width + 1.0);
+        for pair in sigma.windows(2) {
+            assert!((pair[0][0] - pair[1][0]).abs() as f64 <= slope + 1e-4, "{pair:?}");
+        }
+        // Capped along, not across.
+        let wide = FilterSettings {
+            penumbra_scale: 10.0,
+            ..settings
+        };
+        let capped = kernel_sigma(&blocker, &g, &light, n as u32, 1, &wide);
+        assert_eq!(capped[20][0], 8.0);
+        assert!((capped[20][1] as f64 - settings.penumbra_across * width).abs() < 1e-4);
     }
 
     #[test]

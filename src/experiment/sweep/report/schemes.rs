@@ -165,6 +165,9 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
     {
         s += &format!("Blue-noise tables: {}.\n\n", crate::sampling::bluenoise::settings());
     }
+    if at_n.iter().any(|(scheme, _)| *scheme == DiskScheme::StbnCp) {
+        s += &format!("STBN masks: {}.\n\n", crate::sampling::stbn::settings());
+    }
     s += &rank_sentences(&at_n, subject);
     let exact = at_n
         .iter()

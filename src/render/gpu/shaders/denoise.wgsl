@@ -13,7 +13,8 @@ struct Params {
     sigma_normal: f32,
     min_sigma: f32,
     luminance_epsilon: f32,
-    _pad2: vec2<f32>,
+    directionless: f32,
+    _pad2: f32,
 }
 
 const NO_RECEIVER: f32 = -1.0;
@@ -23,7 +24,7 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(2) var<storage, read> variance_in: array<f32>;
 @group(0) @binding(3) var<storage, read> depth: array<f32>;
 @group(0) @binding(4) var<storage, read> normal: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> sigma: array<f32>;
+@group(0) @binding(5) var<storage, read> sigma: array<vec2<f32>>;
 @group(0) @binding(6) var<storage, read_write> image_out: array<f32>;
 @group(0) @binding(7) var<storage, read_write> variance_out: array<f32>;
 
@@ -108,6 +109,64 @@ fn gaussian(@builtin(global_invocation_id) gid: vec3<u32>) {
     image_out[p] = gaussian_at(x, y, params.gaussian_sigma, false);
 }
 
+// The oriented Gaussian of cpu.rs `oriented_at`: the edge's normal from the weighted
+// regression slope over the window, then `along` pixels along it and `across` across.
+fn oriented_at(x: i32, y: i32, along: f32, across: f32) -> f32 {
+    let r = i32(ceil(3.0 * along));
+    let slope = depth_slope(x, y);
+    let p = index(x, y);
+    var sum = 0.0;
+    var weight = 0.0;
+    for (var dy = -r; dy <= r; dy = dy + 1) {
+        for (var dx = -r; dx <= r; dx = dx + 1) {
+            if (!usable(x + dx, y + dy)) {
+                continue;
+            }
+            let d = vec2<f32>(f32(dx), f32(dy));
+            let q = index(x + dx, y + dy);
+            let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * along * along));
+            sum = sum + w * image_in[q];
+            weight = weight + w;
+        }
+    }
+    let mean = sum / weight;
+    var n = vec2<f32>(0.0, 0.0);
+    for (var dy = -r; dy <= r; dy = dy + 1) {
+        for (var dx = -r; dx <= r; dx = dx + 1) {
+            if (!usable(x + dx, y + dy)) {
+                continue;
+            }
+            let d = vec2<f32>(f32(dx), f32(dy));
+            let q = index(x + dx, y + dy);
+            let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * along * along));
+            n = n + w * (image_in[q] - mean) * d;
+        }
+    }
+    let norm = length(n);
+    let oriented = norm > params.directionless * weight;
+    sum = 0.0;
+    weight = 0.0;
+    for (var dy = -r; dy <= r; dy = dy + 1) {
+        for (var dx = -r; dx <= r; dx = dx + 1) {
+            if (!usable(x + dx, y + dy)) {
+                continue;
+            }
+            let d = vec2<f32>(f32(dx), f32(dy));
+            let q = index(x + dx, y + dy);
+            var e = dot(d, d) / (2.0 * across * across);
+            if (oriented) {
+                let a = dot(d, n) / norm;
+                let t = (d.y * n.x - d.x * n.y) / norm;
+                e = a * a / (2.0 * across * across) + t * t / (2.0 * along * along);
+            }
+            let w = geometry_weight(p, q, slope, length(d)) * exp(-e);
+            sum = sum + w * image_in[q];
+            weight = weight + w;
+        }
+    }
+    return sum / weight;
+}
+
 @compute @workgroup_size(8, 8)
 fn penumbra(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= params.width || gid.y >= params.height) {
@@ -121,11 +180,11 @@ fn penumbra(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = sigma[p];
-    if (s < params.min_sigma) {
+    if (s.x < params.min_sigma) {
         image_out[p] = image_in[p];
         return;
     }
-    image_out[p] = gaussian_at(x, y, s, true);
+    image_out[p] = oriented_at(x, y, s.x, s.y);
 }
 
 fn blurred_variance(x: i32, y: i32) -> f32 {

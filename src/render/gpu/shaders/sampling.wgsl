@@ -2,7 +2,7 @@
 // Every function here must return, bit for bit in its integer part, what the Rust one does.
 
 // The SCHEME_* ids and the table layout's constants (PMJ02_POINTS, BLUE_TILE, TABLE_COUNTS,
-// POINTS_HEADER) are generated from the Rust side (gpu::scheme_prelude, sampling::tables) and
+// POINTS_HEADER, STBN_HEADER, STBN_SIDE, STBN_DEPTH) are generated from the Rust side (gpu::scheme_prelude, sampling::tables) and
 // prepended; the tables themselves are `scheme_tables` (render.wgsl's binding, sampling::tables::pack).
 
 const TAU: f32 = 6.283185307179586;
@@ -163,6 +163,34 @@ fn bluenoise_offset(pixel: vec2<u32>, tile_seed: u32, frame: u32) -> vec2<u32> {
     return (o + frame * R2_STEP) & vec2<u32>(0x00ffffffu);
 }
 
+// The STBN slice that frame 0 reads under a tile seed (stbn::time_shift).
+fn stbn_time_shift(tile_seed: u32) -> u32 {
+    return pcg(tile_seed ^ 0x7e3a9f01u) % STBN_DEPTH;
+}
+
+// A pixel's Cranley-Patterson offset in frame `frame` from the spatiotemporal blue-noise masks,
+// 24-bit (stbn::offset): their values at the pixel's place in the stack (the tile shifted by the
+// tile seed in x and y and by stbn_time_shift in t; frames wrap modulo STBN_DEPTH, u32 addition
+// wrapping as the Rust side's) plus the tile seed's shared shift. The masks lie at the offset in
+// the header's STBN_HEADER word, x's stack then y's (sampling::tables::pack).
+fn stbn_offset(pixel: vec2<u32>, tile_seed: u32, frame: u32) -> vec2<u32> {
+    let t = (frame + stbn_time_shift(tile_seed)) % STBN_DEPTH;
+    let i = t * STBN_SIDE * STBN_SIDE + tile_index_in(pixel, tile_seed, STBN_SIDE);
+    let m = scheme_tables[STBN_HEADER];
+    let mask = vec2<u32>(scheme_tables[m + i], scheme_tables[m + STBN_SIDE * STBN_SIDE * STBN_DEPTH + i]);
+    return (mask + cp_shift(tile_seed)) & vec2<u32>(0x00ffffffu);
+}
+
+// Point k of the shared (0,2) set (unscrambled Sobol', 24-bit) rotated by the 24-bit offset `o`
+// modulo 1, through the concentric map: bluenoise-cp's and stbn-cp's sample.
+fn rotated_02(k: u32, o: vec2<u32>) -> vec2<f32> {
+    let sx = reverseBits(k) >> 8u;
+    let sy = sobol_dim1(k) >> 8u;
+    let u = to_unit(((sx + o.x) & 0x00ffffffu) << 8u);
+    let v = to_unit(((sy + o.y) & 0x00ffffffu) << 8u);
+    return concentric(u, v);
+}
+
 // Where the scramble table serving n rays starts in scheme_tables, or 0 (the header's place,
 // never a table's) when the frame carries none: the table fitted for the power of two at or
 // above n (bluenoise::table_rays).
@@ -210,7 +238,8 @@ fn points_point(k: u32, pixel: vec2<u32>, tile_seed: u32) -> vec2<f32> {
 // Sample k of n on the unit disk for the pixel at `pixel` under the tile shift of `tile_seed`,
 // drawing its randomness from `stream` (as at frame 0), in frame `frame` of a temporal sequence
 // (see DiskScheme::point and Site): progressive sequences continue at index frame n + k,
-// random schemes re-key their stream, bluenoise-cp moves its offset, points re-key the tile seed.
+// random schemes re-key their stream, bluenoise-cp moves its offset, stbn-cp reads the frame's
+// slice of its masks, points re-key the tile seed.
 fn disk_point(scheme: u32, n: u32, k: u32, stream_0: u32, pixel: vec2<u32>, tile_seed: u32, frame: u32) -> vec2<f32> {
     let stream = at_frame(stream_0, frame);
     let index = frame * n + k;
@@ -254,12 +283,14 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream_0: u32, pixel: vec2<u32>, tile
             return concentric(p.x, p.y);
         }
         case SCHEME_BLUENOISE_CP: {
-            let o = bluenoise_offset(pixel, tile_seed, frame);
-            let sx = reverseBits(k) >> 8u;
-            let sy = sobol_dim1(k) >> 8u;
-            let u = to_unit(((sx + o.x) & 0x00ffffffu) << 8u);
-            let v = to_unit(((sy + o.y) & 0x00ffffffu) << 8u);
-            return concentric(u, v);
+            return rotated_02(k, bluenoise_offset(pixel, tile_seed, frame));
+        }
+        case SCHEME_STBN_CP: {
+            if (scheme_tables[STBN_HEADER] == 0u) {
+                // No masks packed (sampling::tables::pack packs them for stbn-cp): NaN.
+                return vec2<f32>(bitcast<f32>(0x7fc00000u));
+            }
+            return rotated_02(k, stbn_offset(pixel, tile_seed, frame));
         }
         case SCHEME_SOBOL_BLUENOISE: {
             let table = bluenoise_table(n);
