@@ -155,7 +155,7 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
             assert!(flicker.is_finite() && flicker >= 0.0, "{r:?}");
         }
     }
-    // The clamped history drops the moving sphere's ghost that the running mean keeps.
+    // The clamped history drops the moving sphere's ghost sooner than the same average unclamped.
     let ghost = |acc: &str| -> f64 {
         summary
             .iter()
@@ -172,10 +172,10 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
             .unwrap()
     };
     assert!(
-        ghost("clamped") < ghost("mean"),
-        "ghost: clamped {}, mean {}",
+        ghost("clamped") < ghost("ema"),
+        "ghost: clamped {}, ema at the same alpha {}",
         ghost("clamped"),
-        ghost("mean")
+        ghost("ema")
     );
     let report = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(report.contains("**Answer:**") && report.contains("## The paper's claim restated"));
@@ -190,7 +190,8 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
             .count()
     };
     assert_eq!(rows("| any |"), 3, "{claim}");
-    assert!(rows("| at most the paper's |") <= 3, "{claim}");
+    let cheaper = rows("| at most the paper's |");
+    assert!((1..=3).contains(&cheaper), "{claim}");
 }
 
 #[test]

@@ -20,7 +20,7 @@ pub struct Pipeline {
     pub rays: u32,
     /// Frames accumulated.
     pub frames: u32,
-    /// `mean` or `ema`.
+    /// `mean`, `ema` or `clamped`.
     pub accumulation: String,
     /// Reconstruction filter, or [`REFERENCE`] for the reference picture.
     pub filter: String,

@@ -65,8 +65,8 @@ pub struct Stats {
     pub flicker: f64,
     /// Half-width of its 95 % interval.
     pub flicker_ci95: f64,
-    /// Moving variant: mean over seeds of the ghost's energy, the swept region's mean squared
-    /// error summed over the [`GHOST_FRAMES`] frames after the stop ([`Series::swept`]).
+    /// Moving variant: mean over seeds of the ghost's energy ([`ghosts`]; NaN at one frame, which
+    /// keeps no history).
     pub ghost: f64,
     /// Half-width of its 95 % interval.
     pub ghost_ci95: f64,
@@ -164,7 +164,10 @@ fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
                 true => lag(spec, m, p),
                 false => (f64::NAN, 0),
             };
-            let ghost = mean_ci(&ghosts(m, p));
+            let ghost = match p.on(Variant::Moving) && p.frames > 1 {
+                true => mean_ci(&ghosts(spec, m, p)),
+                false => mean_ci(&[]),
+            };
             let time = m
                 .frame_seconds(&p.scheme, p.rays, &p.filter)
                 .map_or(Estimate::NAN, |s| median_interval(&s));
@@ -202,26 +205,54 @@ fn summarise(spec: &RealtimeSpec, m: &Measured) -> Vec<Summary> {
 /// Frames after the stop whose swept-region error makes the ghost's energy.
 pub const GHOST_FRAMES: usize = 8;
 
-/// Per seed of a moving pipeline at its last frame, the ghost's energy ([`Stats::ghost`]).
-fn ghosts(m: &Measured, pipeline: &Pipeline) -> Vec<f64> {
+/// Per seed of a moving pipeline, the ghost's energy ([`Stats::ghost`]): over the first
+/// [`GHOST_FRAMES`] frames after the stop, the swept region's mean squared error in excess of
+/// the same pipeline's settled noise (its mean squared error over the penumbra on the still
+/// scene at the last frame count, same seed), so that a noisier pipeline does not read as
+/// more ghosted.
+fn ghosts(spec: &RealtimeSpec, m: &Measured, pipeline: &Pipeline) -> Vec<f64> {
+    let last = spec.max_frames();
+    let (moving, still) = (pipeline.at(Variant::Moving, last), pipeline.at(Variant::Static, last));
     m.series
         .iter()
-        .filter(|s| s.pipeline == *pipeline)
-        .map(|s| s.swept.iter().take(GHOST_FRAMES).sum())
+        .filter(|s| s.pipeline == moving)
+        .map(|s| {
+            let floor = m
+                .rows
+                .iter()
+                .find(|r| r.pipeline == still && r.run.seed == s.seed)
+                .map_or(0.0, |r| r.run.rmse * r.run.rmse);
+            s.swept.iter().take(GHOST_FRAMES).map(|&e| (e - floor).max(0.0)).sum()
+        })
         .collect()
 }
 
 /// Lag of a moving pipeline: per seed, the frames after the occluder stops until its 10-90 %
-/// width is first within `lag_tolerance` of the exact width; the most over seeds, and how many
-/// seeds never got there.
+/// width comes within `lag_tolerance` of where the same pipeline settles on the still scene
+/// (its width over exact at the last frame count, same seed; exact where the still scene did
+/// not run) and stays there to the last frame, so that neither a filter's own width bias nor a
+/// noisy pass through the band reads as lag; the most over seeds, and how many seeds never got
+/// there. Frame 0 is the first frame at the final position. A one-frame pipeline keeps no
+/// history: its lag is 0.
 fn lag(spec: &RealtimeSpec, m: &Measured, pipeline: &Pipeline) -> (f64, usize) {
-    let moving = pipeline.at(Variant::Moving, spec.max_frames());
+    if pipeline.frames == 1 {
+        return (0.0, 0);
+    }
+    let last = spec.max_frames();
+    let (moving, still) = (pipeline.at(Variant::Moving, last), pipeline.at(Variant::Static, last));
     let (mut worst, mut censored, mut any) = (0.0f64, 0usize, false);
     for s in m.series.iter().filter(|s| s.pipeline == moving) {
         any = true;
-        match s.width.iter().position(|&r| (r - 1.0).abs() <= spec.lag_tolerance) {
-            Some(k) => worst = worst.max(k as f64),
-            None => censored += 1,
+        let target = m
+            .rows
+            .iter()
+            .find(|r| r.pipeline == still && r.run.seed == s.seed)
+            .map_or(1.0, |r| r.run.width_px / r.run.exact_width_px);
+        let within = |r: f64| (r / target - 1.0).abs() <= spec.lag_tolerance;
+        match s.width.iter().rposition(|&r| !within(r)) {
+            None => {}
+            Some(k) if k + 1 < s.width.len() => worst = worst.max((k + 1) as f64),
+            Some(_) => censored += 1,
         }
     }
     match (any, censored) {
@@ -486,7 +517,7 @@ pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> a
     plot(spec, &summary, dir)?;
     let adapter = run.backend.adapter().clone();
     let mut md = format!(
-        "# Real-time soft shadows: {}\n\n{} at {} x {} px on {} ({}); {} seed(s); frames judged at {:?}; EMA alpha {}; filters: {}.\n",
+        "# Real-time soft shadows: {}\n\n{} at {} x {} px on {} ({}); {} seed(s); frames judged at {:?}; EMA alpha {}; clamped history gamma {}; filters: {}.\n",
         spec.header.name,
         spec.scene_path.display(),
         spec.width,
@@ -498,7 +529,16 @@ pub fn write(spec: &RealtimeSpec, outcomes: Vec<Outcome>, run: &RunContext) -> a
         spec.accumulations
             .iter()
             .find_map(|a| match a {
-                crate::render::denoise::Accumulation::Ema(alpha) => Some(alpha.to_string()),
+                crate::render::denoise::Accumulation::Ema(alpha) | crate::render::denoise::Accumulation::Clamped { alpha, .. } => {
+                    Some(alpha.to_string())
+                }
+                _ => None,
+            })
+            .unwrap_or("-".into()),
+        spec.accumulations
+            .iter()
+            .find_map(|a| match a {
+                crate::render::denoise::Accumulation::Clamped { gamma, .. } => Some(gamma.to_string()),
                 _ => None,
             })
             .unwrap_or("-".into()),
@@ -560,10 +600,11 @@ fn lag_section(spec: &RealtimeSpec, summary: &[Summary]) -> String {
         return String::new();
     }
     let mut out = format!(
-        "\n## Moving occluder: lag, ghost, flicker\n\nThe sphere moves {:.4} m per frame for {} frames, then stops. Lag: frames after the stop until the 10-90 % width across the current contour is within {:.0} % of exact (most over seeds; `never` when a seed is not within it by frame {last}). Ghost: the mean squared error over the swept region (every pixel in the exact penumbra of some position the sphere passed through) summed over the {GHOST_FRAMES} frames after the stop. Flicker: the RMS over the penumbra of each pixel's temporal standard deviation over the last {FLICKER_FRAMES} frames.\n\n| pipeline | lag (frames) | ghost | flicker | RMSE at {last} |\n| --- | --- | --- | --- | --- |\n",
+        "\n## Moving occluder: lag, ghost, flicker\n\nThe sphere moves {:.4} m per frame for {} frames, then stops. Lag: frames after the stop (0: the first frame at the final position) until the 10-90 % width across the current contour comes within {:.0} % of where the same pipeline settles on the still scene and stays there (most over seeds; `never` when a seed is not there by frame {last}). Ghost: the mean squared error over the swept region (every pixel in the exact penumbra of some position the sphere passed through) in excess of the same pipeline's settled error on the still scene, summed over the first {} frames after the stop. Flicker: the RMS over the penumbra of each pixel's temporal standard deviation over the last {FLICKER_FRAMES} frames, where they all follow the stop (`n/a` otherwise).\n\n| pipeline | lag (frames) | ghost | flicker | RMSE at {last} |\n| --- | --- | --- | --- | --- |\n",
         motion.step.length(),
         motion.frames,
-        100.0 * spec.lag_tolerance
+        100.0 * spec.lag_tolerance,
+        GHOST_FRAMES.min((last - motion.frames) as usize)
     );
     for s in rows {
         let _ = writeln!(

@@ -61,7 +61,7 @@ pub struct Run {
     pub stability: f64,
     /// Flicker: the RMS over the exact penumbra of each pixel's temporal standard deviation over
     /// the last [`FLICKER_FRAMES`] frames, where the exact image is the same at both ends of
-    /// them (NaN before the last frame).
+    /// them (NaN before the last frame, and where the occluder moves within them).
     pub flicker: f64,
     /// Shadow rays per frame.
     pub shadow_rays: u64,
@@ -264,6 +264,8 @@ pub fn measure(
         let mut window: Vec<(Vec<f64>, Vec<f64>)> =
             vec![(vec![0.0; (w * h) as usize], vec![0.0; (w * h) as usize]); slots];
         let flicker_from = last.saturating_sub(FLICKER_FRAMES);
+        // Flicker only over frames that all show the final scene.
+        let held_still = variant == Variant::Static || flicker_from >= stop;
         for f in 0..last {
             let frames = f + 1;
             let scene = RealtimeSpec::with_rays(&spec.scene_at(variant, f), rays);
@@ -382,7 +384,7 @@ pub fn measure(
                                 area_ratio,
                                 lost_share,
                                 stability,
-                                flicker: match frames == last {
+                                flicker: match frames == last && held_still {
                                     true => {
                                         let start = refs.reference(spec, variant, flicker_from, backend)?;
                                         flicker(&window[slot], last - flicker_from, &reference, &start)

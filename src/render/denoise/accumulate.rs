@@ -40,7 +40,7 @@ pub enum Accumulation {
 pub const CLAMP_RADIUS: i64 = 2;
 
 impl Accumulation {
-    /// The name in tables: `mean` or `ema`.
+    /// The name in tables: `mean`, `ema` or `clamped`.
     pub fn name(self) -> &'static str {
         match self {
             Accumulation::Mean => "mean",
@@ -124,7 +124,8 @@ impl Accumulator {
             }
             if let (Accumulation::Clamped { gamma, .. }, true) = (self.mode, self.history[i] > 0) {
                 let (lo, hi) = self.neighbourhood(image, i, gamma);
-                let clipped = self.m1[i].clamp(lo, hi);
+                // max/min rather than clamp: a NaN value in the frame must not panic.
+                let clipped = self.m1[i].max(lo).min(hi);
                 // The second moment moves with the first, keeping the history's variance.
                 self.m2[i] += clipped * clipped - self.m1[i] * self.m1[i];
                 self.m1[i] = clipped;

@@ -153,9 +153,10 @@ pub fn gaussian_radius(sigma: f64) -> i32 {
 /// it is: a Gaussian that narrow puts over 99 % of its weight on the pixel itself.
 pub const MIN_SIGMA: f64 = 0.25;
 
-/// Below this length of the penumbra filter's regression slope (value change per pixel times the
-/// window's weight) a neighbourhood has no edge direction: a change of 1e-6 per pixel, far below
-/// any ray count's noise.
+/// Below this length of the penumbra filter's regression vector, sum w (I_q - mean) (q - p), over
+/// the window's weight, a neighbourhood has no edge direction: a slope of about 1e-6 / sigma^2
+/// per pixel. It catches flat and exactly symmetric neighbourhoods only; under noise the
+/// direction is whatever the noise leaves.
 pub const DIRECTIONLESS: f64 = 1e-6;
 
 /// What a filter reads: one accumulated image and its guides, all row-major over one view.
@@ -199,10 +200,10 @@ impl Input<'_> {
             Filter::None => 0,
             Filter::Gaussian => receivers * window(gaussian_radius(self.settings.gaussian_sigma)),
             Filter::Atrous => receivers * 25 * self.settings.atrous_iterations as u64,
-            // The window twice: once for the edge's direction, once to filter.
+            // The window three times: its mean, the edge's direction, the filter.
             Filter::Penumbra => (0..self.pixels())
                 .filter(|&i| self.receives(i) && self.sigma[i][0] as f64 >= MIN_SIGMA)
-                .map(|i| 2 * window(gaussian_radius(self.sigma[i][0] as f64)))
+                .map(|i| 3 * window(gaussian_radius(self.sigma[i][0] as f64)))
                 .sum(),
         }
     }

@@ -46,9 +46,9 @@ pub const MIN_ACROSS: f64 = 0.1;
 /// ([`FilterSettings::penumbra_scale`], [`FilterSettings::penumbra_across`] times the width,
 /// along capped at `penumbra_max_sigma`), from the penumbra width W (pixels, over the pixel's
 /// footprint) its blocker estimate gives; [0, 0] where no blocker was seen nearby. Pixels on a
-/// penumbra's lit side see no blocker themselves: each blocked pixel lends its W to the pixels
-/// around it, falling linearly to 0 at W + 1 pixels away, and a pixel takes the largest it is
-/// lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a
+/// penumbra's lit side see no blocker themselves: each blocked pixel lends its W (at most the
+/// width whose along sigma reaches the cap) to the pixels around it, falling linearly to 0 at
+/// W + 1 pixels away, and a pixel takes the largest it is lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a
 /// seam.
 pub fn kernel_sigma(
     blocker: &[f64],
@@ -59,8 +59,10 @@ pub fn kernel_sigma(
     settings: &FilterSettings,
 ) -> Vec<[f32; 2]> {
     let (w, h) = (width as i64, height as i64);
-    // No tent reaches past the view.
-    let widest = (w + h) as f64;
+    // Past the width whose along sigma is capped a wider estimate changes only the across
+    // sigma, which then stays at most its share of this width: lending it keeps the tents'
+    // reach (and the work, each tent's area) bounded.
+    let widest = settings.penumbra_max_sigma / settings.penumbra_scale;
     let mut lent = vec![0f64; blocker.len()];
     for (i, &b) in blocker.iter().enumerate() {
         if gbuffer.footprint[i] <= 0.0 || !b.is_finite() {
@@ -135,14 +137,16 @@ mod tests {
         for pair in sigma.windows(2) {
             assert!((pair[0][0] - pair[1][0]).abs() as f64 <= slope + 1e-4, "{pair:?}");
         }
-        // Capped along, not across.
+        // Capped: along at its cap, the width lent at the one whose along sigma reaches it.
         let wide = FilterSettings {
             penumbra_scale: 10.0,
             ..settings
         };
         let capped = kernel_sigma(&blocker, &g, &light, n as u32, 1, &wide);
         assert_eq!(capped[20][0], 8.0);
-        assert!((capped[20][1] as f64 - settings.penumbra_across * width).abs() < 1e-4);
+        let widest = 8.0 / 10.0;
+        assert!((capped[20][1] as f64 - (settings.penumbra_across * widest).max(MIN_ACROSS)).abs() < 1e-6);
+        assert_eq!(capped[22], [0.0; 2], "the tent reaches only the capped width + 1");
     }
 
     #[test]
