@@ -665,12 +665,7 @@ mod tests {
             let c = 2.0 * c - 1.0;
             (c.acos() - c * (1.0 - c * c).sqrt()) / std::f64::consts::PI
         };
-        let stbn = temporal_rmse(&offset, &hit, &exact);
-        let r2 = temporal_rmse(&|x, y, f, s| bluenoise::offset_at(x, y, s, f), &hit, &exact);
-        let random = temporal_rmse(&random_offsets, &hit, &exact);
-        for (name, e) in [("STBN", stbn), ("R2-moved 2-D mask", r2), ("random", random)] {
-            eprintln!("{name:>18}: {}", e.map(|v| format!("{v:.4}")).join("  "));
-        }
+        let [stbn, r2, random] = three_ways(&hit, &exact);
         for j in [2, 3] {
             assert!(
                 stbn[j] < random[j] / 1.3,
@@ -689,6 +684,18 @@ mod tests {
         }
     }
 
+    /// [`temporal_rmse`] of one integrand for STBN, the R2-moved 2-D mask and independent random
+    /// offsets, in that order, printed as the tests' comments quote them.
+    fn three_ways(hit: &dyn Fn((f64, f64), (f64, f64)) -> f64, exact: &dyn Fn((f64, f64)) -> f64) -> [[f64; 4]; 3] {
+        let stbn = temporal_rmse(&offset, hit, exact);
+        let r2 = temporal_rmse(&|x, y, f, s| bluenoise::offset_at(x, y, s, f), hit, exact);
+        let random = temporal_rmse(&random_offsets, hit, exact);
+        for (name, e) in [("STBN", stbn), ("R2-moved 2-D mask", r2), ("random", random)] {
+            eprintln!("{name:>18}: {}", e.map(|v| format!("{v:.4}")).join("  "));
+        }
+        [stbn, r2, random]
+    }
+
     /// The same with a 1-D integrand, the share of [0, 1) below a threshold, read from the x
     /// offset alone: what a scalar mask is for (the paper's use). Here STBN's temporal order
     /// beats the R2 walk's x coordinate.
@@ -705,12 +712,7 @@ mod tests {
     fn temporal_error_on_a_step() {
         let hit = |(u, _): (f64, f64), (_, c): (f64, f64)| f64::from(u < c);
         let exact = |(_, c): (f64, f64)| c;
-        let stbn = temporal_rmse(&offset, &hit, &exact);
-        let r2 = temporal_rmse(&|x, y, f, s| bluenoise::offset_at(x, y, s, f), &hit, &exact);
-        let random = temporal_rmse(&random_offsets, &hit, &exact);
-        for (name, e) in [("STBN", stbn), ("R2-moved 2-D mask", r2), ("random", random)] {
-            eprintln!("{name:>18}: {}", e.map(|v| format!("{v:.4}")).join("  "));
-        }
+        let [stbn, r2, random] = three_ways(&hit, &exact);
         for j in [2, 3] {
             assert!(
                 stbn[j] < random[j] / 1.6,
