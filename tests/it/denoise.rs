@@ -14,15 +14,15 @@ const AGREEMENT: f32 = 1e-4;
 
 /// A 61 x 47 view: a floor with a box standing on it (another depth and normal), a hole with no
 /// receiver, noisy values with the variance of 1-4 ray frames, and per-pixel penumbra widths.
-/// The penumbra filter's per-pixel sigmas, along and across the edge.
-type Kernels = Vec<[f32; 2]>;
+/// The penumbra filter's per-pixel sigmas along the edge.
+type Kernels = Vec<f32>;
 
 fn guides() -> (u32, u32, Vec<f32>, Vec<f32>, GBuffer, Kernels) {
     let (w, h) = (61u32, 47u32);
     let mut rng = Seeded(0x5eed_0034);
     let n = (w * h) as usize;
     let mut g = GBuffer::flat(n, 3.0, 0.01);
-    let (mut image, mut variance, mut sigma) = (vec![0f32; n], vec![0f32; n], vec![[0f32; 2]; n]);
+    let (mut image, mut variance, mut sigma) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
     for i in 0..n {
         let (x, y) = ((i as u32 % w) as f64, (i as u32 / w) as f64);
         if (x - 50.0).powi(2) + (y - 8.0).powi(2) < 20.0 {
@@ -42,11 +42,7 @@ fn guides() -> (u32, u32, Vec<f32>, Vec<f32>, GBuffer, Kernels) {
         image[i] = if y < 3.0 { exact as f32 } else { noisy as f32 };
         variance[i] = if x > 55.0 { 0.0 } else { (exact * (1.0 - exact)) as f32 };
         let along = rng.range(0.0, 6.0) as f32;
-        sigma[i] = if x < 5.0 {
-            [0.0; 2]
-        } else {
-            [along, rng.range(0.1, 1.5) as f32]
-        };
+        sigma[i] = if x < 5.0 { 0.0 } else { along };
     }
     (w, h, image, variance, g, sigma)
 }
@@ -157,15 +153,14 @@ fn each_filter_widens_a_straight_edge_as_its_kernel_predicts() {
         );
         let zero = vec![0f32; n];
         // (filter, the Gaussian across the edge the kernel predicts, the penumbra filter's
-        // sigmas): the oriented penumbra kernel on this vertical edge blurs across it by its
-        // across sigma only.
+        // sigma): the penumbra kernel runs along this vertical edge and blurs nothing across it.
         for (filter, sigma, kernel) in [
-            (Filter::Gaussian, 1.5, [0.0, 0.0]),
-            (Filter::Gaussian, 4.0, [0.0, 0.0]),
-            (Filter::Penumbra, 1.0, [4.0, 1.0]),
-            (Filter::Penumbra, 0.0, [0.0, 0.0]),
-            (Filter::Atrous, 0.0, [0.0, 0.0]),
-            (Filter::Atrous, ATROUS_SIGMA, [0.0, 0.0]),
+            (Filter::Gaussian, 1.5, 0.0),
+            (Filter::Gaussian, 4.0, 0.0),
+            (Filter::Penumbra, 0.0, 4.0),
+            (Filter::Penumbra, 0.0, 0.0),
+            (Filter::Atrous, 0.0, 0.0),
+            (Filter::Atrous, ATROUS_SIGMA, 0.0),
         ] {
             let sigmas = vec![kernel; n];
             // The a-trous case with sigma > 0 has unit variance and a luminance sigma so large that
@@ -220,8 +215,8 @@ fn straight_penumbra(w: u32, h: u32, full: f64, angle: f64) -> Vec<f32> {
         .collect()
 }
 
-/// The penumbra filter at its default sigmas (half the width along the edge, 3 % across) on
-/// straight disk-light penumbrae 4-8 pixels wide at any angle: the 10-90 % width stays within
+/// The penumbra filter at its default sigma (half the width, along the edge) on straight
+/// disk-light penumbrae 4-8 pixels wide at any angle: the 10-90 % width stays within
 /// 2 % of the exact image's, noise-free, and its bias on 4-ray images (the mean over seeds of
 /// the filtered images against the mean of the same unfiltered ones, so that what noise the
 /// means keep is on both sides) stays within 2 % too, while the filter takes most of the noise
@@ -233,15 +228,13 @@ fn the_penumbra_filter_widens_a_straight_penumbra_by_at_most_two_percent() {
     let g = GBuffer::flat(n, 3.0, 0.001);
     let settings = FilterSettings::default();
     let zero = vec![0f32; n];
-    for full in [4.0, 8.0] {
+    // Under 4 px the pixels sample the profile too coarsely for any interpolation between them
+    // to be exact: measured, 2 px widens by up to 7.8 % (72 deg), 3 px by up to 3.6 %.
+    for (full, bound) in [(2.0, 0.08), (3.0, 0.04), (4.0, 0.02), (6.0, 0.02), (8.0, 0.02)] {
         for angle in [0.0, 10.0, 30.0, 45.0, 72.0] {
             let exact = straight_penumbra(w, h, full, angle);
             let edge = EdgeProfile::new(&exact, w, h, 20.0);
-            let kernel = [
-                (settings.penumbra_scale * full) as f32,
-                (settings.penumbra_across * full) as f32,
-            ];
-            let sigmas = vec![kernel; n];
+            let sigmas = vec![(settings.penumbra_scale * full) as f32; n];
             let filter = |image: &[f32]| {
                 let input = Input {
                     width: w,
@@ -256,7 +249,7 @@ fn the_penumbra_filter_widens_a_straight_penumbra_by_at_most_two_percent() {
             };
             let clean = edge.width_10_90(&filter(&exact)) / edge.width_10_90(&exact) - 1.0;
             assert!(
-                clean.abs() <= 0.02,
+                clean.abs() <= bound,
                 "{full}-px penumbra at {angle} deg: noise-free widening {:+.2} %",
                 100.0 * clean
             );
@@ -280,7 +273,7 @@ fn the_penumbra_filter_widens_a_straight_penumbra_by_at_most_two_percent() {
             let width = |image: &[f64]| edge.width_10_90(&image.iter().map(|&v| v as f32).collect::<Vec<f32>>());
             let biased = width(&filtered) / width(&raw) - 1.0;
             assert!(
-                biased.abs() <= 0.02,
+                biased.abs() <= bound,
                 "{full}-px penumbra at {angle} deg: the mean of {seeds} filtered 4-ray images is {:+.2} % wider than of the same unfiltered",
                 100.0 * biased
             );
@@ -289,5 +282,46 @@ fn the_penumbra_filter_widens_a_straight_penumbra_by_at_most_two_percent() {
                 "{full}-px penumbra at {angle} deg: squared error {filtered_error:.1} after the filter, {raw_error:.1} before"
             );
         }
+    }
+}
+
+/// A round shadow's penumbra bends away from the filter's straight line: its taps lie t^2 / 2r
+/// outside the circle of radius r through the pixel, further on the inner side of the
+/// penumbra than on the outer, which widens it. The 10-90 % width of a disk-light penumbra 6 px
+/// wide (sigma 3 px along) stays within 2 % of the exact image's around circles of radius 4 W
+/// and more; tighter, it widens (measured: +3.7 % at 16 px, +6.4 % at 12 px, bound 7 %).
+#[test]
+fn the_penumbra_filter_keeps_a_round_penumbras_width_where_it_is_not_tight() {
+    let (w, h) = (72u32, 72u32);
+    let n = (w * h) as usize;
+    let g = GBuffer::flat(n, 3.0, 0.001);
+    let settings = FilterSettings::default();
+    let zero = vec![0f32; n];
+    let full = 6.0;
+    let sigmas = vec![(settings.penumbra_scale * full) as f32; n];
+    for (radius, bound) in [(12.0, 0.07), (16.0, 0.07), (24.0, 0.02), (36.0, 0.02), (48.0, 0.02)] {
+        let exact: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64 - 36.2, (i / w) as f64 - 35.7);
+                disk_edge(((x * x + y * y).sqrt() - radius) / (full / 2.0)) as f32
+            })
+            .collect();
+        let edge = EdgeProfile::new(&exact, w, h, 20.0);
+        let input = Input {
+            width: w,
+            height: h,
+            image: &exact,
+            variance: &zero,
+            gbuffer: &g,
+            sigma: &sigmas,
+            settings,
+        };
+        let filtered = cpu::apply(Filter::Penumbra, &input).image;
+        let widening = edge.width_10_90(&filtered) / edge.width_10_90(&exact) - 1.0;
+        assert!(
+            widening.abs() <= bound,
+            "a {full}-px penumbra around a {radius}-px circle: widening {:+.2} %",
+            100.0 * widening
+        );
     }
 }

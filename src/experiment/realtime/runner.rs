@@ -325,7 +325,7 @@ pub fn measure(
                 let variance = hist.image.variance_or_spatial(w, h);
                 let sigma = match penumbra {
                     true => pixel_sigma(spec, &scene, &guides.gbuffer, &hist.blockers),
-                    false => vec![[0.0; 2]; accumulated.len()],
+                    false => vec![0.0; accumulated.len()],
                 };
                 for (k, &filter) in spec.filters.iter().enumerate() {
                     let input = Input {
@@ -438,13 +438,13 @@ pub fn measure(
 }
 
 /// The penumbra filter's per-pixel sigmas: the widest any light's blocker estimate asks for.
-fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<[f32; 2]> {
-    let mut sigma = vec![[0f32; 2]; gbuffer.depth.len()];
+fn pixel_sigma(spec: &RealtimeSpec, scene: &Scene, gbuffer: &GBuffer, blockers: &[BlockerHistory]) -> Vec<f32> {
+    let mut sigma = vec![0f32; gbuffer.depth.len()];
     for (light, acc) in scene.lights.iter().zip(blockers) {
         let Light::Disk(d) = light else { continue };
         let s = kernel_sigma(acc.blocker(), gbuffer, d, spec.width, spec.height, &spec.settings);
         for (a, b) in sigma.iter_mut().zip(s) {
-            *a = [a[0].max(b[0]), a[1].max(b[1])];
+            *a = a.max(b);
         }
     }
     sigma

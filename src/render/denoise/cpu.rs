@@ -1,7 +1,7 @@
 //! The filters in f64: the reference the WGSL kernels (`gpu/shaders/denoise.wgsl`) follow line
 //! for line in f32; change both together.
 
-use super::{gaussian_radius, Filter, Input, Output, B3, DIRECTIONLESS, LUMINANCE_EPSILON, MIN_SIGMA};
+use super::{gaussian_radius, Filter, Input, Output, B3, DIRECTIONLESS, DIRECTION_SIGMA, LUMINANCE_EPSILON, MIN_SIGMA};
 use rayon::prelude::*;
 
 /// Runs `filter` on `input`.
@@ -13,11 +13,11 @@ pub fn apply(filter: Filter, input: &Input) -> Output {
             per_pixel(input, |x, y| gaussian_at(input, x, y, sigma, false))
         }
         Filter::Penumbra => per_pixel(input, |x, y| {
-            let [along, across] = input.sigma[index(input, x, y)].map(f64::from);
+            let along = input.sigma[index(input, x, y)] as f64;
             if along < MIN_SIGMA {
                 input.image[index(input, x, y)] as f64
             } else {
-                oriented_at(input, x, y, along, across)
+                oriented_at(input, x, y, along)
             }
         }),
         Filter::Atrous => atrous(input),
@@ -76,53 +76,93 @@ fn gaussian_at(input: &Input, x: i32, y: i32, sigma: f64, guided: bool) -> f64 {
     sum / weight
 }
 
-/// The penumbra filter at (x, y): a Gaussian of `along` pixels along the shadow's edge and
-/// `across` pixels across it, over the window of `along`, weighted by the geometry. The edge's
-/// normal is the weighted regression slope of the values over that window under an isotropic
-/// Gaussian of `along`, sum w (I_q - mean) (q - p), which noise averages out of; where it
-/// vanishes (a flat or symmetric neighbourhood) the kernel is the narrow isotropic one.
-fn oriented_at(input: &Input, x: i32, y: i32, along: f64, across: f64) -> f64 {
-    let r = gaussian_radius(along);
+/// The penumbra filter at (x, y): a 1-D Gaussian of `along` pixels along the shadow's edge,
+/// weighted by the geometry, and nothing across it, so that it does not widen the penumbra. Its
+/// taps lie on the edge's line through the pixel, one per pixel of the line's major axis, each
+/// read by Catmull-Rom interpolation across the four pixels around the line, so the weights move
+/// continuously as the direction turns. The edge's normal is the gradient of the weighted
+/// least-squares plane through the values under an isotropic Gaussian of [`DIRECTION_SIGMA`];
+/// where there is none (a flat or symmetric neighbourhood) the pixel is left as it is.
+fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
     let slope = depth_slope(input, x, y);
-    let (sa, sn) = (along as f32 as f64, across as f32 as f64);
-    let taps = || {
-        (-r..=r)
-            .flat_map(move |dy| (-r..=r).map(move |dx| (dx, dy)))
-            .filter_map(move |(dx, dy)| {
-                let (qx, qy) = (x + dx, y + dy);
-                if !usable(input, qx, qy) {
-                    return None;
-                }
-                let (fx, fy) = (dx as f64, dy as f64);
-                let g = geometry_weight(input, x, y, qx, qy, slope, (fx * fx + fy * fy).sqrt());
-                Some((fx, fy, g, input.image[index(input, qx, qy)] as f64))
-            })
+    let guided = |qx: i32, qy: i32| {
+        let (fx, fy) = ((qx - x) as f64, (qy - y) as f64);
+        geometry_weight(input, x, y, qx, qy, slope, (fx * fx + fy * fy).sqrt())
     };
-    let (mut sum, mut weight) = (0.0, 0.0);
-    for (fx, fy, g, v) in taps() {
-        let w = g * (-(fx * fx + fy * fy) / (2.0 * sa * sa)).exp();
-        (sum, weight) = (sum + w * v, weight + w);
+    let value = |qx: i32, qy: i32| input.image[index(input, qx, qy)] as f64;
+    let sd = DIRECTION_SIGMA as f32 as f64;
+    let rd = gaussian_radius(sd);
+    // One pass of weighted sums (q relative to p): the least-squares plane's gradient is
+    // C^-1 b with b = sum w (I - mean) (q - centroid) and C the window's covariance, which a
+    // window cut by the image's border or by the geometry makes anisotropic.
+    let (mut w0, mut wv, mut wx, mut wy, mut wvx, mut wvy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut wxx, mut wxy, mut wyy) = (0.0, 0.0, 0.0);
+    for dy in -rd..=rd {
+        for dx in -rd..=rd {
+            let (qx, qy) = (x + dx, y + dy);
+            if !usable(input, qx, qy) {
+                continue;
+            }
+            let (fx, fy) = (dx as f64, dy as f64);
+            let w = guided(qx, qy) * (-(fx * fx + fy * fy) / (2.0 * sd * sd)).exp();
+            let v = value(qx, qy);
+            (w0, wv, wx, wy) = (w0 + w, wv + w * v, wx + w * fx, wy + w * fy);
+            (wvx, wvy) = (wvx + w * v * fx, wvy + w * v * fy);
+            (wxx, wxy, wyy) = (wxx + w * fx * fx, wxy + w * fx * fy, wyy + w * fy * fy);
+        }
     }
-    let mean = sum / weight;
-    let (mut nx, mut ny) = (0.0, 0.0);
-    for (fx, fy, g, v) in taps() {
-        let w = g * (-(fx * fx + fy * fy) / (2.0 * sa * sa)).exp() * (v - mean);
-        (nx, ny) = (nx + w * fx, ny + w * fy);
+    let (bx, by) = (wvx - wv * wx / w0, wvy - wv * wy / w0);
+    if (bx * bx + by * by).sqrt() <= DIRECTIONLESS * w0 {
+        return value(x, y);
     }
+    let (cxx, cxy, cyy) = (wxx - wx * wx / w0, wxy - wx * wy / w0, wyy - wy * wy / w0);
+    // C^-1 b up to its determinant, positive unless every usable pixel of the window lies on
+    // one line: then there is no plane to fit, and no direction.
+    let (nx, ny) = (cyy * bx - cxy * by, cxx * by - cxy * bx);
     let norm = (nx * nx + ny * ny).sqrt();
-    let oriented = norm > DIRECTIONLESS * weight;
-    let (mut sum, mut weight) = (0.0, 0.0);
-    for (fx, fy, g, v) in taps() {
-        let e = if oriented {
-            let (n, t) = ((fx * nx + fy * ny) / norm, (fy * nx - fx * ny) / norm);
-            n * n / (2.0 * sn * sn) + t * t / (2.0 * sa * sa)
-        } else {
-            (fx * fx + fy * fy) / (2.0 * sn * sn)
-        };
-        let w = g * (-e).exp();
-        (sum, weight) = (sum + w * v, weight + w);
+    if norm.is_nan() || norm <= 0.0 {
+        return value(x, y);
     }
-    sum / weight
+    // The edge's tangent, walked along its major axis.
+    let (tx, ty) = (-ny / norm, nx / norm);
+    let x_major = tx.abs() >= ty.abs();
+    let minor_per_step = if x_major { ty / tx } else { tx / ty };
+    let distance_per_step = (1.0 + minor_per_step * minor_per_step).sqrt();
+    let sa = along as f32 as f64;
+    let r = gaussian_radius(along);
+    let (mut sum, mut weight, mut lo, mut hi) = (0.0, 0.0, f64::INFINITY, f64::NEG_INFINITY);
+    for k in -r..=r {
+        let t = k as f64 * distance_per_step;
+        let g = (-t * t / (2.0 * sa * sa)).exp();
+        let offset = k as f64 * minor_per_step;
+        let below = offset.floor();
+        let f = offset - below;
+        for (j, share) in catmull_rom(f).into_iter().enumerate() {
+            let m = below as i32 + j as i32 - 1;
+            let (qx, qy) = if x_major { (x + k, y + m) } else { (x + m, y + k) };
+            if !usable(input, qx, qy) {
+                continue;
+            }
+            let (w, v) = (g * share * guided(qx, qy), value(qx, qy));
+            (sum, weight) = (sum + w * v, weight + w);
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    }
+    // Catmull-Rom's negative lobes can ring past the values read.
+    (sum / weight).clamp(lo, hi)
+}
+
+/// Catmull-Rom weights of the four pixels at -1, 0, 1, 2 around a point `f` in [0, 1) past
+/// pixel 0: exact on quadratics, so that reading a penumbra's profile between pixels hardly
+/// blurs it (linear interpolation would, by up to 0.5 px).
+fn catmull_rom(f: f64) -> [f64; 4] {
+    let (f2, f3) = (f * f, f * f * f);
+    [
+        (-f + 2.0 * f2 - f3) / 2.0,
+        (2.0 - 5.0 * f2 + 3.0 * f3) / 2.0,
+        (f + 4.0 * f2 - 3.0 * f3) / 2.0,
+        (-f2 + f3) / 2.0,
+    ]
 }
 
 /// The depth change per pixel at (x, y): the larger central (or one-sided, at an edge of the

@@ -88,11 +88,6 @@ pub struct FilterSettings {
     /// The penumbra filter's standard deviation along the edge, as a share of the estimated
     /// penumbra width.
     pub penumbra_scale: f64,
-    /// Its standard deviation across the edge, as a share of the estimated width: a Gaussian of
-    /// s across a penumbra whose profile has standard deviation W / 4 (a disk's, [`penumbra`])
-    /// widens it by sqrt(1 + (4 s)^2) - 1, 0.7 % at the default 0.03 (on the pixel grid a little
-    /// more: pixels off the edge's line get some weight).
-    pub penumbra_across: f64,
     /// Largest standard deviation the penumbra filter uses, pixels.
     pub penumbra_max_sigma: f64,
 }
@@ -106,7 +101,6 @@ impl Default for FilterSettings {
             atrous_sigma_depth: 1.0,
             atrous_sigma_normal: 128.0,
             penumbra_scale: 0.5,
-            penumbra_across: 0.03,
             penumbra_max_sigma: 8.0,
         }
     }
@@ -127,7 +121,6 @@ impl FilterSettings {
         positive("atrous_sigma_depth", self.atrous_sigma_depth, 1e6)?;
         positive("atrous_sigma_normal", self.atrous_sigma_normal, 1e4)?;
         positive("penumbra_scale", self.penumbra_scale, 1e3)?;
-        positive("penumbra_across", self.penumbra_across, 1.0)?;
         positive("penumbra_max_sigma", self.penumbra_max_sigma, MAX_SIGMA)?;
         if !(1..=8).contains(&self.atrous_iterations) {
             return Err((
@@ -153,6 +146,11 @@ pub fn gaussian_radius(sigma: f64) -> i32 {
 /// it is: a Gaussian that narrow puts over 99 % of its weight on the pixel itself.
 pub const MIN_SIGMA: f64 = 0.25;
 
+/// Standard deviation (pixels) of the window the penumbra filter reads the edge's direction
+/// from: wide enough that a few rays a pixel give a direction even across a 2-pixel penumbra,
+/// narrow enough that a curved edge's direction is its local one (13 x 13 taps).
+pub const DIRECTION_SIGMA: f64 = 2.0;
+
 /// Below this length of the penumbra filter's regression vector, sum w (I_q - mean) (q - p), over
 /// the window's weight, a neighbourhood has no edge direction: a slope of about 1e-6 / sigma^2
 /// per pixel. It catches flat and exactly symmetric neighbourhoods only; under noise the
@@ -172,10 +170,10 @@ pub struct Input<'a> {
     pub variance: &'a [f32],
     /// Depth, normal and pixel footprint of the surface each pixel sees.
     pub gbuffer: &'a GBuffer,
-    /// Per-pixel standard deviations (pixels) of the penumbra filter's Gaussian, along and across
-    /// the edge, from the blocker estimate ([`penumbra::kernel_sigma`]); 0 where no blocker was
-    /// seen nearby.
-    pub sigma: &'a [[f32; 2]],
+    /// Per-pixel standard deviation (pixels) of the penumbra filter's Gaussian along the edge,
+    /// from the blocker estimate ([`penumbra::kernel_sigma`]); 0 where no blocker was seen
+    /// nearby.
+    pub sigma: &'a [f32],
     /// The filters' parameters.
     pub settings: FilterSettings,
 }
@@ -200,10 +198,13 @@ impl Input<'_> {
             Filter::None => 0,
             Filter::Gaussian => receivers * window(gaussian_radius(self.settings.gaussian_sigma)),
             Filter::Atrous => receivers * 25 * self.settings.atrous_iterations as u64,
-            // The window three times: its mean, the edge's direction, the filter.
+            // The direction's window, then four pixels per step of the line.
             Filter::Penumbra => (0..self.pixels())
-                .filter(|&i| self.receives(i) && self.sigma[i][0] as f64 >= MIN_SIGMA)
-                .map(|i| 3 * window(gaussian_radius(self.sigma[i][0] as f64)))
+                .filter(|&i| self.receives(i) && self.sigma[i] as f64 >= MIN_SIGMA)
+                .map(|i| {
+                    let along = self.sigma[i] as f64;
+                    window(gaussian_radius(DIRECTION_SIGMA)) + 4 * (2 * gaussian_radius(along) as u64 + 1)
+                })
                 .sum(),
         }
     }

@@ -38,14 +38,9 @@ pub fn blocker_distance(scene: &Scene, r: &Receiver, target: DVec3) -> Option<f6
     Some(analytic.min(mesh)).filter(|&t| t > 0.0 && t < len)
 }
 
-/// Narrowest standard deviation (pixels) across the edge: far below a pixel, where the kernel
-/// keeps only pixels on the edge's line, and above zero, where its exponent would divide by it.
-pub const MIN_ACROSS: f64 = 0.1;
-
-/// Per pixel, the penumbra filter's standard deviations (pixels) along and across the edge
-/// ([`FilterSettings::penumbra_scale`], [`FilterSettings::penumbra_across`] times the width,
-/// along capped at `penumbra_max_sigma`), from the penumbra width W (pixels, over the pixel's
-/// footprint) its blocker estimate gives; [0, 0] where no blocker was seen nearby. Pixels on a
+/// Per pixel, the penumbra filter's standard deviation (pixels) along the edge
+/// ([`FilterSettings::penumbra_scale`] times the width, capped at `penumbra_max_sigma`), from the penumbra width W (pixels, over the pixel's
+/// footprint) its blocker estimate gives; 0 where no blocker was seen nearby. Pixels on a
 /// penumbra's lit side see no blocker themselves: each blocked pixel lends its W (at most the
 /// width whose along sigma reaches the cap) to the pixels around it, falling linearly to 0 at
 /// W + 1 pixels away, and a pixel takes the largest it is lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a
@@ -57,11 +52,10 @@ pub fn kernel_sigma(
     width: u32,
     height: u32,
     settings: &FilterSettings,
-) -> Vec<[f32; 2]> {
+) -> Vec<f32> {
     let (w, h) = (width as i64, height as i64);
-    // Past the width whose along sigma is capped a wider estimate changes only the across
-    // sigma, which then stays at most its share of this width: lending it keeps the tents'
-    // reach (and the work, each tent's area) bounded.
+    // Past the width whose sigma is capped a wider estimate changes nothing: lending it no
+    // further keeps the tents' reach (and the work, each tent's area) bounded.
     let widest = settings.penumbra_max_sigma / settings.penumbra_scale;
     let mut lent = vec![0f64; blocker.len()];
     for (i, &b) in blocker.iter().enumerate() {
@@ -85,14 +79,7 @@ pub fn kernel_sigma(
         }
     }
     lent.iter()
-        .map(|&width| {
-            if width <= 0.0 {
-                return [0.0; 2];
-            }
-            let along = (settings.penumbra_scale * width).min(settings.penumbra_max_sigma);
-            let across = (settings.penumbra_across * width).max(MIN_ACROSS);
-            [along as f32, across as f32]
-        })
+        .map(|&width| (settings.penumbra_scale * width).min(settings.penumbra_max_sigma) as f32)
         .collect()
 }
 
@@ -125,28 +112,25 @@ mod tests {
             let d = (i as f64 - 20.0).abs();
             let along = (settings.penumbra_scale * expect(d)).min(settings.penumbra_max_sigma);
             if d < width + 1.0 {
-                assert!((s[0] as f64 - along).abs() < 1e-4, "pixel {i}: {s:?}, expected {along}");
-                let across = (settings.penumbra_across * expect(d)).max(MIN_ACROSS);
-                assert!((s[1] as f64 - across).abs() < 1e-5, "pixel {i}: {s:?}");
+                assert!((*s as f64 - along).abs() < 1e-4, "pixel {i}: {s}, expected {along}");
             } else {
-                assert_eq!(*s, [0.0; 2], "pixel {i}");
+                assert_eq!(*s, 0.0, "pixel {i}");
             }
         }
         // No seam: neighbours differ by at most the tent's slope.
         let slope = settings.penumbra_scale * width / (width + 1.0);
         for pair in sigma.windows(2) {
-            assert!((pair[0][0] - pair[1][0]).abs() as f64 <= slope + 1e-4, "{pair:?}");
+            assert!((pair[0] - pair[1]).abs() as f64 <= slope + 1e-4, "{pair:?}");
         }
-        // Capped: along at its cap, the width lent at the one whose along sigma reaches it.
+        // Capped: at its cap, the width lent at the one whose sigma reaches it.
         let wide = FilterSettings {
             penumbra_scale: 10.0,
             ..settings
         };
         let capped = kernel_sigma(&blocker, &g, &light, n as u32, 1, &wide);
-        assert_eq!(capped[20][0], 8.0);
-        let widest = 8.0 / 10.0;
-        assert!((capped[20][1] as f64 - (settings.penumbra_across * widest).max(MIN_ACROSS)).abs() < 1e-6);
-        assert_eq!(capped[22], [0.0; 2], "the tent reaches only the capped width + 1");
+        assert_eq!(capped[20], 8.0);
+        assert!(capped[21] > 0.0 && capped[21] < 8.0);
+        assert_eq!(capped[22], 0.0, "the tent reaches only the capped width (0.8 px) + 1");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! (uploads and the read-back outside the time either way), its image read back.
 
 use super::GpuBackend;
-use crate::render::denoise::{Filter, Input, Output, DIRECTIONLESS, LUMINANCE_EPSILON, MIN_SIGMA};
+use crate::render::denoise::{Filter, Input, Output, DIRECTIONLESS, DIRECTION_SIGMA, LUMINANCE_EPSILON, MIN_SIGMA};
 use bytemuck::{Pod, Zeroable};
 use std::time::Instant;
 use wgpu::util::DeviceExt;
@@ -24,7 +24,7 @@ struct Params {
     min_sigma: f32,
     luminance_epsilon: f32,
     directionless: f32,
-    _pad2: f32,
+    direction_sigma: f32,
 }
 const _: () = assert!(std::mem::size_of::<Params>() == 48);
 
@@ -111,12 +111,12 @@ impl GpuBackend {
             min_sigma: MIN_SIGMA as f32,
             luminance_epsilon: LUMINANCE_EPSILON as f32,
             directionless: DIRECTIONLESS as f32,
-            _pad2: 0.0,
+            direction_sigma: DIRECTION_SIGMA as f32,
         };
         let normals: Vec<[f32; 4]> = input.gbuffer.normal.iter().map(|n| [n[0], n[1], n[2], 0.0]).collect();
         let depth = self.storage("depth", &input.gbuffer.depth, 0.0);
         let normal = self.storage("normal", &normals, [0.0; 4]);
-        let sigma = self.storage("sigma", input.sigma, [0.0; 2]);
+        let sigma = self.storage("sigma", input.sigma, 0.0);
         // Ping-pong pairs (image, variance): the input, then two outputs the iterations swap.
         let image_in = self.storage("image", input.image, 0.0);
         let variance_in = self.storage("variance", input.variance, 0.0);

@@ -14,7 +14,7 @@ struct Params {
     min_sigma: f32,
     luminance_epsilon: f32,
     directionless: f32,
-    _pad2: f32,
+    direction_sigma: f32,
 }
 
 const NO_RECEIVER: f32 = -1.0;
@@ -24,7 +24,7 @@ const NO_RECEIVER: f32 = -1.0;
 @group(0) @binding(2) var<storage, read> variance_in: array<f32>;
 @group(0) @binding(3) var<storage, read> depth: array<f32>;
 @group(0) @binding(4) var<storage, read> normal: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> sigma: array<vec2<f32>>;
+@group(0) @binding(5) var<storage, read> sigma: array<f32>;
 @group(0) @binding(6) var<storage, read_write> image_out: array<f32>;
 @group(0) @binding(7) var<storage, read_write> variance_out: array<f32>;
 
@@ -109,62 +109,96 @@ fn gaussian(@builtin(global_invocation_id) gid: vec3<u32>) {
     image_out[p] = gaussian_at(x, y, params.gaussian_sigma, false);
 }
 
-// The oriented Gaussian of cpu.rs `oriented_at`: the edge's normal from the weighted
-// regression slope over the window, then `along` pixels along it and `across` across.
-fn oriented_at(x: i32, y: i32, along: f32, across: f32) -> f32 {
-    let r = i32(ceil(3.0 * along));
+fn catmull_rom(f: f32) -> array<f32, 4> {
+    let f2 = f * f;
+    let f3 = f2 * f;
+    return array<f32, 4>(
+        (-f + 2.0 * f2 - f3) / 2.0,
+        (2.0 - 5.0 * f2 + 3.0 * f3) / 2.0,
+        (f + 4.0 * f2 - 3.0 * f3) / 2.0,
+        (-f2 + f3) / 2.0,
+    );
+}
+
+// The line filter of cpu.rs `oriented_at`: the edge's normal from the weighted least-squares
+// plane over the direction window, then a Gaussian of `along` pixels on the edge's line,
+// Catmull-Rom interpolated across the four pixels around each step.
+fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
     let slope = depth_slope(x, y);
     let p = index(x, y);
+    let sd = params.direction_sigma;
+    let rd = i32(ceil(3.0 * sd));
+    var w0 = 0.0;
+    var wv = 0.0;
+    var wd = vec2<f32>(0.0, 0.0);
+    var wvd = vec2<f32>(0.0, 0.0);
+    var wdd = vec3<f32>(0.0, 0.0, 0.0);
+    for (var dy = -rd; dy <= rd; dy = dy + 1) {
+        for (var dx = -rd; dx <= rd; dx = dx + 1) {
+            if (!usable(x + dx, y + dy)) {
+                continue;
+            }
+            let d = vec2<f32>(f32(dx), f32(dy));
+            let q = index(x + dx, y + dy);
+            let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * sd * sd));
+            let v = image_in[q];
+            w0 = w0 + w;
+            wv = wv + w * v;
+            wd = wd + w * d;
+            wvd = wvd + w * v * d;
+            wdd = wdd + w * vec3<f32>(d.x * d.x, d.x * d.y, d.y * d.y);
+        }
+    }
+    let b = wvd - wv * wd / w0;
+    if (length(b) <= params.directionless * w0) {
+        return image_in[p];
+    }
+    let c = wdd - vec3<f32>(wd.x * wd.x, wd.x * wd.y, wd.y * wd.y) / w0;
+    let n = vec2<f32>(c.z * b.x - c.y * b.y, c.x * b.y - c.y * b.x);
+    let norm = length(n);
+    if (!(norm > 0.0)) {
+        return image_in[p];
+    }
+    let tangent = vec2<f32>(-n.y, n.x) / norm;
+    let x_major = abs(tangent.x) >= abs(tangent.y);
+    var minor_per_step = tangent.x / tangent.y;
+    if (x_major) {
+        minor_per_step = tangent.y / tangent.x;
+    }
+    let distance_per_step = sqrt(1.0 + minor_per_step * minor_per_step);
+    let r = i32(ceil(3.0 * along));
     var sum = 0.0;
     var weight = 0.0;
-    for (var dy = -r; dy <= r; dy = dy + 1) {
-        for (var dx = -r; dx <= r; dx = dx + 1) {
-            if (!usable(x + dx, y + dy)) {
+    var lo = image_in[p];
+    var hi = image_in[p];
+    for (var k = -r; k <= r; k = k + 1) {
+        let t = f32(k) * distance_per_step;
+        let g = exp(-t * t / (2.0 * along * along));
+        let offset = f32(k) * minor_per_step;
+        let below = floor(offset);
+        var share = catmull_rom(offset - below);
+        for (var j = 0; j < 4; j = j + 1) {
+            let m = i32(below) + j - 1;
+            var qx = x + m;
+            var qy = y + k;
+            if (x_major) {
+                qx = x + k;
+                qy = y + m;
+            }
+            if (!usable(qx, qy)) {
                 continue;
             }
-            let d = vec2<f32>(f32(dx), f32(dy));
-            let q = index(x + dx, y + dy);
-            let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * along * along));
-            sum = sum + w * image_in[q];
+            let q = index(qx, qy);
+            let d = vec2<f32>(f32(qx - x), f32(qy - y));
+            let v = image_in[q];
+            let w = g * share[j] * geometry_weight(p, q, slope, length(d));
+            sum = sum + w * v;
             weight = weight + w;
+            lo = min(lo, v);
+            hi = max(hi, v);
         }
     }
-    let mean = sum / weight;
-    var n = vec2<f32>(0.0, 0.0);
-    for (var dy = -r; dy <= r; dy = dy + 1) {
-        for (var dx = -r; dx <= r; dx = dx + 1) {
-            if (!usable(x + dx, y + dy)) {
-                continue;
-            }
-            let d = vec2<f32>(f32(dx), f32(dy));
-            let q = index(x + dx, y + dy);
-            let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * along * along));
-            n = n + w * (image_in[q] - mean) * d;
-        }
-    }
-    let norm = length(n);
-    let oriented = norm > params.directionless * weight;
-    sum = 0.0;
-    weight = 0.0;
-    for (var dy = -r; dy <= r; dy = dy + 1) {
-        for (var dx = -r; dx <= r; dx = dx + 1) {
-            if (!usable(x + dx, y + dy)) {
-                continue;
-            }
-            let d = vec2<f32>(f32(dx), f32(dy));
-            let q = index(x + dx, y + dy);
-            var e = dot(d, d) / (2.0 * across * across);
-            if (oriented) {
-                let a = dot(d, n) / norm;
-                let t = (d.y * n.x - d.x * n.y) / norm;
-                e = a * a / (2.0 * across * across) + t * t / (2.0 * along * along);
-            }
-            let w = geometry_weight(p, q, slope, length(d)) * exp(-e);
-            sum = sum + w * image_in[q];
-            weight = weight + w;
-        }
-    }
-    return sum / weight;
+    return clamp(sum / weight, lo, hi);
 }
 
 @compute @workgroup_size(8, 8)
@@ -180,11 +214,11 @@ fn penumbra(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = sigma[p];
-    if (s.x < params.min_sigma) {
+    if (s < params.min_sigma) {
         image_out[p] = image_in[p];
         return;
     }
-    image_out[p] = oriented_at(x, y, s.x, s.y);
+    image_out[p] = oriented_at(x, y, s);
 }
 
 fn blurred_variance(x: i32, y: i32) -> f32 {
