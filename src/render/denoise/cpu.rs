@@ -92,9 +92,11 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
     let value = |qx: i32, qy: i32| input.image[index(input, qx, qy)] as f64;
     let sd = DIRECTION_SIGMA as f32 as f64;
     let rd = gaussian_radius(sd);
-    // One pass of weighted sums (q relative to p): the least-squares plane's gradient is
-    // C^-1 b with b = sum w (I - mean) (q - centroid) and C the window's covariance, which a
-    // window cut by the image's border or by the geometry makes anisotropic.
+    // One pass of weighted sums (q and I relative to p's): the least-squares plane's gradient
+    // is C^-1 b with b = sum w (I - mean) (q - centroid) and C the window's covariance, which a
+    // window cut by the image's border or by the geometry makes anisotropic. Values relative to
+    // I_p keep b's cancellation small in f32 on a nearly flat fringe.
+    let centre = value(x, y);
     let (mut w0, mut wv, mut wx, mut wy, mut wvx, mut wvy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut wxx, mut wxy, mut wyy) = (0.0, 0.0, 0.0);
     for dy in -rd..=rd {
@@ -105,7 +107,7 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
             }
             let (fx, fy) = (dx as f64, dy as f64);
             let w = guided(qx, qy) * (-(fx * fx + fy * fy) / (2.0 * sd * sd)).exp();
-            let v = value(qx, qy);
+            let v = value(qx, qy) - centre;
             (w0, wv, wx, wy) = (w0 + w, wv + w * v, wx + w * fx, wy + w * fy);
             (wvx, wvy) = (wvx + w * v * fx, wvy + w * v * fy);
             (wxx, wxy, wyy) = (wxx + w * fx * fx, wxy + w * fx * fy, wyy + w * fy * fy);
@@ -113,7 +115,7 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
     }
     let (bx, by) = (wvx - wv * wx / w0, wvy - wv * wy / w0);
     if (bx * bx + by * by).sqrt() <= DIRECTIONLESS * w0 {
-        return value(x, y);
+        return centre;
     }
     let (cxx, cxy, cyy) = (wxx - wx * wx / w0, wxy - wx * wy / w0, wyy - wy * wy / w0);
     // C^-1 b up to its determinant, positive unless every usable pixel of the window lies on
@@ -121,7 +123,7 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
     let (nx, ny) = (cyy * bx - cxy * by, cxx * by - cxy * bx);
     let norm = (nx * nx + ny * ny).sqrt();
     if norm.is_nan() || norm <= 0.0 {
-        return value(x, y);
+        return centre;
     }
     // The edge's tangent, walked along its major axis.
     let (tx, ty) = (-ny / norm, nx / norm);
@@ -137,9 +139,23 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
         let offset = k as f64 * minor_per_step;
         let below = offset.floor();
         let f = offset - below;
-        for (j, share) in catmull_rom(f).into_iter().enumerate() {
-            let m = below as i32 + j as i32 - 1;
-            let (qx, qy) = if x_major { (x + k, y + m) } else { (x + m, y + k) };
+        let pixel = |j: i32| {
+            let m = below as i32 + j - 1;
+            if x_major {
+                (x + k, y + m)
+            } else {
+                (x + m, y + k)
+            }
+        };
+        // Where a hole cuts the four, the step falls back to the two around the line, linearly:
+        // the negative lobes must not outweigh what is left.
+        let whole = (0..4).all(|j| {
+            let (qx, qy) = pixel(j);
+            usable(input, qx, qy)
+        });
+        let shares = if whole { catmull_rom(f) } else { [0.0, 1.0 - f, f, 0.0] };
+        for (j, share) in shares.into_iter().enumerate() {
+            let (qx, qy) = pixel(j as i32);
             if !usable(input, qx, qy) {
                 continue;
             }
@@ -147,6 +163,11 @@ fn oriented_at(input: &Input, x: i32, y: i32, along: f64) -> f64 {
             (sum, weight) = (sum + w * v, weight + w);
             (lo, hi) = (lo.min(v), hi.max(v));
         }
+    }
+    // The centre's tap alone weighs 1; under half that, the lobes of taps whose neighbours the
+    // geometry cut away dominate and the sum means nothing.
+    if weight < 0.5 {
+        return centre;
     }
     // Catmull-Rom's negative lobes can ring past the values read.
     (sum / weight).clamp(lo, hi)

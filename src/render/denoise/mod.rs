@@ -151,8 +151,9 @@ pub const MIN_SIGMA: f64 = 0.25;
 /// narrow enough that a curved edge's direction is its local one (13 x 13 taps).
 pub const DIRECTION_SIGMA: f64 = 2.0;
 
-/// Below this length of the penumbra filter's regression vector, sum w (I_q - mean) (q - p), over
-/// the window's weight, a neighbourhood has no edge direction: a slope of about 1e-6 / sigma^2
+/// Below this length of the penumbra filter's regression vector, sum w (I_q - mean) (q - p) over
+/// its [`DIRECTION_SIGMA`] window, over the window's weight, a neighbourhood has no edge
+/// direction: a slope of about 1e-6 / sigma^2
 /// per pixel. It catches flat and exactly symmetric neighbourhoods only; under noise the
 /// direction is whatever the noise leaves.
 pub const DIRECTIONLESS: f64 = 1e-6;
@@ -198,7 +199,8 @@ impl Input<'_> {
             Filter::None => 0,
             Filter::Gaussian => receivers * window(gaussian_radius(self.settings.gaussian_sigma)),
             Filter::Atrous => receivers * 25 * self.settings.atrous_iterations as u64,
-            // The direction's window, then four pixels per step of the line.
+            // The direction's window, then four pixels per step of the line (an upper bound: a
+            // pixel whose window shows no direction stops after the window).
             Filter::Penumbra => (0..self.pixels())
                 .filter(|&i| self.receives(i) && self.sigma[i] as f64 >= MIN_SIGMA)
                 .map(|i| {

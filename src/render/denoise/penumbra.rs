@@ -39,12 +39,12 @@ pub fn blocker_distance(scene: &Scene, r: &Receiver, target: DVec3) -> Option<f6
 }
 
 /// Per pixel, the penumbra filter's standard deviation (pixels) along the edge
-/// ([`FilterSettings::penumbra_scale`] times the width, capped at `penumbra_max_sigma`), from the penumbra width W (pixels, over the pixel's
-/// footprint) its blocker estimate gives; 0 where no blocker was seen nearby. Pixels on a
-/// penumbra's lit side see no blocker themselves: each blocked pixel lends its W (at most the
-/// width whose along sigma reaches the cap) to the pixels around it, falling linearly to 0 at
-/// W + 1 pixels away, and a pixel takes the largest it is lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a
-/// seam.
+/// ([`FilterSettings::penumbra_scale`] times the width, capped at `penumbra_max_sigma`), from
+/// the penumbra width W (pixels, over the pixel's footprint) its blocker estimate gives; 0 where
+/// no blocker was seen nearby. Pixels on a penumbra's lit side see no blocker themselves: each
+/// blocked pixel lends its W (at most the width whose sigma reaches the cap) to the pixels
+/// around it, falling linearly to 0 at W + 1 pixels away, and a pixel takes the largest it is
+/// lent. The tent is continuous, so the kernel shrinks to nothing instead of stopping at a seam.
 pub fn kernel_sigma(
     blocker: &[f64],
     gbuffer: &GBuffer,

@@ -109,6 +109,13 @@ fn gaussian(@builtin(global_invocation_id) gid: vec3<u32>) {
     image_out[p] = gaussian_at(x, y, params.gaussian_sigma, false);
 }
 
+fn line_pixel(x: i32, y: i32, k: i32, m: i32, x_major: bool) -> vec2<i32> {
+    if (x_major) {
+        return vec2<i32>(x + k, y + m);
+    }
+    return vec2<i32>(x + m, y + k);
+}
+
 fn catmull_rom(f: f32) -> array<f32, 4> {
     let f2 = f * f;
     let f3 = f2 * f;
@@ -127,6 +134,7 @@ fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
     let slope = depth_slope(x, y);
     let p = index(x, y);
     let sd = params.direction_sigma;
+    let centre = image_in[p];
     let rd = i32(ceil(3.0 * sd));
     var w0 = 0.0;
     var wv = 0.0;
@@ -141,7 +149,7 @@ fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
             let d = vec2<f32>(f32(dx), f32(dy));
             let q = index(x + dx, y + dy);
             let w = geometry_weight(p, q, slope, length(d)) * exp(-dot(d, d) / (2.0 * sd * sd));
-            let v = image_in[q];
+            let v = image_in[q] - centre;
             w0 = w0 + w;
             wv = wv + w * v;
             wd = wd + w * d;
@@ -151,13 +159,13 @@ fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
     }
     let b = wvd - wv * wd / w0;
     if (length(b) <= params.directionless * w0) {
-        return image_in[p];
+        return centre;
     }
     let c = wdd - vec3<f32>(wd.x * wd.x, wd.x * wd.y, wd.y * wd.y) / w0;
     let n = vec2<f32>(c.z * b.x - c.y * b.y, c.x * b.y - c.y * b.x);
     let norm = length(n);
     if (!(norm > 0.0)) {
-        return image_in[p];
+        return centre;
     }
     let tangent = vec2<f32>(-n.y, n.x) / norm;
     let x_major = abs(tangent.x) >= abs(tangent.y);
@@ -176,20 +184,23 @@ fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
         let g = exp(-t * t / (2.0 * along * along));
         let offset = f32(k) * minor_per_step;
         let below = floor(offset);
-        var share = catmull_rom(offset - below);
+        let f = offset - below;
+        var whole = true;
         for (var j = 0; j < 4; j = j + 1) {
-            let m = i32(below) + j - 1;
-            var qx = x + m;
-            var qy = y + k;
-            if (x_major) {
-                qx = x + k;
-                qy = y + m;
-            }
-            if (!usable(qx, qy)) {
+            let q = line_pixel(x, y, k, i32(below) + j - 1, x_major);
+            whole = whole && usable(q.x, q.y);
+        }
+        var share = array<f32, 4>(0.0, 1.0 - f, f, 0.0);
+        if (whole) {
+            share = catmull_rom(f);
+        }
+        for (var j = 0; j < 4; j = j + 1) {
+            let cell = line_pixel(x, y, k, i32(below) + j - 1, x_major);
+            if (!usable(cell.x, cell.y)) {
                 continue;
             }
-            let q = index(qx, qy);
-            let d = vec2<f32>(f32(qx - x), f32(qy - y));
+            let q = index(cell.x, cell.y);
+            let d = vec2<f32>(f32(cell.x - x), f32(cell.y - y));
             let v = image_in[q];
             let w = g * share[j] * geometry_weight(p, q, slope, length(d));
             sum = sum + w * v;
@@ -197,6 +208,9 @@ fn oriented_at(x: i32, y: i32, along: f32) -> f32 {
             lo = min(lo, v);
             hi = max(hi, v);
         }
+    }
+    if (weight < 0.5) {
+        return centre;
     }
     return clamp(sum / weight, lo, hi);
 }
