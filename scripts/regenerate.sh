@@ -4,10 +4,12 @@
 #
 #   scripts/regenerate.sh [--allow-dirty] [NAME...]
 #
-# NAMEs (e.g. `sphere body`) run a subset in the same order; without them every experiment
-# runs. The committed results must all name one clean commit with inputs that match the
-# repository's files (tests/it/results_fresh.rs fails otherwise), so run this from a clean
-# checkout of the commit the results will name and commit the results alone on top of it.
+# NAMEs (e.g. `sphere body`: the folders a change affects) run a subset in the same order;
+# without them every experiment runs. Each committed folder must name a clean commit of the
+# history (HEAD or an ancestor) with inputs that match the repository's files
+# (tests/it/results_fresh.rs fails otherwise), and reproduce with the current code
+# (tests/it/reproduction.rs), so run this from a clean checkout of the commit the results will
+# name and commit the results alone on top of it.
 # A tree with changes outside results/ is refused; --allow-dirty runs anyway, for trying the
 # script, but the test command will reject what it writes.
 #

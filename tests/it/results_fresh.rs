@@ -1,6 +1,7 @@
 //! The committed results belong to the code in front of the reader: every folder under
-//! `results/` has a manifest naming the same clean commit as the others, made from
-//! `experiments/FOLDER.toml`, and every input file it lists (experiment, scenes, meshes, points
+//! `results/` has a manifest naming a clean commit of this history (HEAD or an ancestor; that
+//! its numbers are still what the current code computes is tests/it/reproduction.rs's part),
+//! made from `experiments/FOLDER.toml`, and every input file it lists (experiment, scenes, meshes, points
 //! files) still hashes as it did when the results were made. Any edit to an experiment, scene or
 //! mesh therefore fails the test command until the results are regenerated
 //! (`scripts/regenerate.sh`, from a clean checkout, results committed alone on top).
@@ -15,7 +16,7 @@ fn every_committed_results_folder_is_fresh() {
     let list: Vec<String> = problems.iter().map(|p| format!("  {p}")).collect();
     assert!(
         problems.is_empty(),
-        "{} problem(s) with the committed results (each folder must name one clean commit and inputs that match the repository's files):\n{}",
+        "{} problem(s) with the committed results (each folder must name a clean commit of this history and inputs that match the repository's files):\n{}",
         problems.len(),
         list.join("\n")
     );

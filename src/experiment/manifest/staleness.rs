@@ -1,5 +1,8 @@
-//! Whether the committed results folders belong to one clean build and to the files in front
-//! of the reader ([`staleness`]; the test command runs it).
+//! Whether the committed results folders belong to clean builds of the repository's history and
+//! to the files in front of the reader ([`staleness`]; the test command runs it). Folders may
+//! name different commits: a change regenerates the folders it affects
+//! (`scripts/regenerate.sh NAMES`), and that the others still hold what the code in front of the
+//! reader computes is what the reproduction tests (tests/it/reproduction.rs) re-measure.
 
 use super::input::{input_problem, tidy};
 use super::{Manifest, SCHEMA};
@@ -25,10 +28,11 @@ impl std::fmt::Display for Problem {
     }
 }
 
-/// Every way the folders under `results` (each a results folder) fail to belong to one clean
-/// build and to the files of the repository at `repo`: a folder without a readable manifest of
-/// this [`SCHEMA`], a name or experiment file other than `experiments/FOLDER.toml`, a build from
-/// a dirty tree, a commit other than the other folders', an input file missing or changed since
+/// Every way the folders under `results` (each a results folder) fail to belong to a clean
+/// build of the history of the repository at `repo` and to its files: a folder without a
+/// readable manifest of this [`SCHEMA`], a name or experiment file other than
+/// `experiments/FOLDER.toml`, a build from a dirty tree, a commit that is not HEAD or one of its
+/// ancestors (checked where `repo` is a git work tree), an input file missing or changed since
 /// the run. Empty when every folder is fresh. Hidden entries (a run's staging folder) and plain
 /// files are not results folders and are passed over.
 pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
@@ -88,7 +92,7 @@ pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
             }
         }
     }
-    problems.extend(mixed_commits(&commits).into_iter().map(|(f, w)| problem(&f, w)));
+    problems.extend(foreign_commits(&commits, repo).into_iter().map(|(f, w)| problem(&f, w)));
     problems
 }
 
@@ -133,36 +137,41 @@ fn one_line(s: &str) -> String {
         .join(" ")
 }
 
-/// The folders whose commit is not the one most folders name, each with what it is. When no
-/// commit is named by more folders than every other, every folder is named.
-fn mixed_commits(commits: &[(String, String)]) -> Vec<(String, String)> {
-    let mut count: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
-    for (_, c) in commits {
-        *count.entry(c).or_default() += 1;
+/// The folders whose commit is not in the history of the repository at `repo` (HEAD or an
+/// ancestor of it), each with what it is: results of code that was never committed here, or of
+/// a branch that did not land. Nothing where `repo` is no git work tree or a shallow clone (an
+/// exported copy has no history to check against, a shallow one only part of it).
+fn foreign_commits(commits: &[(String, String)], repo: &Path) -> Vec<(String, String)> {
+    let shallow = std::process::Command::new("git")
+        .arg("-C")
+        .arg(repo)
+        .args(["rev-parse", "--is-shallow-repository"])
+        .output();
+    match shallow {
+        Ok(out) if out.status.success() && out.stdout.starts_with(b"false") => {}
+        _ => return vec![],
     }
-    if count.len() < 2 {
+    if !repo.join(".git").exists() {
         return vec![];
     }
-    let most = count.values().copied().max().unwrap_or(0);
-    let leaders: Vec<&str> = count.iter().filter(|(_, &n)| n == most).map(|(c, _)| *c).collect();
-    let majority = (leaders.len() == 1).then(|| leaders[0]);
-    let summary = count
-        .iter()
-        .map(|(c, n)| format!("{} ({n})", short(c)))
-        .collect::<Vec<_>>()
-        .join(", ");
     commits
         .iter()
-        .filter(|(_, c)| Some(c.as_str()) != majority)
-        .map(|(f, c)| {
-            (
-                f.clone(),
-                format!(
-                    "built from commit {}, but the results folders name {} commits: {summary}",
-                    short(c),
-                    count.len()
+        .filter_map(|(folder, commit)| {
+            let status = std::process::Command::new("git")
+                .arg("-C")
+                .arg(repo)
+                .args(["merge-base", "--is-ancestor", commit, "HEAD"])
+                .stderr(std::process::Stdio::null())
+                .status();
+            let what = match status {
+                Ok(s) if s.success() => return None,
+                Ok(_) => format!(
+                    "built from commit {}, which is not HEAD or one of its ancestors",
+                    short(commit)
                 ),
-            )
+                Err(e) => format!("cannot ask git whether commit {} is in the history: {e}", short(commit)),
+            };
+            Some((folder.clone(), what))
         })
         .collect()
 }
@@ -306,19 +315,58 @@ mod tests {
     }
 
     #[test]
-    fn mixed_commits_are_caught() {
+    fn folders_may_name_different_commits_of_the_history_but_no_other() {
         let repo = Repo::new(&["a", "b", "c"]);
-        repo.run("b", "22ab66d2415fe440541a222c3f8442bd1285999f", true);
+        let git = |args: &[&str]| {
+            let out = std::process::Command::new("git")
+                .arg("-C")
+                .arg(repo.root())
+                .args([
+                    "-c",
+                    "user.name=t",
+                    "-c",
+                    "user.email=t@t",
+                    "-c",
+                    "commit.gpgsign=false",
+                ])
+                .args(args)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "git {args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            String::from_utf8(out.stdout).unwrap().trim().to_string()
+        };
+        git(&["init", "-q"]);
+        git(&["add", "experiments", "assets"]);
+        git(&["commit", "-q", "-m", "first"]);
+        let first = git(&["rev-parse", "HEAD"]);
+        repo.write("notes.txt", "x");
+        git(&["add", "notes.txt"]);
+        git(&["commit", "-q", "-m", "second"]);
+        let second = git(&["rev-parse", "HEAD"]);
+        repo.run("a", &first, true);
+        repo.run("b", &second, true);
+        repo.run("c", &second, true);
+        assert_eq!(repo.problems(), vec![]);
+        // A commit this history does not hold (COMMIT, from another repository).
+        repo.run("c", COMMIT, true);
         only(
             &repo.problems(),
-            "b",
-            "built from commit 22ab66d2415f, but the results folders name 2 commits",
+            "c",
+            "built from commit 3ce542543f04, which is not HEAD or one of its ancestors",
         );
-        // No commit named by most folders: every folder is named.
-        let repo = Repo::new(&["a", "b"]);
-        repo.run("b", "22ab66d2415fe440541a222c3f8442bd1285999f", true);
-        let folders: Vec<String> = repo.problems().into_iter().map(|p| p.folder).collect();
-        assert_eq!(folders, ["a", "b"]);
+        // A commit after HEAD, on a branch that did not land.
+        git(&["checkout", "-q", "-b", "side"]);
+        repo.write("side.txt", "x");
+        git(&["add", "side.txt"]);
+        git(&["commit", "-q", "-m", "side"]);
+        let side = git(&["rev-parse", "HEAD"]);
+        git(&["checkout", "-q", "-"]);
+        repo.run("c", &side, true);
+        only(&repo.problems(), "c", "which is not HEAD or one of its ancestors");
     }
 
     #[test]
