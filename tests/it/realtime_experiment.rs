@@ -145,6 +145,8 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
         "variants x schemes x rays x frames x acc x filters x seeds"
     );
     assert!(runs.iter().all(|r| r["width_px"].parse::<f64>().unwrap().is_finite()));
+    // The sphere's reference is exact (quadrature): no share of any error is its noise.
+    assert!(runs.iter().all(|r| r["reference_noise_mse"] == "0.0"), "{:?}", runs[0]);
     // Flicker is read at the last frame only, over the pixels of the penumbra that held still
     // through its window (on the still scene all of them; here the sphere moves in the window).
     for r in &runs {
@@ -179,6 +181,7 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     );
     let report = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert!(report.contains("**Answer:**") && report.contains("## The paper's claim restated"));
+    assert!(report.contains("The reference is exact"), "{report}");
     // The claim's table: per frame count a blue-noise pipeline at 4 rays at any cost, and one
     // at no more cost than the paper's frame.
     let claim = &report[report.find("## The paper's claim restated").unwrap()..];

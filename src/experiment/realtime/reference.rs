@@ -28,6 +28,10 @@ pub struct RefFrame {
     pub width_px: f64,
     /// Whether `image` is exact (quadrature) rather than rendered.
     pub exact: bool,
+    /// The rendered reference's own noise: the expected mean-squared error of `image` over
+    /// `mask`, estimated from its two independent halves (0 where exact). A pipeline's MSE
+    /// against the reference counts it once on top of its own.
+    pub noise_mse: f64,
 }
 
 /// The guides of one scene state.
@@ -87,8 +91,9 @@ impl References {
         Ok(g)
     }
 
-    /// The reference at frame `f` of `variant`; a scene without an exact answer renders one
-    /// with `spec.reference_samples` jittered rays per light on `backend`.
+    /// The reference at frame `f` of `variant`; a scene without an exact answer renders two
+    /// of `spec.reference_samples` jittered rays per light on `backend` with independent seeds
+    /// and takes their mean, whose noise their difference measures ([`RefFrame::noise_mse`]).
     pub fn reference(
         &self,
         spec: &RealtimeSpec,
@@ -114,25 +119,28 @@ impl References {
             .collect();
         let receivers = Receivers::new(&scene, view, spec.plane, &hit, view.camera.look_at, 1.0);
         let exact = has_exact_answer(&scene);
-        let image = if exact {
-            exact_image(&scene, view.pixels(), spec.plane, &receivers).0
+        let (image, halves) = if exact {
+            (exact_image(&scene, view.pixels(), spec.plane, &receivers).0, None)
         } else {
             let dense = RealtimeSpec::with_rays(&scene, spec.reference_samples);
-            let sampling = Sampling {
-                scheme: DiskScheme::Jittered,
-                pattern: Pattern::PerPixel,
-                seed: GROUND_TRUTH_SEED,
-                frame: 0,
+            let mut render = |seed: u32| -> anyhow::Result<Vec<f32>> {
+                let sampling = Sampling {
+                    scheme: DiskScheme::Jittered,
+                    pattern: Pattern::PerPixel,
+                    seed,
+                    frame: 0,
+                };
+                Ok(shadow_image(&backend.render(&dense, view, sampling)?.visibility))
             };
-            let frame = backend.render(&dense, view, sampling)?;
-            let all = shadow_image(&frame.visibility);
-            let mut image = vec![NO_RECEIVER; all.len()];
+            let (a, b) = (render(GROUND_TRUTH_SEED)?, render(GROUND_TRUTH_SEED.wrapping_add(1))?);
+            let mut image = vec![NO_RECEIVER; a.len()];
             for &(i, _) in &receivers.pixels {
-                image[i] = all[i];
+                image[i] = 0.5 * (a[i] + b[i]);
             }
-            image
+            (image, Some((a, b)))
         };
         let mask = PenumbraMask::new(&image, &receivers);
+        let noise_mse = halves.map_or(0.0, |(a, b)| mean_of_two_noise(&a, &b, &mask.pixels));
         let edge = EdgeProfile::new(&image, spec.width, spec.height, REACH);
         let width_px = edge.width_10_90(&image);
         let r = Arc::new(RefFrame {
@@ -142,8 +150,71 @@ impl References {
             edge,
             width_px,
             exact,
+            noise_mse,
         });
         self.frames.lock().expect("not poisoned").insert(key, r.clone());
         Ok(r)
+    }
+}
+
+/// The expected squared error of the mean of two independent, equally noisy estimates `a` and
+/// `b` at `pixels`, averaged over them: each pixel's (a - b)^2 has expectation 2 var, the mean's
+/// variance is var / 2, so (a - b)^2 / 4. Unbiased for any noise the two renders share no part of.
+pub fn mean_of_two_noise(a: &[f32], b: &[f32], pixels: &[usize]) -> f64 {
+    if pixels.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = pixels
+        .iter()
+        .map(|&i| {
+            let d = f64::from(a[i]) - f64::from(b[i]);
+            d * d / 4.0
+        })
+        .sum();
+    sum / pixels.len() as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mean_of_two_noise;
+    use crate::sampling::rng::Seeded;
+
+    /// Two estimates of a known image with independent uniform noise of known variance: the
+    /// estimate recovers the mean's variance (var / 2) within its sampling error.
+    #[test]
+    fn the_noise_of_a_mean_of_two_is_read_from_their_difference() {
+        let n = 200_000;
+        let truth: Vec<f32> = (0..n).map(|i| (i % 97) as f32 / 97.0).collect();
+        let mut rng = Seeded(7);
+        let half_range = 0.1_f32;
+        let mut noisy = || -> Vec<f32> {
+            truth
+                .iter()
+                .map(|&t| t + half_range * rng.range(-1.0, 1.0) as f32)
+                .collect()
+        };
+        let (a, b) = (noisy(), noisy());
+        let pixels: Vec<usize> = (0..n).collect();
+        let estimate = mean_of_two_noise(&a, &b, &pixels);
+        let var = f64::from(half_range * half_range) / 3.0;
+        let actual: f64 = pixels
+            .iter()
+            .map(|&i| {
+                let e = 0.5 * (f64::from(a[i]) + f64::from(b[i])) - f64::from(truth[i]);
+                e * e
+            })
+            .sum::<f64>()
+            / n as f64;
+        assert!(
+            (estimate / (var / 2.0) - 1.0).abs() < 0.02,
+            "estimate {estimate}, var/2 {}",
+            var / 2.0
+        );
+        assert!(
+            (estimate / actual - 1.0).abs() < 0.02,
+            "estimate {estimate}, actual {actual}"
+        );
+        assert_eq!(mean_of_two_noise(&a, &a, &pixels), 0.0);
+        assert_eq!(mean_of_two_noise(&a, &b, &[]), 0.0);
     }
 }

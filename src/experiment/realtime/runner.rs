@@ -52,6 +52,9 @@ pub struct Run {
     pub width_px: f64,
     /// The exact image's.
     pub exact_width_px: f64,
+    /// The reference's own noise over this frame's penumbra, as a mean-squared error
+    /// ([`super::reference::RefFrame::noise_mse`]; 0 where the reference is exact).
+    pub reference_noise_mse: f64,
     /// Penumbra area (EPS < V < 1 - EPS) over the exact image's.
     pub area_ratio: f64,
     /// Share of the exact penumbra shown fully lit or dark.
@@ -381,6 +384,7 @@ pub fn measure(
                                 flip,
                                 width_px: reference.edge.width_10_90(&measured),
                                 exact_width_px: reference.width_px,
+                                reference_noise_mse: reference.noise_mse,
                                 area_ratio,
                                 lost_share,
                                 stability,

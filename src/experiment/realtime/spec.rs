@@ -155,7 +155,8 @@ pub struct RealtimeSpec {
     pub settings: FilterSettings,
     /// Seeds.
     pub seeds: Vec<u32>,
-    /// Rays per pixel of the ground truth where the scene has no exact answer.
+    /// Rays per pixel of each of the two renders whose mean is the reference where the scene
+    /// has no exact answer.
     pub reference_samples: u32,
     /// Largest |width / exact width - 1| a pipeline may show and stay eligible (the 2 %).
     pub width_tolerance: f64,
