@@ -3,6 +3,8 @@
 //! outputs hold what the report claims, and bad files are refused at their key.
 
 use crate::common;
+use penumbra::experiment::realtime::reference::References;
+use penumbra::experiment::realtime::spec::{RealtimeSpec, Variant};
 use penumbra::render::cpu::CpuBackend;
 use penumbra::render::denoise::{Accumulation, Accumulator};
 use penumbra::render::{Backend, Sampling, View};
@@ -255,11 +257,85 @@ fn bad_realtime_files_are_refused_at_their_key() {
             "verdict.budget_schemes[2]",
             "paper at 16 rays is listed twice",
         ),
+        (
+            ("seeds = [1, 2, 3, 4]", "seeds = [1, 1779033704]"),
+            "sweep.seeds[1]",
+            "a seed of the reference's renders",
+        ),
     ] {
         let err = common::rejected_at(dir.path(), &text.replace(edit.0, edit.1), key);
         assert!(
             err.contains(&format!("key `{key}`")) && err.contains(says),
             "{edit:?}: {err}"
         );
+    }
+}
+
+/// A rendered reference's noise estimate (a quarter of its two halves' squared difference) is
+/// the error it actually has: the sphere scene with a triangle far outside the view has no exact
+/// answer by construction, so its reference is rendered, while the same scene without the
+/// triangle has the exact one, with the same receivers. 64 jittered rays per render, on the
+/// f64 CPU backend and on the GPU that renders the committed references, keep the noise large
+/// against any rounding; over about 3,000 penumbra pixels the summed squared errors agree within
+/// 15 % (each sum's own sampling error is a few per cent; a rendered reference biased against
+/// the exact image, or an estimator off by its factor of 2, would fail).
+#[test]
+fn a_rendered_references_noise_estimate_matches_its_error_against_the_exact_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = std::fs::read_to_string(common::repo("experiments/scenes/sphere.toml")).unwrap();
+    std::fs::write(dir.path().join("exact.toml"), &sphere).unwrap();
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        "v 50 50 0.1\nv 50.1 50 0.1\nv 50 50.1 0.1\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("rendered.toml"),
+        format!("{sphere}\n[[meshes]]\npath = \"tri.obj\"\n"),
+    )
+    .unwrap();
+    let load = |scene: &str| {
+        let text = format!(
+            "kind = \"realtime\"\nname = \"noise\"\nscene = \"{scene}\"\nbackend = \"cpu\"\n\n\
+             [measure]\ncamera = \"measure\"\nwidth = 128\nheight = 128\nplane = 0\n\n\
+             [sweep]\nvariants = [\"static\"]\nschemes = [\"uniform\"]\nrays = [4]\nframes = [1]\n\
+             accumulations = [\"mean\"]\nema_alpha = 0.1\nfilters = [\"none\"]\nseeds = [1]\n\n[reference]\nsamples = 64\n"
+        );
+        let path = dir.path().join(format!("{scene}.experiment.toml"));
+        std::fs::write(&path, text).unwrap();
+        RealtimeSpec::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (rendered_spec, exact_spec) = (load("rendered.toml"), load("exact.toml"));
+    let exact = References::default()
+        .reference(&exact_spec, Variant::Static, 0, &mut CpuBackend::default())
+        .unwrap();
+    assert!(exact.exact);
+    assert!(exact.mask.pixels.len() > 2000, "{}", exact.mask.pixels.len());
+    let check = |name: &str, backend: &mut dyn Backend| {
+        let rendered = References::default()
+            .reference(&rendered_spec, Variant::Static, 0, backend)
+            .unwrap();
+        assert!(!rendered.exact);
+        assert_eq!(rendered.receivers.pixels, exact.receivers.pixels);
+        // Outside the exact penumbra every ray agrees, so the rendered mask is the exact one
+        // less pixels whose few lit (or dark) rays all missed: compare sums, not means.
+        let actual: f64 = exact
+            .mask
+            .pixels
+            .iter()
+            .map(|&i| (f64::from(rendered.image[i]) - f64::from(exact.image[i])).powi(2))
+            .sum();
+        let estimate = rendered.noise_mse * rendered.mask.pixels.len() as f64;
+        let ratio = estimate / actual;
+        println!(
+            "{name}: noise estimate {estimate:.4e} over {} px, actual {actual:.4e} over {} px: {ratio:.3}",
+            rendered.mask.pixels.len(),
+            exact.mask.pixels.len()
+        );
+        assert!((ratio - 1.0).abs() < 0.15, "{name}: estimate / actual = {ratio}");
+    };
+    check("cpu", &mut CpuBackend::default());
+    if let Some(mut gpu) = common::gpu() {
+        check("gpu", &mut *gpu);
     }
 }

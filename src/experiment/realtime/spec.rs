@@ -404,6 +404,13 @@ impl RealtimeSpec {
             if s.seeds[..i].contains(seed) {
                 return Err(source.error(&key_path!["sweep", "seeds", i], format!("{seed} is listed twice")));
             }
+            // A pipeline on the reference's own rays would read as nearly exact.
+            if super::reference::REFERENCE_SEEDS.contains(seed) {
+                return Err(source.error(
+                    &key_path!["sweep", "seeds", i],
+                    format!("{seed} is a seed of the reference's renders; choose another"),
+                ));
+            }
         }
         let settings = f.filters.unwrap_or_default();
         settings
