@@ -77,6 +77,13 @@ pub enum DiskScheme {
     /// masks' slice f (modulo their depth), so the offset changes over frames along each pixel's
     /// blue-noise sequence in time rather than by R2 steps ([`stbn::offset`]).
     StbnCp,
+    /// [`DiskScheme::SobolBluenoise`] rescrambled every frame: frame f reads the scramble tile
+    /// under a tile shift re-keyed by f ([`rng::at_frame`]) and draws the first n points of its
+    /// pixel's new scramble, so every frame is a blue-noise arrangement of n-point (0,2) nets
+    /// (the temporal variant of Heitz et al. 2019), where sobol-bluenoise's frames continue one
+    /// scramble's sequence and are blue only at frame 0. The price: frames are independent, so
+    /// the temporal mean converges as 1 / sqrt(F), not as the sequence does.
+    SobolBluenoiseT,
 }
 
 /// Where one pixel's samples come from: its random stream, and, for the schemes arranged over
@@ -120,7 +127,7 @@ impl Site {
 
 impl DiskScheme {
     /// Every scheme, in report order.
-    pub const ALL: [DiskScheme; 10] = [
+    pub const ALL: [DiskScheme; 11] = [
         DiskScheme::Uniform,
         DiskScheme::Paper,
         DiskScheme::PaperLiteral,
@@ -131,6 +138,7 @@ impl DiskScheme {
         DiskScheme::BluenoiseCp,
         DiskScheme::SobolBluenoise,
         DiskScheme::StbnCp,
+        DiskScheme::SobolBluenoiseT,
     ];
 
     /// The name used in experiment files and CSV columns.
@@ -146,6 +154,7 @@ impl DiskScheme {
             DiskScheme::BluenoiseCp => "bluenoise-cp",
             DiskScheme::SobolBluenoise => "sobol-bluenoise",
             DiskScheme::StbnCp => "stbn-cp",
+            DiskScheme::SobolBluenoiseT => "sobol-bluenoise-t",
             DiskScheme::Points(id) => id.label(),
         }
     }
@@ -175,6 +184,9 @@ impl DiskScheme {
             DiskScheme::StbnCp => {
                 "spatiotemporal blue-noise masks (Wolfe et al. 2022) rotating a shared (0,2) set per frame (Cranley-Patterson)"
             }
+            DiskScheme::SobolBluenoiseT => {
+                "sobol-bluenoise rescrambled every frame: a blue-noise arrangement of n-point nets in each frame, independent over frames"
+            }
         };
         built_in.into()
     }
@@ -187,6 +199,7 @@ impl DiskScheme {
                 | DiskScheme::BluenoiseCp
                 | DiskScheme::SobolBluenoise
                 | DiskScheme::StbnCp
+                | DiskScheme::SobolBluenoiseT
                 | DiskScheme::Points(_)
         )
     }
@@ -231,7 +244,8 @@ impl DiskScheme {
     /// per-pixel random schemes draw from a fresh stream ([`Stream::at_frame`]); bluenoise-cp
     /// moves its offsets by f R2 steps ([`bluenoise::offset_at`]); stbn-cp reads its masks' slice
     /// f ([`stbn::offset`]); a points set's tile seed is re-keyed like a stream
-    /// ([`rng::at_frame`]). Frame 0 is the single frame, unchanged.
+    /// ([`rng::at_frame`]), as is sobol-bluenoise-t's, which restarts its sequence every frame.
+    /// Frame 0 is the single frame, unchanged.
     pub fn point(self, n: u32, k: u32, site: Site) -> DVec2 {
         debug_assert!(k < n);
         // The re-seeded schemes' stream, and the progressive ones' index (wrapping, as on the GPU).
@@ -287,6 +301,12 @@ impl DiskScheme {
             DiskScheme::SobolBluenoise => {
                 let [x, y] = site.pixel;
                 let (sx, sy) = sobol::scrambled_sobol_2d(index, bluenoise::scramble(x, y, n, site.tile_seed));
+                concentric(rng::to_unit(sx), rng::to_unit(sy))
+            }
+            DiskScheme::SobolBluenoiseT => {
+                let [x, y] = site.pixel;
+                let tile_seed = rng::at_frame(site.tile_seed, site.frame);
+                let (sx, sy) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, tile_seed));
                 concentric(rng::to_unit(sx), rng::to_unit(sy))
             }
             DiskScheme::Points(id) => {
@@ -553,7 +573,8 @@ mod tests {
                 let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
                 concentric(wrap(sx, ox), wrap(sy, oy))
             }
-            DiskScheme::SobolBluenoise => {
+            // Newer than frames: its single frame is sobol-bluenoise's.
+            DiskScheme::SobolBluenoise | DiskScheme::SobolBluenoiseT => {
                 let (a, b) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, site.tile_seed));
                 concentric(rng::to_unit(a), rng::to_unit(b))
             }

@@ -57,7 +57,7 @@ pub fn wgsl_prelude() -> String {
 pub fn pack(uses: &[(DiskScheme, u32)]) -> Vec<u32> {
     let mut counts: Vec<u32> = uses
         .iter()
-        .filter(|(s, _)| *s == DiskScheme::SobolBluenoise)
+        .filter(|(s, _)| matches!(s, DiskScheme::SobolBluenoise | DiskScheme::SobolBluenoiseT))
         .map(|&(_, n)| bluenoise::table_rays(n))
         .collect();
     counts.sort_unstable();

@@ -36,6 +36,7 @@ fn gpu_matches_cpu_on_the_sphere_scene() {
             (DiskScheme::BluenoiseCp, Pattern::PerPixel),
             (DiskScheme::SobolBluenoise, Pattern::PerPixel),
             (DiskScheme::StbnCp, Pattern::PerPixel),
+            (DiskScheme::SobolBluenoiseT, Pattern::PerPixel),
         ] {
             let view = View {
                 camera: &scene.cameras[camera],

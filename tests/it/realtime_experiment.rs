@@ -185,7 +185,7 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     assert!(report.contains("**Answer:**") && report.contains("## The paper's claim restated"));
     assert!(report.contains("The reference is exact"), "{report}");
     // The claim's table: per frame count a blue-noise pipeline at 4 rays at any cost, and one
-    // at no more cost than the paper's frame.
+    // at no more cost than the paper's frame where the timing places one there.
     let claim = &report[report.find("## The paper's claim restated").unwrap()..];
     let claim = &claim[..claim[3..].find("\n## ").map_or(claim.len(), |e| e + 3)];
     let rows = |cost: &str| {
@@ -195,8 +195,15 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
             .count()
     };
     assert_eq!(rows("| any |"), 3, "{claim}");
-    let cheaper = rows("| at most the paper's |");
-    assert!((1..=3).contains(&cheaper), "{claim}");
+    // A row at the paper's cost is answered only with a time the rule places within it.
+    let cheaper: Vec<&str> = claim
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains("| at most the paper's |"))
+        .collect();
+    assert!(cheaper.len() <= 3, "{claim}");
+    for row in cheaper {
+        assert!(row.contains(": faster |") || row.contains(": equivalent |"), "{row}");
+    }
 }
 
 #[test]

@@ -89,7 +89,8 @@ fn area_uniform_schemes_pass_chi_square() {
 /// per-seed Cranley-Patterson shift). A scheme that forgot either would put a pixel's sample k
 /// at one place for every seed. sobol-bluenoise draws from the tile's 4096 scrambles, so 3000
 /// seeds see few repeats. The rotated sets are checked in a later frame too (bluenoise-cp's
-/// offsets moved by R2 steps, stbn-cp's read from another slice of its masks).
+/// offsets moved by R2 steps, stbn-cp's read from another slice of its masks, sobol-bluenoise-t's
+/// scrambles from another shift of its tile).
 #[test]
 fn screen_arranged_samples_are_uniform_over_seeds() {
     for scheme in [
@@ -97,9 +98,10 @@ fn screen_arranged_samples_are_uniform_over_seeds() {
         DiskScheme::BluenoiseCp,
         DiskScheme::SobolBluenoise,
         DiskScheme::StbnCp,
+        DiskScheme::SobolBluenoiseT,
     ] {
         let frames: &[u32] = match scheme {
-            DiskScheme::BluenoiseCp | DiskScheme::StbnCp => &[0, 13],
+            DiskScheme::BluenoiseCp | DiskScheme::StbnCp | DiskScheme::SobolBluenoiseT => &[0, 13],
             _ => &[0],
         };
         for &frame in frames {

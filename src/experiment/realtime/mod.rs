@@ -16,6 +16,7 @@ pub mod reference;
 pub mod report;
 pub mod runner;
 pub mod spec;
+pub mod temporal;
 
 pub use pipeline::Pipeline;
 pub use spec::{RealtimeSpec, Variant};

@@ -251,12 +251,7 @@ pub fn measure(
             .map(|&a| History {
                 accumulation: a,
                 image: Accumulator::new(a, w, h),
-                blockers: spec
-                    .scene
-                    .lights
-                    .iter()
-                    .map(|_| BlockerHistory::new(a, (w * h) as usize))
-                    .collect(),
+                blockers: spec.scene.lights.iter().map(|_| BlockerHistory::new(a, w, h)).collect(),
             })
             .collect();
         // Per (accumulation, filter): the previous frame's output, what is measured after the stop
@@ -565,7 +560,7 @@ pub fn time(
         if blocker_accs.is_empty() {
             blocker_accs = b
                 .iter()
-                .map(|_| BlockerHistory::new(Accumulation::Mean, (w * h) as usize))
+                .map(|_| BlockerHistory::new(Accumulation::Mean, w, h))
                 .collect();
         }
         for (acc, bl) in blocker_accs.iter_mut().zip(&b) {

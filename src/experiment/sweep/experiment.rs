@@ -272,7 +272,11 @@ impl Declaration for Sweep {
 
     fn measure(&self, unit: &Unit, backend: &mut dyn Backend, progress: &Progress) -> anyhow::Result<UnitOutcome> {
         let s = &self.spec;
-        if s.axes.schemes.contains(&DiskScheme::SobolBluenoise) {
+        if s.axes
+            .schemes
+            .iter()
+            .any(|x| matches!(x, DiskScheme::SobolBluenoise | DiskScheme::SobolBluenoiseT))
+        {
             // Every table the sweep reads, generated in parallel once (later calls find them).
             let mut counts = s.axes.samples.clone();
             counts.extend(s.figures.as_ref().map(|f| f.samples));

@@ -216,15 +216,18 @@ impl Accumulator {
 #[derive(Clone, Debug)]
 pub struct BlockerHistory {
     mode: Accumulation,
+    width: usize,
     blocker: Vec<f64>,
     blocked_frames: Vec<u32>,
 }
 
 impl BlockerHistory {
-    /// An empty history of `pixels` pixels.
-    pub fn new(mode: Accumulation, pixels: usize) -> BlockerHistory {
+    /// An empty history of a `width` x `height` view.
+    pub fn new(mode: Accumulation, width: u32, height: u32) -> BlockerHistory {
+        let pixels = width as usize * height as usize;
         BlockerHistory {
             mode,
+            width: width as usize,
             blocker: vec![f64::NAN; pixels],
             blocked_frames: vec![0; pixels],
         }
@@ -232,8 +235,12 @@ impl BlockerHistory {
 
     /// Adds one frame: per pixel, the mean distance to the blockers its shadow rays met (NaN
     /// where none met one), at the pixels with a receiver in its shadow image (`NO_RECEIVER`
-    /// where none: those keep their history).
+    /// where none: those keep their history). A clamped history is first clipped to the range
+    /// of this frame's distances over the [`CLAMP_RADIUS`] window (the min/max clamp of TAA,
+    /// Karis 2014): once an occluder has moved, the penumbra filter's kernel follows the
+    /// blockers the rays meet now instead of the ones they met.
     pub fn add(&mut self, image: &[f32], blocker: &[f64]) {
+        let clamped = matches!(self.mode, Accumulation::Clamped { .. });
         for (i, &v) in image.iter().enumerate() {
             if v == NO_RECEIVER || !blocker[i].is_finite() {
                 continue;
@@ -242,11 +249,32 @@ impl BlockerHistory {
             let w = self.mode.weight(self.blocked_frames[i]);
             let old = if self.blocker[i].is_nan() {
                 blocker[i]
+            } else if clamped {
+                let (lo, hi) = self.range(image, blocker, i);
+                self.blocker[i].max(lo).min(hi)
             } else {
                 self.blocker[i]
             };
             self.blocker[i] = old + w * (blocker[i] - old);
         }
+    }
+
+    /// The least and greatest finite distance of this frame over the receiver pixels of the
+    /// [`CLAMP_RADIUS`] window around pixel `i` (which holds at least pixel `i`'s own).
+    fn range(&self, image: &[f32], blocker: &[f64], i: usize) -> (f64, f64) {
+        let w = self.width as i64;
+        let h = (image.len() / self.width) as i64;
+        let (x, y) = (i as i64 % w, i as i64 / w);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for qy in (y - CLAMP_RADIUS).max(0)..=(y + CLAMP_RADIUS).min(h - 1) {
+            for qx in (x - CLAMP_RADIUS).max(0)..=(x + CLAMP_RADIUS).min(w - 1) {
+                let q = (qy * w + qx) as usize;
+                if image[q] != NO_RECEIVER && blocker[q].is_finite() {
+                    (lo, hi) = (lo.min(blocker[q]), hi.max(blocker[q]));
+                }
+            }
+        }
+        (lo, hi)
     }
 
     /// Drops the blocker history of the pixels marked `changed` ([`Accumulator::forget`]).
@@ -298,7 +326,7 @@ mod tests {
     #[test]
     fn pixels_without_a_receiver_stay_without() {
         let mut a = Accumulator::new(Accumulation::Ema(0.1), 2, 1);
-        let mut b = BlockerHistory::new(Accumulation::Ema(0.1), 2);
+        let mut b = BlockerHistory::new(Accumulation::Ema(0.1), 2, 1);
         for (image, blocker) in [([NO_RECEIVER, 0.5], [1.0, 2.0]), ([NO_RECEIVER, 0.5], [1.0, 4.0])] {
             a.add(&image);
             b.add(&image, &blocker);
@@ -311,11 +339,39 @@ mod tests {
 
     #[test]
     fn blocker_distances_average_over_the_frames_that_met_a_blocker() {
-        let mut b = BlockerHistory::new(Accumulation::Mean, 1);
+        let mut b = BlockerHistory::new(Accumulation::Mean, 1, 1);
         for blocker in [2.0, f64::NAN, 4.0] {
             b.add(&[0.5], &[blocker]);
         }
         assert!((b.blocker()[0] - 3.0).abs() < 1e-12);
+    }
+
+    /// An occluder 2 m away for 8 frames, then 4 m away, seen by a 5 x 5 view whose pixels'
+    /// distances spread by +-0.25 m: the clamped history follows the step in the first frame
+    /// after it (clipped to the new range, then blended), the moving average at the same alpha
+    /// still holds most of the old distance; while the distance holds still, clamping keeps the
+    /// spread's noise (the history stays inside the neighbourhood's range).
+    #[test]
+    fn a_clamped_blocker_history_follows_a_moved_occluder() {
+        let image = vec![0.5f32; 25];
+        let frame = |d: f64| -> Vec<f64> { (0..25).map(|i| d + 0.25 * ((i % 3) as f64 - 1.0)).collect() };
+        let alpha = 0.1;
+        let mut clamped = BlockerHistory::new(Accumulation::Clamped { alpha, gamma: 1.0 }, 5, 5);
+        let mut ema = BlockerHistory::new(Accumulation::Ema(alpha), 5, 5);
+        for f in 0..9 {
+            let d = frame(if f < 8 { 2.0 } else { 4.0 });
+            clamped.add(&image, &d);
+            ema.add(&image, &d);
+            if f == 7 {
+                for (c, e) in clamped.blocker().iter().zip(ema.blocker()) {
+                    assert!((c - 2.0).abs() <= 0.25 && (c - e).abs() < 1e-12, "{c} vs {e}");
+                }
+            }
+        }
+        let centre = 12;
+        // Clipped to at least 3.75, then 0.1 of the way to this pixel's 4.0.
+        assert!(clamped.blocker()[centre] >= 3.75, "{}", clamped.blocker()[centre]);
+        assert!(ema.blocker()[centre] < 2.5, "{}", ema.blocker()[centre]);
     }
 
     /// A straight 6-pixel ramp on a 64 x 8 view that moves 1 pixel per frame for 8 frames and
@@ -397,7 +453,7 @@ mod tests {
     #[test]
     fn a_forgotten_pixel_starts_afresh() {
         let mut a = Accumulator::new(Accumulation::Ema(0.1), 2, 1);
-        let mut b = BlockerHistory::new(Accumulation::Ema(0.1), 2);
+        let mut b = BlockerHistory::new(Accumulation::Ema(0.1), 2, 1);
         for _ in 0..5 {
             a.add(&[0.0, 0.0]);
             b.add(&[0.0, 0.0], &[1.0, 1.0]);

@@ -159,10 +159,12 @@ pub fn scheme_section(summaries: &[Summary], slice: &Slice, n: u32, radius: f64,
     let mut s = format!(
         "\n## Which scheme at {n} rays{label}\n\nPer-pixel pattern, light radius {radius} m, means over seeds with 95 % intervals. Blurred error: the error against the ground truth blurred by a Gaussian of 1 pixel (what a denoiser that averages neighbours leaves), RMSE over the penumbra. Low-frequency share: the power of the error's spectrum below 0.125 cycles per pixel over all of it up to 0.5 (receiver pixels, Hann window, its mean removed): white noise puts 1/16 there, blue noise less, a pattern shared by neighbours (banding, bias) more. Widths against the exact image's.\n\n"
     );
-    if at_n
-        .iter()
-        .any(|(scheme, _)| matches!(scheme, DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise))
-    {
+    if at_n.iter().any(|(scheme, _)| {
+        matches!(
+            scheme,
+            DiskScheme::BluenoiseCp | DiskScheme::SobolBluenoise | DiskScheme::SobolBluenoiseT
+        )
+    }) {
         s += &format!("Blue-noise tables: {}.\n\n", crate::sampling::bluenoise::settings());
     }
     if at_n.iter().any(|(scheme, _)| *scheme == DiskScheme::StbnCp) {

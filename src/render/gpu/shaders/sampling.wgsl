@@ -302,6 +302,15 @@ fn disk_point(scheme: u32, n: u32, k: u32, stream_0: u32, pixel: vec2<u32>, tile
             let s = scrambled_sobol_2d(index, scheme_tables[table + tile_index(pixel, tile_seed)]);
             return concentric(to_unit(s.x), to_unit(s.y));
         }
+        case SCHEME_SOBOL_BLUENOISE_T: {
+            // sobol-bluenoise rescrambled per frame: the tile shift re-keyed, the first n points.
+            let table = bluenoise_table(n);
+            if (table == 0u) {
+                return vec2<f32>(bitcast<f32>(0x7fc00000u));
+            }
+            let s = scrambled_sobol_2d(k, scheme_tables[table + tile_index(pixel, at_frame(tile_seed, frame))]);
+            return concentric(to_unit(s.x), to_unit(s.y));
+        }
         case SCHEME_POINTS: {
             return points_point(k, pixel, at_frame(tile_seed, frame));
         }
