@@ -143,7 +143,7 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     let runs = read(&dir.path().join("runs.csv"));
     assert_eq!(
         runs.len(),
-        2 * 3 * 2 * 3 * 3 * 4 * 4,
+        2 * 4 * 2 * 3 * 3 * 4 * 4,
         "variants x schemes x rays x frames x acc x filters x seeds"
     );
     assert!(runs.iter().all(|r| r["width_px"].parse::<f64>().unwrap().is_finite()));
@@ -188,21 +188,46 @@ fn the_ci_twin_converges_when_still_and_ghosts_when_moving() {
     // at no more cost than the paper's frame where the timing places one there.
     let claim = &report[report.find("## The paper's claim restated").unwrap()..];
     let claim = &claim[..claim[3..].find("\n## ").map_or(claim.len(), |e| e + 3)];
-    let rows = |cost: &str| {
+    let blue_rows = |cost: &str| {
         claim
             .lines()
-            .filter(|l| l.starts_with("| ") && l.contains(cost) && l.contains("bluenoise-cp x 4"))
+            .filter(|l| l.starts_with("| ") && l.contains(cost) && l.contains(" x 4 ray(s)"))
             .count()
     };
-    assert_eq!(rows("| any |"), 3, "{claim}");
-    // A row at the paper's cost is answered only with a time the rule places within it.
-    let cheaper: Vec<&str> = claim
-        .lines()
-        .filter(|l| l.starts_with("| ") && l.contains("| at most the paper's |"))
-        .collect();
-    assert!(cheaper.len() <= 3, "{claim}");
-    for row in cheaper {
-        assert!(row.contains(": faster |") || row.contains(": equivalent |"), "{row}");
+    assert_eq!(blue_rows("| any |"), 3, "{claim}");
+    // A row at the paper's cost is answered only with a time the rule places within it; a frame
+    // count without one says so.
+    for frames in ["1", "2", "8"] {
+        let row = claim
+            .lines()
+            .find(|l| l.starts_with(&format!("| {frames} | at most the paper's |")));
+        match row {
+            Some(row) => assert!(row.contains(": faster |") || row.contains(": equivalent |"), "{row}"),
+            None => assert!(
+                claim.lines().any(|l| l.starts_with("At ")
+                    && l.contains("no blue-noise pipeline's time is placed")
+                    && l.split(" frame(s)")
+                        .next()
+                        .unwrap()
+                        .split([' ', ','])
+                        .any(|w| w == frames)),
+                "{frames} frames: no row at the paper's cost and no sentence saying why\n{claim}"
+            ),
+        }
+    }
+    // Each scheme's unfiltered running mean after every judged frame count, against uniform's.
+    let temporal = &report[report.find("## Temporal error per scheme").expect("temporal section")..];
+    for scheme in ["uniform", "paper", "bluenoise-cp", "sobol-bluenoise-t"] {
+        for rays in [4, 16] {
+            let row = temporal
+                .lines()
+                .find(|l| l.starts_with(&format!("| {scheme} x {rays} |")))
+                .unwrap_or_else(|| panic!("{scheme} x {rays}: no row\n{temporal}"));
+            assert_eq!(row.matches(" +- ").count(), 3, "{row}");
+            if scheme == "uniform" {
+                assert_eq!(row.matches("(1.00)").count(), 3, "{row}");
+            }
+        }
     }
 }
 

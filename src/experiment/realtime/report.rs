@@ -436,43 +436,49 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
     };
     // At most the paper's cost: the rule places the time within it (faster, or equivalent).
     let within_cost = |r: &Estimate| matches!(Comparison::of(r), Comparison::Faster | Comparison::Equivalent);
-    let mut unplaced = Vec::new();
+    let (mut unplaced, mut absent) = (Vec::new(), Vec::new());
     let mut answered = 0;
     for (&frames, equal_cost) in spec.frames.iter().flat_map(|f| [(f, false), (f, true)]) {
-        let best = summary
-            .iter()
-            .filter(|s| {
+        let candidates = || {
+            summary.iter().filter(move |s| {
                 s.pipeline.on(Variant::Static)
                     && blue.contains(&s.pipeline.scheme.as_str())
                     && s.pipeline.rays <= 4
                     && s.pipeline.frames == frames
             })
+        };
+        let best = candidates()
             .filter(|s| !equal_cost || cost(s).is_some_and(|r| within_cost(&r)))
             .min_by(|a, b| a.stats.rmse.total_cmp(&b.stats.rmse));
-        let Some(best) = best else { continue };
         if equal_cost {
-            // Cheaper by a time the rule cannot place: said beside the table, not answered with.
-            let closer = summary
-                .iter()
-                .filter(|s| {
-                    s.pipeline.on(Variant::Static)
-                        && blue.contains(&s.pipeline.scheme.as_str())
-                        && s.pipeline.rays <= 4
-                        && s.pipeline.frames == frames
-                        && s.stats.rmse < best.stats.rmse
-                })
+            // Less error, but a time the rule calls undecided against the paper's: said beside
+            // the table, never answered with.
+            let bound = best.map_or(f64::INFINITY, |b| b.stats.rmse);
+            let closer = candidates()
+                .filter(|s| s.stats.rmse < bound)
                 .filter_map(|s| Some((s, cost(s)?)))
                 .filter(|(_, r)| Comparison::of(r) == Comparison::Undecided)
                 .min_by(|a, b| a.0.stats.rmse.total_cmp(&b.0.stats.rmse));
             if let Some((s, r)) = closer {
                 unplaced.push(format!(
-                    "at {frames} frame(s), {} (RMSE {}, {}x the paper's time: undecided)",
+                    "at {frames} frame(s), {}{} (RMSE {}, {}x the paper's time: undecided)",
+                    if best.is_none() {
+                        "where none is placed within the paper's cost, "
+                    } else {
+                        ""
+                    },
                     s.pipeline.label(),
                     show(s.stats.rmse, s.stats.rmse_ci95, 4),
                     r.show_ratio(2)
                 ));
             }
         }
+        let Some(best) = best else {
+            if equal_cost {
+                absent.push(frames.to_string());
+            }
+            continue;
+        };
         let time = match cost(best) {
             Some(r) => format!("{}: {}", r.show_ratio(2), Comparison::of(&r).word()),
             None => "n/a".into(),
@@ -511,10 +517,17 @@ fn claim_section(spec: &RealtimeSpec, m: &Measured, summary: &[Summary]) -> Stri
     if answered == 0 {
         out += "\nNot answered: no blue-noise scheme at 4 rays or fewer is in this run.\n";
     }
+    if !absent.is_empty() {
+        let _ = writeln!(
+            out,
+            "\nAt {} frame(s) no blue-noise pipeline's time is placed at or under the paper's (faster or equivalent), so the table has no row at the paper's cost there.",
+            absent.join(", ")
+        );
+    }
     if !unplaced.is_empty() {
         let _ = writeln!(
             out,
-            "\nWith less RMSE than a row at the paper's cost, but a time the rule places neither within nor beyond the paper's (so not answered with): {}.",
+            "\nWith less RMSE than the row at the paper's cost (or where there is none), but a time the rule calls undecided against the paper's (its interval reaches past the 5 % margin or could not be formed; so not answered with): {}.",
             unplaced.join("; ")
         );
     }
