@@ -15,6 +15,7 @@ mod common;
 mod cwbvh;
 mod denoise;
 mod dynamic_updates;
+mod flip_official;
 mod frame_power;
 mod frames_experiment;
 mod fuzz_config;
