@@ -298,15 +298,14 @@ impl DiskScheme {
                 let wrap = |a: u32, b: u32| rng::to_unit((a.wrapping_add(b) & 0x00ff_ffff) << 8);
                 concentric(wrap(sx, ox), wrap(sy, oy))
             }
-            DiskScheme::SobolBluenoise => {
+            DiskScheme::SobolBluenoise | DiskScheme::SobolBluenoiseT => {
+                // The sequence continued under one scramble, or restarted under the frame's.
+                let (index, tile_seed) = match self {
+                    DiskScheme::SobolBluenoise => (index, site.tile_seed),
+                    _ => (k, rng::at_frame(site.tile_seed, site.frame)),
+                };
                 let [x, y] = site.pixel;
-                let (sx, sy) = sobol::scrambled_sobol_2d(index, bluenoise::scramble(x, y, n, site.tile_seed));
-                concentric(rng::to_unit(sx), rng::to_unit(sy))
-            }
-            DiskScheme::SobolBluenoiseT => {
-                let [x, y] = site.pixel;
-                let tile_seed = rng::at_frame(site.tile_seed, site.frame);
-                let (sx, sy) = sobol::scrambled_sobol_2d(k, bluenoise::scramble(x, y, n, tile_seed));
+                let (sx, sy) = sobol::scrambled_sobol_2d(index, bluenoise::scramble(x, y, n, tile_seed));
                 concentric(rng::to_unit(sx), rng::to_unit(sy))
             }
             DiskScheme::Points(id) => {

@@ -39,6 +39,17 @@ pub enum Accumulation {
 /// Half-side of the neighbourhood a clamped history is clipped to (5 x 5 pixels).
 pub const CLAMP_RADIUS: i64 = 2;
 
+/// The pixels of the [`CLAMP_RADIUS`] window around pixel `i` of a `width`-wide view of
+/// `pixels` pixels, cut at the view's edges, row by row: the neighbourhood both clamped
+/// histories (image and blocker distances) are clipped to.
+fn clamp_window(i: usize, width: usize, pixels: usize) -> impl Iterator<Item = usize> {
+    let (w, h) = (width as i64, (pixels / width) as i64);
+    let (x, y) = (i as i64 % w, i as i64 / w);
+    ((y - CLAMP_RADIUS).max(0)..=(y + CLAMP_RADIUS).min(h - 1)).flat_map(move |qy| {
+        ((x - CLAMP_RADIUS).max(0)..=(x + CLAMP_RADIUS).min(w - 1)).map(move |qx| (qy * w + qx) as usize)
+    })
+}
+
 /// Fewest finite blocker distances a window must hold for a clamped blocker history to be
 /// clipped to their range. Fewer (the penumbra's rim at one ray, where few rays meet a blocker)
 /// bound too little: a lone distance would replace the history every frame, so the history is
@@ -147,16 +158,11 @@ impl Accumulator {
     /// Mean -+ `gamma` standard deviations of `image` over the receiver pixels of the
     /// [`CLAMP_RADIUS`] window around pixel `i`.
     fn neighbourhood(&self, image: &[f32], i: usize, gamma: f64) -> (f64, f64) {
-        let w = self.width as i64;
-        let h = (image.len() / self.width) as i64;
-        let (x, y) = (i as i64 % w, i as i64 / w);
         let (mut s1, mut s2, mut n) = (0.0, 0.0, 0.0);
-        for qy in (y - CLAMP_RADIUS).max(0)..=(y + CLAMP_RADIUS).min(h - 1) {
-            for qx in (x - CLAMP_RADIUS).max(0)..=(x + CLAMP_RADIUS).min(w - 1) {
-                let v = image[(qy * w + qx) as usize];
-                if v != NO_RECEIVER {
-                    (s1, s2, n) = (s1 + v as f64, s2 + (v as f64).powi(2), n + 1.0);
-                }
+        for q in clamp_window(i, self.width, image.len()) {
+            let v = image[q];
+            if v != NO_RECEIVER {
+                (s1, s2, n) = (s1 + v as f64, s2 + (v as f64).powi(2), n + 1.0);
             }
         }
         let mean = s1 / n;
@@ -268,16 +274,10 @@ impl BlockerHistory {
     /// [`CLAMP_RADIUS`] window around pixel `i`, where the window holds at least
     /// [`MIN_CLAMP_SAMPLES`] of them.
     fn range(&self, image: &[f32], blocker: &[f64], i: usize) -> Option<(f64, f64)> {
-        let w = self.width as i64;
-        let h = (image.len() / self.width) as i64;
-        let (x, y) = (i as i64 % w, i as i64 / w);
         let (mut lo, mut hi, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-        for qy in (y - CLAMP_RADIUS).max(0)..=(y + CLAMP_RADIUS).min(h - 1) {
-            for qx in (x - CLAMP_RADIUS).max(0)..=(x + CLAMP_RADIUS).min(w - 1) {
-                let q = (qy * w + qx) as usize;
-                if image[q] != NO_RECEIVER && blocker[q].is_finite() {
-                    (lo, hi, n) = (lo.min(blocker[q]), hi.max(blocker[q]), n + 1);
-                }
+        for q in clamp_window(i, self.width, image.len()) {
+            if image[q] != NO_RECEIVER && blocker[q].is_finite() {
+                (lo, hi, n) = (lo.min(blocker[q]), hi.max(blocker[q]), n + 1);
             }
         }
         (n >= MIN_CLAMP_SAMPLES).then_some((lo, hi))
