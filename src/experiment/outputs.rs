@@ -29,7 +29,7 @@ pub struct Outputs {
     shard: Option<Vec<PathBuf>>,
     /// The results folder (exclusively) or a shard's folder (with the results folder shared),
     /// open and locked for as long as this run writes there; the first is the results folder.
-    locks: Vec<File>,
+    locks: Vec<FolderLock>,
 }
 
 /// The results folder a run will replace, as the real path its swap acts on: created if
@@ -80,9 +80,24 @@ enum Hold {
     Shared,
 }
 
+/// A folder locked with `flock`, unlocked explicitly when dropped. Closing alone is not enough:
+/// the lock belongs to the open file description, and a process another thread forks holds a
+/// copy of every descriptor until it execs, so a folder released by closing could still read
+/// as held by "another run" for that moment.
+#[derive(Debug)]
+struct FolderLock(File);
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        use std::os::fd::AsRawFd;
+        // SAFETY: a valid open descriptor; unlocking acts on the description, every copy.
+        unsafe { libc::flock(self.0.as_raw_fd(), libc::LOCK_UN) };
+    }
+}
+
 /// Locks `dir` for this run as `hold` says, or says which run holds it; the lock lasts as long
-/// as the returned file stays open.
-fn lock(dir: &Path, hold: Hold, held: &str) -> anyhow::Result<File> {
+/// as the returned lock lives.
+fn lock(dir: &Path, hold: Hold, held: &str) -> anyhow::Result<FolderLock> {
     use std::os::fd::AsRawFd;
     let file = File::open(dir).with_context(|| format!("opening {}", dir.display()))?;
     let how = match hold {
@@ -103,7 +118,7 @@ fn lock(dir: &Path, hold: Hold, held: &str) -> anyhow::Result<File> {
             dir.display()
         );
     }
-    Ok(file)
+    Ok(FolderLock(file))
 }
 
 /// What a run refused by a held results folder is told.
@@ -280,7 +295,7 @@ impl Outputs {
     /// what is there now, and the staged results stay where they are, named.
     fn check_home_held(&mut self) -> anyhow::Result<()> {
         use std::os::unix::fs::MetadataExt;
-        let locked = self.locks[0].metadata()?;
+        let locked = self.locks[0].0.metadata()?;
         let now = std::fs::symlink_metadata(&self.home)
             .ok()
             .filter(|m| m.is_dir())
@@ -425,6 +440,26 @@ mod tests {
         assert!(shard.contains("a whole run or a merge"), "{shard}");
         drop(merge);
         Outputs::begin_shard(&home, &two).unwrap();
+    }
+
+    #[test]
+    fn a_dropped_lock_is_free_while_a_forked_process_still_holds_its_descriptor() {
+        let dir = tempfile::tempdir().unwrap();
+        let held = lock(dir.path(), Hold::Alone, "held").unwrap();
+        // SAFETY: the child only sleeps and exits (async-signal-safe calls) before it would exec.
+        let child = unsafe { libc::fork() };
+        assert!(child >= 0, "fork failed");
+        if child == 0 {
+            unsafe {
+                libc::sleep(2);
+                libc::_exit(0);
+            }
+        }
+        drop(held);
+        let again = lock(dir.path(), Hold::Alone, "held");
+        let mut status = 0;
+        unsafe { libc::waitpid(child, &mut status, 0) };
+        again.unwrap();
     }
 
     #[test]
