@@ -23,6 +23,7 @@ pub mod geometry;
 pub mod mesh;
 pub mod metrics;
 pub mod output;
+pub mod peers;
 pub mod reference;
 pub mod render;
 pub mod sampling;

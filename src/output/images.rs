@@ -118,6 +118,21 @@ fn write_exr_as<T: exr::prelude::IntoSample>(
     height: u32,
     sample: impl Fn(f32) -> T + Sync,
 ) -> anyhow::Result<()> {
+    let bytes = exr_bytes_as(values, width, height, sample).map_err(|e| anyhow!("encoding {}: {e}", path.display()))?;
+    write_atomic(path, &bytes)
+}
+
+/// A one-channel float EXR (channel `Y`) as bytes, for files written as part of a set.
+pub fn exr_bytes(values: &[f32], width: u32, height: u32) -> anyhow::Result<Vec<u8>> {
+    exr_bytes_as(values, width, height, |v| v)
+}
+
+fn exr_bytes_as<T: exr::prelude::IntoSample>(
+    values: &[f32],
+    width: u32,
+    height: u32,
+    sample: impl Fn(f32) -> T + Sync,
+) -> anyhow::Result<Vec<u8>> {
     use exr::prelude::*;
     let w = width as usize;
     let channels = SpecificChannels::build()
@@ -125,11 +140,8 @@ fn write_exr_as<T: exr::prelude::IntoSample>(
         .with_pixel_fn(|p: Vec2<usize>| (sample(values[p.y() * w + p.x()]),));
     let image = Image::from_channels((w, height as usize), channels);
     let mut bytes = Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut bytes)
-        .map_err(|e| anyhow!("encoding {}: {e}", path.display()))?;
-    write_atomic(path, &bytes.into_inner())
+    image.write().to_buffered(&mut bytes).map_err(|e| anyhow!("{e}"))?;
+    Ok(bytes.into_inner())
 }
 
 #[cfg(test)]

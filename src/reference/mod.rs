@@ -11,4 +11,4 @@ pub mod visibility;
 
 pub use on_axis::OnAxis;
 pub use quadrature::Integral;
-pub use visibility::{occluders, visible_fraction, visible_fraction_estimate};
+pub use visibility::{irradiance_fraction_estimate, occluders, visible_fraction, visible_fraction_estimate};

@@ -56,12 +56,72 @@ pub fn visible_fraction_estimate(
     spheres: &[Sphere],
     planes: &[Plane],
 ) -> Integral {
-    let exactly = |value: f64| Integral {
-        value,
-        ..Default::default()
+    fraction(p, n, light, spheres, planes, Weight::Area).0
+}
+
+/// The exact irradiance a disk light gives a receiver point, as the fraction of its unoccluded
+/// irradiance that arrives and that unoccluded part: E = L_e (fraction x free), with
+/// free = integral over the disk (above the receiver's horizon) of cos_r cos_l / d^2 dA (m^0:
+/// a solid-angle-like geometry term) and L_e = power / (pi^2 a^2) for the one-sided
+/// Lambertian disk. This is what a renderer's radiance estimates converge to (penumbra's
+/// irradiance estimate, [`crate::render::shading`], and any path tracer's); [`visible_fraction`]
+/// weighs the disk by area instead, and the two differ by the weight's variation over the
+/// disk (about 4 r a / d^2, under 1 % for the shipped scene) inside the penumbra.
+pub fn irradiance_fraction_estimate(
+    p: DVec3,
+    n: DVec3,
+    light: &DiskLight,
+    spheres: &[Sphere],
+    planes: &[Plane],
+) -> (Integral, f64) {
+    fraction(p, n, light, spheres, planes, Weight::Irradiance)
+}
+
+/// How the points of the disk count in an integral over its visible part.
+#[derive(Clone, Copy, PartialEq)]
+enum Weight {
+    /// By area: the visible fraction V.
+    Area,
+    /// By cos_r cos_l / d^2: the irradiance.
+    Irradiance,
+}
+
+/// The visible part of the disk as a fraction of the whole (as `weight` counts it), with the
+/// whole's integral (pi a^2 for [`Weight::Area`]; above the receiver's horizon for
+/// [`Weight::Irradiance`]).
+fn fraction(
+    p: DVec3,
+    n: DVec3,
+    light: &DiskLight,
+    spheres: &[Sphere],
+    planes: &[Plane],
+    weight: Weight,
+) -> (Integral, f64) {
+    let a = light.radius;
+    let (u, v) = light.basis();
+    let chord = |theta: f64, spheres: &[Sphere], planes: &[&Plane]| {
+        visible_rho_integral(p, n, light, u * theta.cos() + v * theta.sin(), spheres, planes, weight)
     };
-    if light.normal.dot(p - light.center) <= 0.0 {
-        return exactly(0.0); // behind the one-sided emitter
+    let whole = match weight {
+        Weight::Area => PI * a * a,
+        Weight::Irradiance if light.normal.dot(p - light.center) <= 0.0 => 0.0,
+        Weight::Irradiance => {
+            // Only the horizon cuts the unoccluded disk: a smooth integrand but for the
+            // horizon's chord, resolved to the same relative tolerance as the visible part.
+            let d = (light.center - p).length();
+            let scale = PI * a * a / (d * d);
+            integrate_panels(|t| chord(t, &[], &[]), 0.0, TAU, TOLERANCE * scale, PANELS).value
+        }
+    };
+    let exactly = |value: f64| {
+        let integral = Integral {
+            value,
+            ..Default::default()
+        };
+        (integral, whole)
+    };
+    if light.normal.dot(p - light.center) <= 0.0 || whole <= 0.0 {
+        return exactly(0.0); // behind the one-sided emitter, or below the horizon
     }
     if spheres
         .iter()
@@ -77,26 +137,19 @@ pub fn visible_fraction_estimate(
     if occluding_planes.is_empty() && unoccluded_and_above_horizon(p, n, light, spheres) {
         return exactly(1.0);
     }
-    let (u, v) = light.basis();
-    let a = light.radius;
-    let chord = |theta: f64| {
-        visible_rho_integral(
-            p,
-            n,
-            light.center,
-            u * theta.cos() + v * theta.sin(),
-            a,
-            spheres,
-            &occluding_planes,
-        )
-    };
-    let total = integrate_panels(chord, 0.0, TAU, TOLERANCE * PI * a * a, PANELS);
-    let area = PI * a * a;
-    Integral {
-        value: (total.value / area).clamp(0.0, 1.0),
-        error: total.error / area,
+    let total = integrate_panels(
+        |t| chord(t, spheres, &occluding_planes),
+        0.0,
+        TAU,
+        TOLERANCE * whole,
+        PANELS,
+    );
+    let integral = Integral {
+        value: (total.value / whole).clamp(0.0, 1.0),
+        error: total.error / whole,
         depth_limited: total.depth_limited,
-    }
+    };
+    (integral, whole)
 }
 
 /// Conservative test that nothing can hide any part of the light: the whole disk is above the
@@ -116,8 +169,20 @@ fn unoccluded_and_above_horizon(p: DVec3, n: DVec3, light: &DiskLight, spheres: 
     })
 }
 
-/// Integral of rho d rho over the visible part of the ray {C + rho e : 0 <= rho <= a}.
-fn visible_rho_integral(p: DVec3, n: DVec3, c: DVec3, e: DVec3, a: f64, spheres: &[Sphere], planes: &[&Plane]) -> f64 {
+/// Integral of w rho d rho over the visible part of the ray {C + rho e : 0 <= rho <= a}, with
+/// w = 1 ([`Weight::Area`]: exact) or cos_r cos_l / d^2 ([`Weight::Irradiance`]: 8-point
+/// Gauss-Legendre on each visible interval, where w is smooth; its relative change across the
+/// disk is about 4 a / d, so the rule's error is far below the tolerance wherever d >> a).
+fn visible_rho_integral(
+    p: DVec3,
+    n: DVec3,
+    light: &DiskLight,
+    e: DVec3,
+    spheres: &[Sphere],
+    planes: &[&Plane],
+    weight: Weight,
+) -> f64 {
+    let (c, a) = (light.center, light.radius);
     let w0 = c - p;
     let mut cuts = vec![0.0, a];
     let mut add = |c2: f64, c1: f64, c0: f64| {
@@ -142,14 +207,44 @@ fn visible_rho_integral(p: DVec3, n: DVec3, c: DVec3, e: DVec3, a: f64, spheres:
         add(0.0, pl.normal.dot(e), pl.normal.dot(c - pl.point));
     }
     cuts.sort_by(f64::total_cmp);
+    let geometry = |rho: f64| {
+        let d = w0 + e * rho;
+        let d2 = d.length_squared();
+        n.dot(d).max(0.0) * (-light.normal.dot(d)).max(0.0) / (d2 * d2)
+    };
     let mut sum = 0.0;
     for w in cuts.windows(2) {
         let (r0, r1) = (w[0], w[1]);
         if r1 > r0 && is_visible(p, n, c + e * (0.5 * (r0 + r1)), spheres, planes) {
-            sum += 0.5 * (r1 * r1 - r0 * r0);
+            sum += match weight {
+                Weight::Area => 0.5 * (r1 * r1 - r0 * r0),
+                Weight::Irradiance => gauss_legendre_8(|rho| geometry(rho) * rho, r0, r1),
+            };
         }
     }
     sum
+}
+
+/// 8-point Gauss-Legendre rule on [a, b]: exact for polynomials of degree 15.
+fn gauss_legendre_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    const X: [f64; 4] = [
+        0.183_434_642_495_649_8,
+        0.525_532_409_916_329,
+        0.796_666_477_413_626_7,
+        0.960_289_856_497_536_3,
+    ];
+    const W: [f64; 4] = [
+        0.362_683_783_378_362,
+        0.313_706_645_877_887_3,
+        0.222_381_034_453_374_5,
+        0.101_228_536_290_376_3,
+    ];
+    let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
+    h * X
+        .iter()
+        .zip(W)
+        .map(|(&x, w)| w * (f(c - h * x) + f(c + h * x)))
+        .sum::<f64>()
 }
 
 /// Whether light point `q` is visible from receiver `p` (normal `n`): above the horizon, and the
@@ -337,5 +432,102 @@ mod tests {
         assert!(r.iter().any(|&x| (x - 1e-8).abs() < 1e-22));
         assert!(quadratic_roots(1.0, 0.0, 1.0).is_empty());
         assert_eq!(quadratic_roots(0.0, 2.0, -1.0), vec![0.5]);
+    }
+
+    /// Configuration factor of a differential area facing a parallel coaxial-plane disk of
+    /// radius a at height h, offset r from its axis: F = (1 - (h^2 + r^2 - a^2) /
+    /// sqrt((h^2 + r^2 + a^2)^2 - 4 r^2 a^2)) / 2; the integral of cos cos / d^2 is pi F.
+    fn parallel_disk_factor(h: f64, r: f64, a: f64) -> f64 {
+        let (h2, r2, a2) = (h * h, r * r, a * a);
+        0.5 * (1.0 - (h2 + r2 - a2) / ((h2 + r2 + a2).powi(2) - 4.0 * r2 * a2).sqrt())
+    }
+
+    #[test]
+    fn unoccluded_irradiance_is_the_parallel_disk_configuration_factor() {
+        for (h, a) in [(2.0, 0.02), (1.0, 0.5), (0.1, 0.05)] {
+            let l = down_light(DVec3::new(0.0, 0.0, h), a);
+            for r in [0.0, 0.3 * a, a, 3.0 * a, 40.0 * a] {
+                let (f, whole) = irradiance_fraction_estimate(DVec3::new(r, 0.0, 0.0), DVec3::Z, &l, &[], &[]);
+                let exact = PI * parallel_disk_factor(h, r, a);
+                assert!(
+                    (whole / exact - 1.0).abs() < 1e-9,
+                    "h {h} a {a} r {r}: {whole} vs {exact}"
+                );
+                assert_eq!(f.value, 1.0);
+            }
+        }
+    }
+
+    /// A tilted receiver sees part of the disk below its horizon: the unoccluded integral is
+    /// the area's weighted integral above the horizon only, checked here against a fine
+    /// midpoint sum over the disk (an independent path).
+    #[test]
+    fn a_horizon_cuts_the_unoccluded_irradiance() {
+        let l = down_light(DVec3::new(0.0, 0.0, 0.3), 0.2);
+        let n = DVec3::new(1.0, 0.0, 0.2).normalize();
+        let p = DVec3::new(0.05, 0.0, 0.0);
+        let (f, whole) = irradiance_fraction_estimate(p, n, &l, &[], &[]);
+        let steps = 2000;
+        let h = 2.0 * l.radius / steps as f64;
+        let mut sum = 0.0;
+        for i in 0..steps {
+            for j in 0..steps {
+                let (x, y) = (-l.radius + (i as f64 + 0.5) * h, -l.radius + (j as f64 + 0.5) * h);
+                if x * x + y * y < l.radius * l.radius {
+                    let d = l.center + DVec3::new(x, y, 0.0) - p;
+                    let d2 = d.length_squared();
+                    sum += n.dot(d).max(0.0) * (-l.normal.dot(d)).max(0.0) / (d2 * d2) * h * h;
+                }
+            }
+        }
+        assert!((whole / sum - 1.0).abs() < 2e-4, "{whole} vs midpoint {sum}");
+        assert_eq!(f.value, 1.0, "the horizon is in the whole, not an occluder of it");
+    }
+
+    /// In the shipped scene's penumbra the irradiance-weighted fraction agrees with a
+    /// stratified estimate over the disk (an independent path: point tests, no roots) within
+    /// its sampling error, and differs from the area fraction V by more than that error: the
+    /// two conventions are distinguishable, which is why the judge uses this one.
+    #[test]
+    fn the_irradiance_fraction_matches_a_stratified_estimate_and_differs_from_v() {
+        let l = down_light(DVec3::new(0.0, 0.0, 2.0), 0.02);
+        let s = [Sphere {
+            center: DVec3::new(0.0, 0.0, 0.5),
+            radius: 0.25,
+            albedo: 0.8,
+        }];
+        let (u, v) = l.basis();
+        let mut separated = 0;
+        for r in [0.333, 0.336, 0.339, 0.342] {
+            let p = DVec3::new(r, 0.0, 0.0);
+            let (f, whole) = irradiance_fraction_estimate(p, DVec3::Z, &l, &s, &[]);
+            let m = 1200;
+            let (mut vis, mut all) = (0.0, 0.0);
+            for i in 0..m {
+                for j in 0..m {
+                    // Stratified in (rho^2, theta) with a fixed interior offset: uniform by area.
+                    let (a, b) = ((i as f64 + 0.37) / m as f64, (j as f64 + 0.61) / m as f64);
+                    let (rho, th) = (l.radius * a.sqrt(), TAU * b);
+                    let q = l.center + rho * (th.cos() * u + th.sin() * v);
+                    let d = q - p;
+                    let d2 = d.length_squared();
+                    let w = DVec3::Z.dot(d) * (-l.normal.dot(d)) / (d2 * d2);
+                    all += w;
+                    if is_visible(p, DVec3::Z, q, &s, &[]) {
+                        vis += w;
+                    }
+                }
+            }
+            let stratified = vis / all;
+            // A stratified estimate errs only in the ~m cells the silhouette crosses (1/m^2
+            // each, signs mixed): about m^-1.5 = 2.4e-5 here; measured 4e-6 to 4.2e-5.
+            let tol = 1.5e-4;
+            assert!((f.value - stratified).abs() < tol, "r {r}: {} vs {stratified}", f.value);
+            assert!((whole / (PI * parallel_disk_factor(2.0, r, 0.02)) - 1.0).abs() < 1e-9);
+            let area = visible_fraction(p, DVec3::Z, &l, &s, &[]);
+            separated += ((f.value - area).abs() > tol) as u32;
+        }
+        // Measured: the weighted fraction exceeds V by 5e-4 to 1.4e-3 at these four points.
+        assert_eq!(separated, 4, "the weighting moved a point by less than the error");
     }
 }

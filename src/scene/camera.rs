@@ -77,10 +77,16 @@ impl Camera {
 
     /// The ray through the centre of pixel (x, y) of a `width` x `height` image; row 0 is the top.
     pub fn ray(&self, x: u32, y: u32, width: u32, height: u32) -> Ray {
+        self.ray_at(x as f64 + 0.5, y as f64 + 0.5, width, height)
+    }
+
+    /// The ray through image position (x, y) in pixels from the top-left corner (a pixel's
+    /// centre is at +0.5 in both): for references averaged over a pixel's square.
+    pub fn ray_at(&self, x: f64, y: f64, width: u32, height: u32) -> Ray {
         let f = self.frame().expect("validated camera has a frame");
         let (hx, hy) = self.half_extents(width, height);
-        let sx = (2.0 * (x as f64 + 0.5) / width as f64 - 1.0) * hx;
-        let sy = (1.0 - 2.0 * (y as f64 + 0.5) / height as f64) * hy;
+        let sx = (2.0 * x / width as f64 - 1.0) * hx;
+        let sy = (1.0 - 2.0 * y / height as f64) * hy;
         match self.projection {
             Projection::Perspective { .. } => Ray {
                 origin: self.position,

@@ -348,6 +348,8 @@ const FOLDERS: &[&str] = &[
     "body-structures",
     "dynamic",
     "fps",
+    // Judged peers' images: tests/it/peers.rs recomputes them from their CSVs.
+    "peers",
     "realtime",
     "realtime-body",
     "scaling",

@@ -54,6 +54,33 @@ pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
     let mut problems = Vec::new();
     let mut commits: Vec<(String, String)> = Vec::new();
     for folder in &folders {
+        // A folder of judged peers' images names its build and scene file as a manifest does,
+        // but no experiment file made it.
+        let provenance = results.join(folder).join(crate::peers::panel::PROVENANCE);
+        if !results.join(folder).join("manifest.toml").exists() && provenance.exists() {
+            match read_provenance(&provenance) {
+                Ok(p) => {
+                    if !p.build.clean {
+                        problems.push(problem(
+                            folder,
+                            format!(
+                                "judged by a build from a dirty tree ({}): its numbers belong to no commit",
+                                p.build.label()
+                            ),
+                        ));
+                    }
+                    commits.push((folder.clone(), p.build.commit.clone()));
+                    problems.extend(
+                        p.inputs
+                            .iter()
+                            .filter_map(|i| input_problem(i, repo))
+                            .map(|w| problem(folder, w)),
+                    );
+                }
+                Err(what) => problems.push(problem(folder, what)),
+            }
+            continue;
+        }
         let manifest = match read_manifest(&results.join(folder).join("manifest.toml")) {
             Ok(m) => m,
             Err(what) => {
@@ -94,6 +121,19 @@ pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
     }
     problems.extend(foreign_commits(&commits, repo).into_iter().map(|(f, w)| problem(&f, w)));
     problems
+}
+
+/// A judged folder's provenance, or why it cannot be read.
+fn read_provenance(path: &Path) -> Result<crate::peers::panel::Provenance, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{} cannot be read: {e}", crate::peers::panel::PROVENANCE))?;
+    toml::from_str(&text).map_err(|e: toml::de::Error| {
+        format!(
+            "{} is not a judge's provenance: {}",
+            crate::peers::panel::PROVENANCE,
+            one_line(&e.to_string())
+        )
+    })
 }
 
 /// The manifest at `path`, or why it cannot be read as one of this [`SCHEMA`].

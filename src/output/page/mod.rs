@@ -13,7 +13,7 @@
 
 mod data;
 mod markdown;
-mod rebuild;
+pub(crate) mod rebuild;
 
 use crate::files::write_atomic;
 use crate::metrics::flip::{flip_map, PIXELS_PER_DEGREE};

@@ -203,7 +203,7 @@ fn natural(name: &str) -> Vec<(u128, String)> {
 /// longer than its declared pixels stored raw, plus an eighth and a MiB (a sparse file of
 /// gigabytes behind a small header). A compressed file a few MB long can declare gigabytes of
 /// pixels.
-fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
+pub(crate) fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
     use crate::config::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
     let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
         .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;

@@ -1,0 +1,305 @@
+//! A set of images of one exported view judged together against each reference asked for (one
+//! per pixel filter the images' exports record and shadow-ray lift), with what the judge
+//! writes: judge.csv (one row per image and lift), groups.csv (per group of seeds), profile.csv
+//! and profile.png (mean signed error across the exact edge), report.md, the references as
+//! EXRs, and provenance.toml (the build and the scene file that made it).
+
+use super::judge::{error_profile, judge, read_radiance, summarise, GroupSummary, Judgement, Lift, Reference};
+use super::view::{ExportedView, PixelFilter, FILE};
+use crate::experiment::manifest::{Build, Input};
+use crate::files::Refused;
+use crate::output::plots::{line_plot, Axes, Point, Series};
+use crate::scene::Scene;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// One group of seeds under one reference: the reference's index in [`Panel::references`], the
+/// summary, and the mean signed error across the exact edge ([`error_profile`]).
+pub type Group = (usize, GroupSummary, Vec<(f64, f64)>);
+
+/// Every image judged, under every lift.
+pub struct Panel {
+    /// The view all images share.
+    pub view: ExportedView,
+    /// The lifts asked for.
+    pub lifts: Vec<Lift>,
+    /// One reference per (filter, lift) used.
+    pub references: Vec<(PixelFilter, Lift, Reference)>,
+    /// Per image and lift: the reference's index, the scores and the image as a visible fraction.
+    pub judged: Vec<(usize, Judgement, Vec<f32>)>,
+    /// The scene file as read.
+    pub scene_input: Input,
+    /// The images as read.
+    pub image_inputs: Vec<Input>,
+}
+
+/// What the build and inputs of a judged folder were: the freshness check reads it as it reads
+/// an experiment's manifest.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Provenance {
+    /// The judge's build.
+    pub build: Build,
+    /// The lifts judged under.
+    pub lifts: Vec<String>,
+    /// The scene file (the one input in the repository).
+    pub inputs: Vec<Input>,
+    /// The judged images (made outside the repository, named for the record).
+    pub images: Vec<Input>,
+}
+
+/// File name of [`Provenance`] in a judged folder.
+pub const PROVENANCE: &str = "provenance.toml";
+
+/// Pixel filter names as the files write them.
+pub fn filter_name(p: PixelFilter) -> &'static str {
+    match p {
+        PixelFilter::Centre => "centre",
+        PixelFilter::Box => "box",
+    }
+}
+
+impl Panel {
+    /// Judges `images` (each beside its export's view.toml; one scene, camera and size) under
+    /// each of `lifts`.
+    pub fn judge(images: &[PathBuf], lifts: &[Lift]) -> anyhow::Result<Panel> {
+        let mut views = Vec::new();
+        for image in images {
+            let record = image.parent().unwrap_or(Path::new(".")).join(FILE);
+            if !record.is_file() {
+                return Err(Refused(format!(
+                    "{}: no {FILE} beside it; judge images in the folder of the export that made their view",
+                    image.display()
+                ))
+                .into());
+            }
+            views.push(ExportedView::read(&record)?);
+        }
+        let first = views
+            .first()
+            .cloned()
+            .ok_or_else(|| Refused("no images to judge".into()))?;
+        for (v, image) in views.iter().zip(images) {
+            let same = (&v.scene, &v.scene_fnv1a, &v.camera, v.width, v.height, v.plane)
+                == (
+                    &first.scene,
+                    &first.scene_fnv1a,
+                    &first.camera,
+                    first.width,
+                    first.height,
+                    first.plane,
+                );
+            if !same {
+                return Err(Refused(format!(
+                    "{}: its view ({}, camera `{}`, {} x {}) is not {}'s ({}, camera `{}`, {} x {}); judge one view at a time",
+                    image.display(),
+                    v.scene.display(),
+                    v.camera,
+                    v.width,
+                    v.height,
+                    images[0].display(),
+                    first.scene.display(),
+                    first.camera,
+                    first.width,
+                    first.height
+                ))
+                .into());
+            }
+        }
+        let bytes = crate::files::read_regular(&first.scene)?;
+        if ExportedView::fingerprint(&bytes) != first.scene_fnv1a {
+            return Err(Refused(format!(
+                "{}: changed since the export (FNV-1a {} then, {} now); export and render the view again",
+                first.scene.display(),
+                first.scene_fnv1a,
+                ExportedView::fingerprint(&bytes)
+            ))
+            .into());
+        }
+        let scene = Scene::load(&first.scene)?;
+        let mut radiance = Vec::new();
+        for image in images {
+            radiance.push(read_radiance(image, &first)?);
+        }
+        let mut references: Vec<(PixelFilter, Lift, Reference)> = Vec::new();
+        let mut judged = Vec::new();
+        for &lift in lifts {
+            for ((v, image), l) in views.iter().zip(images).zip(&radiance) {
+                let k = match references.iter().position(|(f, g, _)| *f == v.pixel && *g == lift) {
+                    Some(k) => k,
+                    None => {
+                        references.push((v.pixel, lift, Reference::exact(&scene, &first, v.pixel, lift)?));
+                        references.len() - 1
+                    }
+                };
+                let reference = &references[k].2;
+                let name = image
+                    .file_name()
+                    .map_or_else(|| image.display().to_string(), |n| n.to_string_lossy().into_owned());
+                let fraction = reference.fraction_of(l, &image.display().to_string())?;
+                judged.push((k, judge(reference, v.pixel, lift, &name, &fraction)?, fraction));
+            }
+        }
+        Ok(Panel {
+            scene_input: Input::read(&first.scene)?,
+            image_inputs: images.iter().map(|i| Input::read(i)).collect::<std::io::Result<_>>()?,
+            view: first,
+            lifts: lifts.to_vec(),
+            references,
+            judged,
+        })
+    }
+
+    /// Per reference, its groups' summaries and error profiles, in the order images were given.
+    pub fn groups(&self) -> Vec<Group> {
+        let mut out = Vec::new();
+        for (k, (_, _, reference)) in self.references.iter().enumerate() {
+            let of: Vec<(Judgement, Vec<f32>)> = self
+                .judged
+                .iter()
+                .filter(|(r, _, _)| *r == k)
+                .map(|(_, j, f)| (j.clone(), f.clone()))
+                .collect();
+            for s in summarise(reference, &of) {
+                let fractions: Vec<&[f32]> = of
+                    .iter()
+                    .filter(|(j, _)| j.group == s.group)
+                    .map(|(_, f)| f.as_slice())
+                    .collect();
+                let profile = error_profile(reference, &fractions);
+                out.push((k, s, profile));
+            }
+        }
+        out
+    }
+
+    /// The report: what was judged and one table row per group and reference.
+    pub fn report(&self, groups: &[Group]) -> String {
+        let v = &self.view;
+        let mut r = format!(
+            "# Judged against the exact reference\n\nScene `{}` (FNV-1a {}), camera `{}`, {} x {} pixels, plane {}. Each image's \
+             radiance is divided by the exact unoccluded radiance of its pixel and compared with the exact fraction \
+             (irradiance-weighted), under the pixel filter its export records and each shadow-ray lift asked for (`none`: rays \
+             from the surface, as penumbra traces them; `mitsuba3`: Mitsuba 3's offset along the normal). The penumbra is the \
+             exact image's (fraction strictly between 0.001 and 0.999); widths are across the exact edge, in pixels; FLIP is \
+             LDR (8-bit grey) at 67.02 pixels per degree; intervals are 95 % over seeds. The mean signed error's shape across \
+             the edge is in profile.csv (profile.png).\n\n",
+            self.scene_input.path, v.scene_fnv1a, v.camera, v.width, v.height, v.plane
+        );
+        r.push_str(
+            "| group | filter | lift | seeds | penumbra RMSE | mean signed error | 10-90 % width (px) | exact width (px) | lit level | FLIP | bias^2 | variance |\n",
+        );
+        r.push_str("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (k, s, _) in groups {
+            let (filter, lift, _) = &self.references[*k];
+            let _ = writeln!(
+                r,
+                "| {} | {} | {} | {} | {:.5} +- {:.5} | {:+.5} +- {:.5} | {:.3} +- {:.3} | {:.3} | {:.5} | {:.4} | {:.2e} +- {:.1e} | {:.2e} |",
+                s.group,
+                filter_name(*filter),
+                lift.describe(),
+                s.seeds,
+                s.penumbra_rmse,
+                s.penumbra_rmse_ci95,
+                s.penumbra_bias,
+                s.penumbra_bias_ci95,
+                s.width_10_90_px,
+                s.width_10_90_px_ci95,
+                s.exact_width_10_90_px,
+                s.lit_mean,
+                s.flip_ldr_67ppd,
+                s.bias2,
+                s.bias2_ci95,
+                s.variance
+            );
+        }
+        r.push('\n');
+        for (filter, lift, reference) in &self.references {
+            let _ = writeln!(
+                r,
+                "Reference under the {} filter, lift {}: {} pixels judged; {} point evaluations reached the quadrature's depth limit.\n",
+                filter_name(*filter),
+                lift.describe(),
+                reference.judged().len(),
+                reference.depth_limited
+            );
+        }
+        r
+    }
+
+    /// Writes everything into `dir` (a staging folder).
+    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
+        let groups = self.groups();
+        let mut rows = csv::Writer::from_writer(Vec::new());
+        for (_, j, _) in &self.judged {
+            rows.serialize(j)?;
+        }
+        let mut summary = csv::Writer::from_writer(Vec::new());
+        let mut profile = csv::Writer::from_writer(Vec::new());
+        profile.write_record([
+            "group",
+            "pixel_filter",
+            "shadow_origin_lift",
+            "distance_px",
+            "mean_error",
+        ])?;
+        let mut series = Vec::new();
+        for (k, s, curve) in &groups {
+            let (filter, lift, _) = &self.references[*k];
+            summary.serialize(s)?;
+            for (d, e) in curve {
+                profile.write_record([
+                    s.group.clone(),
+                    filter_name(*filter).into(),
+                    lift.describe(),
+                    format!("{d:.4}"),
+                    format!("{e:.6e}"),
+                ])?;
+            }
+            series.push(Series {
+                name: format!("{} (lift {})", s.group, lift.describe()),
+                look: series.len(),
+                points: curve.iter().map(|&(d, e)| Point::bare(d, e)).collect(),
+            });
+        }
+        let provenance = Provenance {
+            build: Build::current(),
+            lifts: self.lifts.iter().map(|l| l.describe()).collect(),
+            inputs: vec![self.scene_input.clone()],
+            images: self.image_inputs.clone(),
+        };
+        super::write_files(
+            dir,
+            &[
+                ("judge.csv".into(), rows.into_inner()?),
+                ("groups.csv".into(), summary.into_inner()?),
+                ("profile.csv".into(), profile.into_inner()?),
+                ("report.md".into(), self.report(&groups).into_bytes()),
+                (PROVENANCE.into(), toml::to_string(&provenance)?.into_bytes()),
+            ],
+        )?;
+        for (filter, lift, r) in &self.references {
+            let name = format!(
+                "reference-{}-lift-{}.exr",
+                filter_name(*filter),
+                lift.describe().replace(' ', "")
+            );
+            super::write_files(
+                dir,
+                &[(name, crate::output::images::exr_bytes(&r.fraction, r.width, r.height)?)],
+            )?;
+        }
+        line_plot(
+            &dir.join("profile.png"),
+            &Axes::new(
+                "Mean signed error across the exact edge",
+                "signed distance to the exact 50 % contour (pixels; umbra side negative)",
+                "image - exact",
+                false,
+                false,
+            ),
+            &series,
+            &[],
+        )
+    }
+}
