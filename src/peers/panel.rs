@@ -2,11 +2,11 @@
 //! per pixel filter the images' exports record and shadow-ray lift), with what the judge
 //! writes: judge.csv (one row per image and lift), groups.csv (per group of seeds), profile.csv
 //! and profile.png (mean signed error across the exact edge), report.md, the references as
-//! EXRs, and provenance.toml (the build and the scene file that made it).
+//! EXRs, and provenance.toml ([`Provenance`]: the build and the scene file that made it).
 
 use super::judge::{error_profile, judge, read_radiance, summarise, GroupSummary, Judgement, Lift, Reference};
 use super::view::{ExportedView, PixelFilter, FILE};
-use crate::experiment::manifest::{Build, Input};
+use crate::experiment::manifest::{Build, Input, Provenance, PROVENANCE};
 use crate::files::Refused;
 use crate::output::plots::{line_plot, Axes, Point, Series};
 use crate::scene::Scene;
@@ -32,24 +32,6 @@ pub struct Panel {
     /// The images as read.
     pub image_inputs: Vec<Input>,
 }
-
-/// What the build and inputs of a judged folder were: the freshness check reads it as it reads
-/// an experiment's manifest.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Provenance {
-    /// The judge's build.
-    pub build: Build,
-    /// The lifts judged under.
-    pub lifts: Vec<String>,
-    /// The scene file (the one input in the repository).
-    pub inputs: Vec<Input>,
-    /// The judged images (made outside the repository, named for the record).
-    pub images: Vec<Input>,
-}
-
-/// File name of [`Provenance`] in a judged folder.
-pub const PROVENANCE: &str = "provenance.toml";
 
 /// Pixel filter names as the files write them.
 pub fn filter_name(p: PixelFilter) -> &'static str {

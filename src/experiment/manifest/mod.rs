@@ -11,12 +11,14 @@
 pub mod build;
 pub mod input;
 pub mod machine;
+pub mod provenance;
 pub mod run;
 pub mod staleness;
 
 pub use build::Build;
 pub use input::{tidy, Input};
 pub use machine::Machine;
+pub use provenance::{Provenance, PROVENANCE};
 pub use run::{peak_rss, utc, RunInfo};
 pub use staleness::{staleness, Problem};
 

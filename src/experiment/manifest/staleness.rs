@@ -56,7 +56,7 @@ pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
     for folder in &folders {
         // A folder of judged peers' images names its build and scene file as a manifest does,
         // but no experiment file made it.
-        let provenance = results.join(folder).join(crate::peers::panel::PROVENANCE);
+        let provenance = results.join(folder).join(super::PROVENANCE);
         if !results.join(folder).join("manifest.toml").exists() && provenance.exists() {
             match read_provenance(&provenance) {
                 Ok(p) => {
@@ -124,13 +124,12 @@ pub fn staleness(results: &Path, repo: &Path) -> Vec<Problem> {
 }
 
 /// A judged folder's provenance, or why it cannot be read.
-fn read_provenance(path: &Path) -> Result<crate::peers::panel::Provenance, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{} cannot be read: {e}", crate::peers::panel::PROVENANCE))?;
+fn read_provenance(path: &Path) -> Result<super::Provenance, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{} cannot be read: {e}", super::PROVENANCE))?;
     toml::from_str(&text).map_err(|e: toml::de::Error| {
         format!(
             "{} is not a judge's provenance: {}",
-            crate::peers::panel::PROVENANCE,
+            super::PROVENANCE,
             one_line(&e.to_string())
         )
     })
