@@ -36,8 +36,16 @@ fi
 "$venv/bin/pip" install -q "mitsuba==$MITSUBA_VERSION" numpy
 "$venv/bin/python" scripts/peers-mitsuba.py "$work/mitsuba" --spp "$SPP" --seeds "$SEEDS" --variant scalar_rgb
 
-target/release/judge "$work"/mitsuba/mitsuba-*.exr "$work"/penumbra/penumbra-*.exr \
-    --lift none,mitsuba3 --out "$work/judged"
+# Images in order of sample count (the report's rows follow it), Mitsuba's then penumbra's.
+images=()
+for renderer in mitsuba/mitsuba penumbra/penumbra-uniform; do
+    for spp in ${SPP//,/ }; do
+        for seed in $(seq 1 "$SEEDS"); do
+            images+=("$work/$renderer-spp$spp-seed$seed.exr")
+        done
+    done
+done
+target/release/judge "${images[@]}" --lift none,mitsuba3 --out "$work/judged"
 # The times and Mitsuba's pixel centres travel with the judged folder.
 cp "$work/mitsuba/scene.xml" "$work/judged/mitsuba-scene.xml"
 cp "$work/mitsuba/mitsuba-times.csv" "$work/mitsuba/mitsuba-pixel-centres.csv" "$work/penumbra/penumbra-times.csv" "$work/judged/"

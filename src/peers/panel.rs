@@ -8,7 +8,7 @@ use super::judge::{error_profile, judge, read_radiance, summarise, GroupSummary,
 use super::view::{ExportedView, PixelFilter, FILE};
 use crate::experiment::manifest::{Build, Input, Provenance, PROVENANCE};
 use crate::files::Refused;
-use crate::output::plots::{line_plot, Axes, Point, Series};
+use crate::output::plots::{line_panels, Axes, Panel as PlotPanel, Point, Series, LOOKS};
 use crate::scene::Scene;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -225,10 +225,12 @@ impl Panel {
             "distance_px",
             "mean_error",
         ])?;
-        let mut series = Vec::new();
+        // One panel per reference; a group keeps its look (by its first appearance) in each,
+        // and the plot draws the first LOOKS groups (profile.csv holds every one).
+        let mut names: Vec<&str> = Vec::new();
+        let mut panels: Vec<PlotPanel> = Vec::new();
         for (k, s, curve) in &groups {
             let (filter, lift, _) = &self.references[*k];
-            summary.serialize(s)?;
             for (d, e) in curve {
                 profile.write_record([
                     s.group.clone(),
@@ -238,11 +240,30 @@ impl Panel {
                     format!("{e:.6e}"),
                 ])?;
             }
-            series.push(Series {
-                name: format!("{} (lift {})", s.group, lift.describe()),
-                look: series.len(),
+            summary.serialize(s)?;
+            let look = match names.iter().position(|n| *n == s.group) {
+                Some(i) => i,
+                None => {
+                    names.push(&s.group);
+                    names.len() - 1
+                }
+            };
+            if look >= LOOKS {
+                continue;
+            }
+            let title = format!("{} filter, lift {}", filter_name(*filter), lift.describe());
+            let series = Series {
+                name: s.group.clone(),
+                look,
                 points: curve.iter().map(|&(d, e)| Point::bare(d, e)).collect(),
-            });
+            };
+            match panels.iter_mut().find(|p| p.title == title) {
+                Some(p) => p.series.push(series),
+                None => panels.push(PlotPanel {
+                    title,
+                    series: vec![series],
+                }),
+            }
         }
         let provenance = Provenance {
             build: Build::current(),
@@ -271,16 +292,21 @@ impl Panel {
                 &[(name, crate::output::images::exr_bytes(&r.fraction, r.width, r.height)?)],
             )?;
         }
-        line_plot(
+        // Across the exact penumbra and as far again on each side; outside it the error is 0.
+        let reach = self.judged.first().map_or(f64::NAN, |(_, j, _)| j.exact_extent_px);
+        line_panels(
             &dir.join("profile.png"),
-            &Axes::new(
-                "Mean signed error across the exact edge",
-                "signed distance to the exact 50 % contour (pixels; umbra side negative)",
-                "image - exact",
-                false,
-                false,
-            ),
-            &series,
+            &Axes {
+                x_range: reach.is_finite().then_some((-reach, reach)),
+                ..Axes::new(
+                    "Mean signed error across the exact edge",
+                    "distance to the exact 50 % contour (px, umbra < 0)",
+                    "image - exact",
+                    false,
+                    false,
+                )
+            },
+            &panels,
             &[],
         )
     }
