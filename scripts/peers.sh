@@ -10,8 +10,9 @@
 # 2. renders the Mitsuba scene at 16 to 4096 samples per pixel (one emitter sample each), four
 #    seeds each, with Mitsuba 3 from PyPI in a virtual environment under target/ (the test
 #    command never needs it);
-# 3. judges every image against the exact reference twice: with shadow rays from the surface
-#    (penumbra's) and lifted as Mitsuba 3 lifts them (--lift none,mitsuba3).
+# 3. judges every image against the exact reference (shadow rays from the surface, as penumbra
+#    traces them) and Mitsuba's also against the answer for shadow rays lifted as Mitsuba 3
+#    lifts them (its export records the lift).
 #
 # results/peers is replaced only when everything succeeded; the renders stay in target/peers.
 # Run it from a clean checkout of the commit the results will name, as scripts/regenerate.sh.
@@ -45,7 +46,7 @@ for renderer in mitsuba/mitsuba penumbra/penumbra-uniform; do
         done
     done
 done
-target/release/judge "${images[@]}" --lift none,mitsuba3 --out "$work/judged"
+target/release/judge "${images[@]}" --out "$work/judged"
 # The times and Mitsuba's pixel centres travel with the judged folder.
 cp "$work/mitsuba/scene.xml" "$work/judged/mitsuba-scene.xml"
 cp "$work/mitsuba/mitsuba-times.csv" "$work/mitsuba/mitsuba-pixel-centres.csv" "$work/penumbra/penumbra-times.csv" "$work/judged/"

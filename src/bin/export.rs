@@ -83,6 +83,7 @@ fn run(args: &Args) -> anyhow::Result<String> {
                 .join(", ")
         ))
     })?;
+    penumbra::peers::refuse_unmatched_effects(&scene, &args.scene)?;
     let scene_path = std::path::absolute(&args.scene)?;
     let (w, h) = args.size;
     let mut record = mitsuba::view_of(&scene_path, &bytes, &args.camera, w, h);
@@ -95,6 +96,7 @@ fn run(args: &Args) -> anyhow::Result<String> {
         }
         Target::Penumbra => {
             record.pixel = view::PixelFilter::Centre;
+            record.lift = "none".into();
             let mut backend = CpuBackend::default();
             let mut times = csv::Writer::from_writer(Vec::new());
             times.write_record(["image", "spp", "seed", "scheme", "shadow_rays", "seconds", "threads"])?;

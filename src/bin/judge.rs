@@ -1,6 +1,7 @@
-//! `judge IMAGE.exr... --out DIR [--lift none,mitsuba3]`: scores radiance images of an exported
-//! view (each beside the `view.toml` its export wrote: Mitsuba's renders, penumbra's own, any
-//! renderer's) against penumbra's exact reference, and writes the folder `penumbra::peers::panel`
+//! `judge IMAGE.exr... --out DIR`: scores radiance images of an exported view (each beside the
+//! `view.toml` its export wrote: Mitsuba's renders, penumbra's own, any renderer's) against
+//! penumbra's exact reference (and, for a renderer whose export records a shadow-ray lift, the
+//! answer for that lift too), and writes the folder `penumbra::peers::panel`
 //! describes (judge.csv, groups.csv, profile.csv/png, report.md, reference EXRs,
 //! provenance.toml). Exit status: 0 done, 2 bad input (an image of another view, size or scene;
 //! a non-EXR; missing channels; a non-finite pixel; a scene without an exact answer), 1 else.
@@ -8,7 +9,6 @@
 use clap::Parser;
 use penumbra::experiment::cli::{print_out, report_error};
 use penumbra::files::Refused;
-use penumbra::peers::judge::Lift;
 use penumbra::peers::panel::Panel;
 use penumbra::peers::write_folder;
 use std::path::PathBuf;
@@ -24,17 +24,12 @@ struct Args {
     /// The folder written (replaced as a whole, only once everything is written).
     #[arg(long)]
     out: PathBuf,
-    /// The references to judge against, by where shadow rays start: `none` (on the surface, as
-    /// penumbra traces them), `mitsuba3` (Mitsuba 3's offset along the normal, 1.2e-4 m near
-    /// the shipped sphere scene's edge) or a lift in metres; several, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "none")]
-    lift: Vec<Lift>,
 }
 
 fn main() -> std::process::ExitCode {
     let args = Args::parse();
     let run = || -> anyhow::Result<()> {
-        let panel = Panel::judge(&args.images, &args.lift)?;
+        let panel = Panel::judge(&args.images)?;
         write_folder(&args.out, |dir| panel.write(dir))?;
         print_out(&panel.report(&panel.groups()))?;
         Ok(())

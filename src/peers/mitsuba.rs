@@ -56,7 +56,7 @@ pub struct Export {
 /// file would simulate differently: mirrors, ambient occlusion, shading without shadows; a view
 /// that sees a light's disk).
 pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<Export> {
-    refuse_unmatched_effects(scene, view)?;
+    super::refuse_unmatched_effects(scene, &view.scene)?;
     refuse_visible_lights(scene, camera, view)?;
     let mut x = String::new();
     let f = |v: f64| format!("{v:?}");
@@ -235,27 +235,6 @@ fn extent(scene: &Scene, camera: &Camera) -> f64 {
     r.max(1.0)
 }
 
-/// Refuses effects the exported file would not simulate as penumbra does.
-fn refuse_unmatched_effects(scene: &Scene, view: &ExportedView) -> anyhow::Result<()> {
-    let scene_name = view.scene.display();
-    let unmatched = if scene.has_mirrors() {
-        Some("mirror reflections (a mirror weight above zero)")
-    } else if scene.ambient.is_some() {
-        Some("ambient occlusion")
-    } else if !scene.shading.shadows {
-        Some("shading without shadow rays")
-    } else {
-        None
-    };
-    match unmatched {
-        Some(what) => Err(Refused(format!(
-            "{scene_name}: asks for {what}, which the exported file would not simulate as penumbra does; export scenes of direct lighting with shadows"
-        ))
-        .into()),
-        None => Ok(()),
-    }
-}
-
 /// Refuses a view in which a pixel's camera ray meets a disk light before any surface: such a
 /// disk is a surface in Mitsuba and nothing in penumbra.
 fn refuse_visible_lights(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<()> {
@@ -313,5 +292,6 @@ pub fn view_of(
         height,
         plane: 0,
         pixel: PixelFilter::Box,
+        lift: "mitsuba3".into(),
     }
 }

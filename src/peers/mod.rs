@@ -13,7 +13,31 @@ pub mod view;
 
 use crate::experiment::outputs::{resolve_home, Outputs};
 use crate::files::Refused;
+use crate::scene::Scene;
 use std::path::Path;
+
+/// Refuses effects beyond direct lighting with shadows (mirrors, ambient occlusion, shading
+/// without shadow rays): an exported file would simulate them otherwise than penumbra, and the
+/// exact reference has no answer for them.
+pub fn refuse_unmatched_effects(scene: &Scene, name: &Path) -> anyhow::Result<()> {
+    let unmatched = if scene.has_mirrors() {
+        Some("mirror reflections (a mirror weight above zero)")
+    } else if scene.ambient.is_some() {
+        Some("ambient occlusion")
+    } else if !scene.shading.shadows {
+        Some("shading without shadow rays")
+    } else {
+        None
+    };
+    match unmatched {
+        Some(what) => Err(Refused(format!(
+            "{}: asks for {what}, which neither an exported file nor the exact reference simulates as penumbra does; export and judge scenes of direct lighting with shadows",
+            name.display()
+        ))
+        .into()),
+        None => Ok(()),
+    }
+}
 
 /// Replaces the folder `out` with what `write` puts into the folder it is given, in one step:
 /// a failed write leaves the earlier folder whole.

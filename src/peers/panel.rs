@@ -21,7 +21,7 @@ pub type Group = (usize, GroupSummary, Vec<(f64, f64)>);
 pub struct Panel {
     /// The view all images share.
     pub view: ExportedView,
-    /// The lifts asked for.
+    /// The lifts judged under: none, and each image's renderer's own.
     pub lifts: Vec<Lift>,
     /// One reference per (filter, lift) used.
     pub references: Vec<(PixelFilter, Lift, Reference)>,
@@ -42,11 +42,25 @@ pub fn filter_name(p: PixelFilter) -> &'static str {
 }
 
 impl Panel {
-    /// Judges `images` (each beside its export's view.toml; one scene, camera and size) under
-    /// each of `lifts`.
-    pub fn judge(images: &[PathBuf], lifts: &[Lift]) -> anyhow::Result<Panel> {
+    /// Judges `images` (each beside its export's view.toml; one scene, camera and size; no file
+    /// or file name twice, since a name is a seed of its group) against the exact answer and,
+    /// where an image's export records a shadow-ray lift, against the answer for that lift too.
+    pub fn judge(images: &[PathBuf]) -> anyhow::Result<Panel> {
         let mut views = Vec::new();
+        let mut lifts = vec![Lift::None];
+        let mut seen: Vec<(PathBuf, std::ffi::OsString)> = Vec::new();
         for image in images {
+            let canonical = image.canonicalize().unwrap_or_else(|_| image.clone());
+            let name = image.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+            if let Some((earlier, _)) = seen.iter().find(|(c, n)| *c == canonical || *n == name) {
+                return Err(Refused(format!(
+                    "{}: given twice, or named as {} is (an image's name is a seed of its group); give each image once, named apart",
+                    image.display(),
+                    earlier.display()
+                ))
+                .into());
+            }
+            seen.push((canonical, name));
             let record = image.parent().unwrap_or(Path::new(".")).join(FILE);
             if !record.is_file() {
                 return Err(Refused(format!(
@@ -55,8 +69,18 @@ impl Panel {
                 ))
                 .into());
             }
-            views.push(ExportedView::read(&record)?);
+            let view = ExportedView::read(&record)?;
+            let lift: Lift = view
+                .lift
+                .parse()
+                .map_err(|e| Refused(format!("{}: `lift`: {e}", record.display())))?;
+            if !lifts.contains(&lift) {
+                lifts.push(lift);
+            }
+            views.push((view, lift));
         }
+        let own_lifts: Vec<Lift> = views.iter().map(|v| v.1).collect();
+        let views: Vec<ExportedView> = views.into_iter().map(|v| v.0).collect();
         let first = views
             .first()
             .cloned()
@@ -105,8 +129,11 @@ impl Panel {
         }
         let mut references: Vec<(PixelFilter, Lift, Reference)> = Vec::new();
         let mut judged = Vec::new();
-        for &lift in lifts {
-            for ((v, image), l) in views.iter().zip(images).zip(&radiance) {
+        for &lift in &lifts {
+            for (((v, image), l), own) in views.iter().zip(images).zip(&radiance).zip(&own_lifts) {
+                if lift != Lift::None && lift != *own {
+                    continue;
+                }
                 let k = match references.iter().position(|(f, g, _)| *f == v.pixel && *g == lift) {
                     Some(k) => k,
                     None => {
@@ -126,7 +153,7 @@ impl Panel {
             scene_input: Input::read(&first.scene)?,
             image_inputs: images.iter().map(|i| Input::read(i)).collect::<std::io::Result<_>>()?,
             view: first,
-            lifts: lifts.to_vec(),
+            lifts,
             references,
             judged,
         })
@@ -161,8 +188,9 @@ impl Panel {
         let mut r = format!(
             "# Judged against the exact reference\n\nScene `{}` (FNV-1a {}), camera `{}`, {} x {} pixels, plane {}. Each image's \
              radiance is divided by the exact unoccluded radiance of its pixel and compared with the exact fraction \
-             (irradiance-weighted), under the pixel filter its export records and each shadow-ray lift asked for (`none`: rays \
-             from the surface, as penumbra traces them; `mitsuba3`: Mitsuba 3's offset along the normal). The penumbra is the \
+             (irradiance-weighted), under the pixel filter its export records, for shadow rays from the surface (lift `none`, \
+             as penumbra traces them) and, for a renderer whose export records one, from its own lift \
+             (`mitsuba3`: Mitsuba 3's offset along the normal). The penumbra is the \
              exact image's (fraction strictly between 0.001 and 0.999); widths are across the exact edge, in pixels; FLIP is \
              LDR (8-bit grey) at 67.02 pixels per degree; intervals are 95 % over seeds. The mean signed error's shape across \
              the edge is in profile.csv (profile.png).\n\n",

@@ -37,6 +37,10 @@ pub struct ExportedView {
     pub plane: usize,
     /// The pixel filter the exported renderer applies.
     pub pixel: PixelFilter,
+    /// Where the exported renderer starts shadow rays ([`super::judge::Lift`]): `none` (on the
+    /// surface, penumbra) or `mitsuba3`; images are judged against the exact answer and, where
+    /// this is not `none`, against the answer for their renderer's own lift too.
+    pub lift: String,
 }
 
 /// File name of the record in an export folder.

@@ -296,10 +296,12 @@ fn images_that_are_not_of_the_view_are_refused() {
         ],
     );
     assert_eq!(code, 0, "{err}");
-    refused(
-        &[&good, &other.join("penumbra-uniform-spp4-seed1.exr")],
-        "judge one view at a time",
-    );
+    std::fs::rename(
+        other.join("penumbra-uniform-spp4-seed1.exr"),
+        other.join("elsewhere-seed1.exr"),
+    )
+    .unwrap();
+    refused(&[&good, &other.join("elsewhere-seed1.exr")], "judge one view at a time");
     // An export of a copy of the scene, then the copy edited.
     let copy = dir.path().join("copy.toml");
     std::fs::copy(sphere(), &copy).unwrap();
@@ -334,6 +336,92 @@ fn images_that_are_not_of_the_view_are_refused() {
         &[&edited.join("penumbra-uniform-spp4-seed1.exr")],
         "changed since the export",
     );
+    // One image twice, or two images of one name (a name is a seed of its group).
+    refused(&[&good, &good], "given twice");
+    let twin = dir.path().join("twin");
+    let (code, err) = run(
+        "export",
+        &[
+            &sphere(),
+            "--camera",
+            "measure",
+            "--size",
+            "32x8",
+            "--to",
+            "penumbra",
+            "--spp",
+            "4",
+            "--seeds",
+            "1",
+            "--out",
+            path(&twin),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    refused(
+        &[&good, &twin.join("penumbra-uniform-spp4-seed1.exr")],
+        "given twice, or named as",
+    );
+}
+
+/// Scenes without a soft shadow of one disk light to judge on the view: the light under the
+/// plane (no judged pixel), two lights, shading without shadow rays; each refused, naming it.
+#[test]
+fn views_without_a_shadow_to_judge_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(common::repo("experiments/scenes/sphere.toml")).unwrap();
+    let cases = [
+        ("below", base.replace("center = [0.0, 0.0, 2.0]", "center = [0.0, 0.0, -2.0]"), "nothing to judge"),
+        (
+            "two",
+            format!("{base}\n[[lights]]\ntype = \"disk\"\ncenter = [0.5, 0.0, 2.0]\nnormal = [0.0, 0.0, -1.0]\nradius = 0.02\npower = 60.0\nsamples = 4\n"),
+            "holds 2 light(s)",
+        ),
+        ("unshadowed", format!("{base}\n[shading]\nshadows = false\n"), "shading without shadow rays"),
+    ];
+    for (name, text, needle) in cases {
+        let scene = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&scene, text).unwrap();
+        let out = dir.path().join(name);
+        let (code, err) = run(
+            "export",
+            &[
+                path(&scene),
+                "--camera",
+                "measure",
+                "--size",
+                "16x4",
+                "--to",
+                "penumbra",
+                "--spp",
+                "4",
+                "--seeds",
+                "1",
+                "--out",
+                path(&out),
+            ],
+        );
+        let err = if code == 0 {
+            let (code, err) = run(
+                "judge",
+                &[
+                    path(&out.join("penumbra-uniform-spp4-seed1.exr")),
+                    "--out",
+                    path(&dir.path().join("j")),
+                ],
+            );
+            assert_eq!(code, 2, "{name}: {err}");
+            err
+        } else {
+            assert_eq!(code, 2, "{name}: {err}");
+            err
+        };
+        assert!(
+            err.contains(needle) && err.contains(&format!("{name}.toml")),
+            "{name}: {err}"
+        );
+        assert!(!dir.path().join("j").exists(), "{name}: a refused judge writes nothing");
+    }
 }
 
 /// A CSV as one map per row.
@@ -380,11 +468,9 @@ fn committed_peers_recompute_from_their_csvs() {
             ("width_10_90_px", "width_10_90_px_ci95", "width_10_90_px"),
         ] {
             let m = mean_ci(&col(column));
-            assert!(
-                (m.mean - num(mean)).abs() <= 1e-12 * m.mean.abs().max(1.0),
-                "{mean} {g:?}"
-            );
-            assert!((m.ci95 - num(ci)).abs() <= 1e-12 * m.ci95.abs().max(1.0), "{ci} {g:?}");
+            let same = |a: f64, b: f64| (a.is_nan() && b.is_nan()) || (a - b).abs() <= 1e-12 * a.abs().max(1.0);
+            assert!(same(m.mean, num(mean)), "{mean} {g:?}");
+            assert!(same(m.ci95, num(ci)), "{ci} {g:?}");
         }
         let mse: f64 = col("penumbra_rmse").iter().map(|r| r * r).sum::<f64>() / members.len() as f64;
         assert!(
