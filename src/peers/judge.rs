@@ -375,10 +375,7 @@ pub fn judge(
     Ok(Judgement {
         image: image.to_string(),
         group: group_of(&stem),
-        pixel_filter: match filter {
-            PixelFilter::Centre => "centre",
-            PixelFilter::Box => "box",
-        },
+        pixel_filter: filter.name(),
         shadow_origin_lift: lift.describe(),
         pixels: all.pixels.len(),
         penumbra_pixels: penumbra.pixels.len(),

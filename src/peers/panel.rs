@@ -33,14 +33,6 @@ pub struct Panel {
     pub image_inputs: Vec<Input>,
 }
 
-/// Pixel filter names as the files write them.
-pub fn filter_name(p: PixelFilter) -> &'static str {
-    match p {
-        PixelFilter::Centre => "centre",
-        PixelFilter::Box => "box",
-    }
-}
-
 impl Panel {
     /// Judges `images` (each beside its export's view.toml; one scene, camera and size; no file
     /// or file name twice, since a name is a seed of its group) against the exact answer and,
@@ -206,7 +198,7 @@ impl Panel {
                 r,
                 "| {} | {} | {} | {} | {:.5} +- {:.5} | {:+.5} +- {:.5} | {:.3} +- {:.3} | {:.3} | {:.5} | {:.4} | {:.2e} +- {:.1e} | {:.2e} |",
                 s.group,
-                filter_name(*filter),
+                filter.name(),
                 lift.describe(),
                 s.seeds,
                 s.penumbra_rmse,
@@ -228,7 +220,7 @@ impl Panel {
             let _ = writeln!(
                 r,
                 "Reference under the {} filter, lift {}: {} pixels judged; {} point evaluations reached the quadrature's depth limit.\n",
-                filter_name(*filter),
+                filter.name(),
                 lift.describe(),
                 reference.judged().len(),
                 reference.depth_limited
@@ -262,7 +254,7 @@ impl Panel {
             for (d, e) in curve {
                 profile.write_record([
                     s.group.clone(),
-                    filter_name(*filter).into(),
+                    filter.name().into(),
                     lift.describe(),
                     format!("{d:.4}"),
                     format!("{e:.6e}"),
@@ -279,7 +271,7 @@ impl Panel {
             if look >= LOOKS {
                 continue;
             }
-            let title = format!("{} filter, lift {}", filter_name(*filter), lift.describe());
+            let title = format!("{} filter, lift {}", filter.name(), lift.describe());
             let series = Series {
                 name: s.group.clone(),
                 look,
@@ -312,7 +304,7 @@ impl Panel {
         for (filter, lift, r) in &self.references {
             let name = format!(
                 "reference-{}-lift-{}.exr",
-                filter_name(*filter),
+                filter.name(),
                 lift.describe().replace(' ', "")
             );
             super::write_files(

@@ -18,6 +18,16 @@ pub enum PixelFilter {
     Box,
 }
 
+impl PixelFilter {
+    /// The name the files write (`centre`, `box`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PixelFilter::Centre => "centre",
+            PixelFilter::Box => "box",
+        }
+    }
+}
+
 /// What was exported: enough to rebuild the exact reference of the view.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
