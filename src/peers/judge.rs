@@ -28,7 +28,6 @@ use crate::reference::{irradiance_fraction_estimate, occluders};
 use crate::render::cpu::closest_hit;
 use crate::render::NO_RECEIVER;
 use crate::scene::{Light, Scene};
-use anyhow::Context;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::path::Path;
@@ -518,22 +517,7 @@ pub fn summarise(reference: &Reference, judged: &[(Judgement, Vec<f32>)]) -> Vec
 /// whose size must be the view's; refused with its path (not an EXR, another size, other
 /// channels).
 pub fn read_radiance(path: &Path, view: &ExportedView) -> anyhow::Result<Vec<f32>> {
-    use exr::prelude::*;
-    use std::io::{Read, Seek};
-    let mut file = crate::files::open_regular(path)?;
-    crate::output::page::rebuild::check_exr_header(path, &file)?;
-    let mut bytes = Vec::new();
-    file.rewind()
-        .and_then(|_| file.read_to_end(&mut bytes))
-        .with_context(|| format!("reading {}", path.display()))?;
-    let img = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(std::io::Cursor::new(bytes))
-        .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
+    let img = crate::output::page::rebuild::read_exr_layer(path)?;
     let size = img.layer_data.size;
     if (size.width() as u32, size.height() as u32) != (view.width, view.height) {
         return Err(Refused(format!(

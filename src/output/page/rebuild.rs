@@ -203,7 +203,7 @@ fn natural(name: &str) -> Vec<(u128, String)> {
 /// longer than its declared pixels stored raw, plus an eighth and a MiB (a sparse file of
 /// gigabytes behind a small header). A compressed file a few MB long can declare gigabytes of
 /// pixels.
-pub(crate) fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
+fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Result<()> {
     use crate::config::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
     let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
         .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
@@ -244,9 +244,11 @@ pub(crate) fn check_exr_header(path: &Path, file: &std::fs::File) -> anyhow::Res
     Ok(())
 }
 
-/// A one-channel EXR's values, width and height, its header checked first
-/// ([`check_exr_header`]).
-fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
+/// The first valid layer of the EXR at `path`, every channel, its header checked first
+/// ([`check_exr_header`]); a file that is not a readable EXR is refused with its path.
+pub(crate) fn read_exr_layer(
+    path: &Path,
+) -> anyhow::Result<exr::prelude::Image<exr::prelude::Layer<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>>> {
     use exr::prelude::*;
     use std::io::{Read, Seek};
     let mut file = crate::files::open_regular(path)?;
@@ -255,14 +257,19 @@ fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
     file.rewind()
         .and_then(|_| file.read_to_end(&mut bytes))
         .with_context(|| format!("reading {}", path.display()))?;
-    let img = read()
+    read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
         .all_attributes()
         .from_buffered(std::io::Cursor::new(bytes))
-        .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())))?;
+        .map_err(|e| Refused(format!("{}: not a readable EXR image: {e}", path.display())).into())
+}
+
+/// A one-channel EXR's values, width and height ([`read_exr_layer`]).
+fn read_exr(path: &Path) -> anyhow::Result<(Vec<f32>, u32, u32)> {
+    let img = read_exr_layer(path)?;
     let size = img.layer_data.size;
     let channel = img
         .layer_data
