@@ -26,6 +26,7 @@ pub mod brute;
 pub mod bundle;
 pub mod bvh;
 pub mod cwbvh;
+pub mod embree;
 pub mod kdtree;
 pub mod memory;
 pub mod settings;
@@ -307,6 +308,13 @@ pub struct Registered {
     /// paper Section 8; a BVH's refit; a rebuild): what [`Accelerator::update`] takes, and how
     /// many copies of it a moving scene times.
     pub updates: &'static [UpdateMethod],
+    /// Whether its answers are the f64 reference's (every structure whose leaves run the
+    /// project's f64 triangle test): experiments require an exact structure's images to equal
+    /// the others' bit for bit, and count where an inexact one's (Embree's f32 tests) differ.
+    pub exact: bool,
+    /// Whether its CPU walk counts nodes and primitive tests ([`work`]); where not (Embree
+    /// exposes no counters), tables leave those columns empty rather than write zeros.
+    pub counts_work: bool,
 }
 
 /// The ball (centre, radius) a structure built over some triangles can follow them within.
@@ -329,6 +337,8 @@ pub const REGISTRY: &[Registered] = &[
         // with its own preset; a rebuild with obvhs' fastest preset, what an engine would do per
         // frame (the fastest tree to build, slower to walk).
         updates: &[UpdateMethod::Refit, UpdateMethod::Rebuild, UpdateMethod::RebuildFastest],
+        exact: true,
+        counts_work: true,
     },
     Registered {
         name: "brute",
@@ -341,6 +351,8 @@ pub const REGISTRY: &[Registered] = &[
         memory: |n, _| n as u64 * 72,
         follows_within: None,
         updates: &[UpdateMethod::Rebuild],
+        exact: true,
+        counts_work: true,
     },
     Registered {
         name: "vlf",
@@ -355,6 +367,8 @@ pub const REGISTRY: &[Registered] = &[
         // The object's ids removed from every tile it covered and inserted again where it now
         // is (paper Section 8).
         updates: &[UpdateMethod::InPlace],
+        exact: true,
+        counts_work: true,
     },
     Registered {
         name: "kdtree",
@@ -372,6 +386,8 @@ pub const REGISTRY: &[Registered] = &[
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
         updates: &[UpdateMethod::Rebuild],
+        exact: true,
+        counts_work: true,
     },
     Registered {
         name: "kdtree-sah",
@@ -390,6 +406,8 @@ pub const REGISTRY: &[Registered] = &[
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
         updates: &[UpdateMethod::Rebuild],
+        exact: true,
+        counts_work: true,
     },
     Registered {
         name: "cwbvh",
@@ -408,6 +426,24 @@ pub const REGISTRY: &[Registered] = &[
         memory: |n, _| n as u64 * (4 + 72),
         follows_within: None,
         updates: &[UpdateMethod::Rebuild],
+        exact: true,
+        counts_work: true,
+    },
+    Registered {
+        name: "embree",
+        wgsl: "",
+        gpu: false,
+        gpu_buffers: 0,
+        params: settings::validate::<embree::EmbreeSettings>,
+        tuning: <embree::EmbreeSettings as settings::Params>::tuning,
+        build: |t, s| Ok(Arc::new(embree::Embree::build(t, s.typed())?)),
+        // Its vertex and index buffers (48 bytes a triangle), the f64 copy, and at least a
+        // leaf reference per triangle.
+        memory: |n, _| n as u64 * (48 + 72 + 4),
+        follows_within: None,
+        updates: &[UpdateMethod::Rebuild],
+        exact: false,
+        counts_work: false,
     },
 ];
 

@@ -79,6 +79,16 @@ impl SettingsPlaces {
         })
     }
 
+    /// The first of `names` without a GPU form ([`crate::accel::Registered::gpu`]), located at
+    /// its place in the file: what the GPU backend cannot run ([`crate::experiment::Experiment::gpu_gap`]).
+    pub fn gpu_gap<'a>(&self, names: impl IntoIterator<Item = &'a str>) -> Option<String> {
+        let name = names
+            .into_iter()
+            .find(|n| crate::accel::registered(n).is_some_and(|r| !r.gpu))?;
+        let message = format!("`{name}` has no GPU form (it runs on the CPU backend only)");
+        Some(self.error(name, message.clone()).map_or(message, |e| e.to_string()))
+    }
+
     /// `e` located where it is a device's refusal ([`DeviceLimit`]): a structure's at its
     /// settings, a frame's at the key that set its size; any other error as it is.
     pub fn locate(&self, e: anyhow::Error) -> anyhow::Error {

@@ -95,10 +95,12 @@ fn render(b: &mut dyn Backend, s: &Scene, cam: &Camera) -> Frame {
 }
 
 /// The structure's CPU queries against `accel::brute_force` on seeded rays through the meshes'
-/// bounding box: same triangle, same t; any-hit agrees with a closest hit existing.
+/// bounding box: same triangle, same t; any-hit agrees with a closest hit existing. (An
+/// inexact structure, Embree's f32 tests, is held to brute force but for edge grazes by its own
+/// tests.)
 #[test]
 fn every_structure_matches_brute_force_on_the_cpu() {
-    for r in REGISTRY {
+    for r in REGISTRY.iter().filter(|r| r.exact) {
         let s = scene(r.name);
         let a = s.accel.as_ref().unwrap();
         assert_eq!(a.name(), r.name);
@@ -132,7 +134,7 @@ fn vertex_aimed_rays_on_the_body_match_brute_force() {
     let body = Scene::load(&common::repo("experiments/scenes/body.toml")).unwrap();
     let t = &body.triangles;
     let stream = Stream::new(1, 0, None);
-    for r in REGISTRY {
+    for r in REGISTRY.iter().filter(|r| r.exact) {
         let s = body.clone().with_accelerator(AccelSettings::default_for(r));
         let a = s.accel.as_ref().unwrap();
         let mut wrong = 0;
@@ -146,6 +148,22 @@ fn vertex_aimed_rays_on_the_body_match_brute_force() {
             wrong += (a.any_hit(o, d, f64::INFINITY, u32::MAX) != want.is_some()) as u32;
         }
         assert_eq!(wrong, 0, "{}: {wrong} answers differ from brute force", r.name);
+    }
+}
+
+/// An inexact structure's frame (Embree's f32 triangle tests) against the exact one: the same
+/// surface seen in every pixel but 1 %, and shadows that differ in at most 1 % of the
+/// visibility samples' worth (a ray grazing an edge decided the other way).
+fn inexact_frame_is_close(name: &str, got: &Frame, want: &Frame) {
+    let n = want.hit.len();
+    let hits = got.hit.iter().zip(&want.hit).filter(|(a, b)| a != b).count();
+    assert!(hits * 100 <= n, "{name}: {hits} of {n} pixels see another surface");
+    for (light, (g, w)) in got.visibility.iter().zip(&want.visibility).enumerate() {
+        let moved: f64 = g.iter().zip(w).map(|(a, b)| (a - b).abs() as f64).sum();
+        assert!(
+            moved <= 0.01 * n as f64,
+            "{name}: light {light}'s visibility moved by {moved} over {n} pixels"
+        );
     }
 }
 
@@ -170,6 +188,10 @@ fn frames_do_not_depend_on_the_structure() {
                 continue;
             }
             let got = render(b, &scene(r.name), &cam);
+            if !r.exact {
+                inexact_frame_is_close(r.name, &got, &want);
+                continue;
+            }
             assert_eq!(got.hit, want.hit, "{name}: {} hits", r.name);
             assert_eq!(got.visibility, want.visibility, "{name}: {} visibility", r.name);
             assert_eq!(got.radiance, want.radiance, "{name}: {} radiance", r.name);

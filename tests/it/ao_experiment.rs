@@ -267,3 +267,78 @@ fn the_ci_experiment_runs_on_the_gpu() {
         );
     }
 }
+
+/// Embree in the ao kind (CPU only): its rows leave the work counters empty (it exposes none)
+/// and count the pixels its f32 answers change against the first exact structure's image; the
+/// report sets every structure's per-thread throughput against Embree's from the same rounds;
+/// asked for on the GPU, the run is refused before any work at `[accel.embree]`.
+#[test]
+fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::repo("experiments/ao-ci.toml"))
+        .unwrap()
+        .replace("../assets/", &format!("{}/", common::repo("assets").display()))
+        .replace("\"cwbvh\", \"brute\"]", "\"cwbvh\", \"brute\", \"embree\"]")
+        .replace("issue = [\"single\", \"bundled\"]", "issue = [\"single\"]")
+        + "\n[accel.embree]\nquality = \"medium\"\n";
+    let exp = dir.path().join("ao-embree.toml");
+    std::fs::write(&exp, &text).unwrap();
+    let out = dir.path().join("out");
+    common::run_experiment(&exp, &out, &["--backend", "cpu"]);
+    let (header, rows) = common::table(&out.join("ao.csv"));
+    let col = |name: &str| common::column(&header, name);
+    let embree: Vec<_> = rows.iter().filter(|r| &r[col("structure")] == "embree").collect();
+    assert_eq!(embree.len(), 2, "one row per mesh");
+    for r in &embree {
+        assert_eq!(
+            (&r[col("nodes_visited")], &r[col("primitive_tests")]),
+            ("", ""),
+            "{r:?}"
+        );
+        assert_eq!(&r[col("embree_quality")], "medium", "{r:?}");
+        let (same, differing) = (
+            &r[col("same_image_as_first")],
+            r[col("differing_pixels")].parse::<usize>().unwrap(),
+        );
+        assert_eq!(same == "true", differing == 0, "{r:?}");
+        assert!(differing * 100 <= 24 * 24, "{r:?}");
+        assert!(r[col("rays_per_s")].parse::<f64>().unwrap() > 0.0);
+    }
+    for r in rows.iter().filter(|r| &r[col("structure")] != "embree") {
+        assert_eq!(
+            (&r[col("same_image_as_first")], &r[col("differing_pixels")]),
+            ("true", "0"),
+            "{r:?}"
+        );
+        assert!(r[col("primitive_tests")].parse::<u64>().unwrap() > 0, "{r:?}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("every exact structure's AO image equals"), "{report}");
+    assert!(
+        report.contains("**Inexact structures**") && report.contains("embree on cow:"),
+        "{report}"
+    );
+    assert!(
+        report.contains("## Per thread") && report.contains("| speed vs embree |"),
+        "{report}"
+    );
+    assert!(
+        report.contains("| cow | vlf | ") && report.contains("| cow | embree | "),
+        "{report}"
+    );
+    // The GPU backend cannot run it: refused at its settings, nothing written.
+    let refused = dir.path().join("gpu");
+    let (code, err) = common::sweep(&[
+        exp.as_os_str(),
+        "--out".as_ref(),
+        refused.as_os_str(),
+        "--backend".as_ref(),
+        "gpu".as_ref(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("ao-embree.toml:") && err.contains("accel.embree") && err.contains("no GPU form"),
+        "{err}"
+    );
+    assert!(!refused.exists());
+}

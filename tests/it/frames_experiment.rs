@@ -560,3 +560,41 @@ fn a_moving_part_runs_on_the_gpu() {
     assert_eq!(rows.len(), 2 * 3 * 7, "2 shadings x 3 frames x 7 update methods");
     assert!(rows.iter().any(|r| &r[col("update")] == "refit"));
 }
+
+/// Embree listed first in the CI walkthrough: the exact structures are held to the first exact
+/// one's frames (zero differing pixels), Embree's f32 answers are counted against them and kept
+/// apart from the exactness line, and its rows leave the work counters empty.
+#[test]
+fn embree_is_measured_against_the_first_exact_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = ci().replace(
+        "structures = [\"kdtree\", \"vlf\", \"bvh\", \"cwbvh\", \"brute\"]",
+        "structures = [\"embree\", \"kdtree\", \"vlf\", \"bvh\"]",
+    );
+    let (header, rows, report) = run(dir.path(), &text);
+    let col = |name: &str| common::column(&header, name);
+    let pixels = 32 * 32;
+    let mut embree = 0;
+    for r in &rows {
+        let differing: usize = r[col("differing_pixels")].parse().unwrap();
+        if &r[col("structure")] == "embree" {
+            embree += 1;
+            assert_eq!(
+                (&r[col("nodes_visited")], &r[col("primitive_tests")]),
+                ("", ""),
+                "{r:?}"
+            );
+            assert!(differing * 100 <= pixels, "{r:?}");
+        } else {
+            assert_eq!(differing, 0, "{r:?}");
+            assert!(r[col("primitive_tests")].parse::<u64>().unwrap() > 0, "{r:?}");
+        }
+    }
+    assert_eq!(embree, 2 * 3, "both shadings, 3 frames");
+    assert!(
+        report.contains("every exact structure's frame equals the first exact structure's"),
+        "{report}"
+    );
+    assert!(!report.contains("Exactness FAILED"), "{report}");
+    assert!(report.contains("no work counters"), "{report}");
+}

@@ -131,6 +131,10 @@ impl Declaration for AoSpec {
         true
     }
 
+    fn gpu_gap(&self) -> Option<String> {
+        self.places.gpu_gap(self.structures.iter().map(|(s, _)| *s))
+    }
+
     fn backend(&self) -> crate::render::BackendChoice {
         crate::render::BackendChoice::Cpu
     }

@@ -54,8 +54,16 @@ pub struct AoRow {
     pub receivers: usize,
     /// Mean AO over those pixels.
     pub mean_ao: f64,
-    /// Whether the AO image equals the first structure's bit for bit.
+    /// Whether the AO image equals the reference image (the first exact structure's on the
+    /// mesh) bit for bit.
     pub same_image: bool,
+    /// Pixels whose AO differs from the reference image's.
+    #[serde(default)]
+    pub differing_pixels: usize,
+    /// Mean AO difference from the reference image over its receivers (this image's minus the
+    /// reference's; an inexact structure's extra or lost occluders in one number).
+    #[serde(default)]
+    pub ao_difference: f64,
     /// The AO image (receivers in [0, 1], else -1).
     pub image: Vec<f32>,
 }
@@ -220,14 +228,13 @@ fn tune(
 }
 
 /// One untimed frame of `scene` (`structure` at `settings`, rays issued as `issue`): its image,
-/// rays and work, and whether the image equals `first` (the mesh's first image, kept).
+/// rays and work (compared with the reference image by [`compare`]).
 fn measure(
     spec: &AoSpec,
     mesh: &AoMesh,
     (structure, settings, issue): (&'static str, &AccelSettings, Issue),
     scene: &Scene,
     backend: &mut dyn Backend,
-    first: &mut Option<Vec<f32>>,
 ) -> anyhow::Result<AoRow> {
     let stats = scene.accel.as_ref().expect("a mesh scene has a structure").stats();
     let view = View {
@@ -238,8 +245,6 @@ fn measure(
     let frame = backend.render(scene, view, SAMPLING)?;
     let image = frame.ambient.expect("the scene asks for ambient occlusion");
     let seen: Vec<f64> = image.iter().filter(|&&v| v >= 0.0).map(|&v| v as f64).collect();
-    let same_image = first.as_ref().is_none_or(|f| *f == image);
-    first.get_or_insert_with(|| image.clone());
     Ok(AoRow {
         mesh: mesh.name.clone(),
         triangles: mesh.triangles.positions.len(),
@@ -254,9 +259,38 @@ fn measure(
         work: frame.work,
         receivers: seen.len(),
         mean_ao: seen.iter().sum::<f64>() / seen.len().max(1) as f64,
-        same_image,
+        same_image: true,
+        differing_pixels: 0,
+        ao_difference: 0.0,
         image,
     })
+}
+
+/// Compares every row's image of one mesh with the reference: the first exact structure's
+/// (every exact structure must equal it bit for bit; an inexact one, Embree's f32 tests, is
+/// measured against it), or the first row's where no structure is exact.
+fn compare(rows: &mut [AoRow]) {
+    let Some(reference) = rows
+        .iter()
+        .find(|r| crate::accel::registered(r.structure).is_none_or(|s| s.exact))
+        .or(rows.first())
+        .map(|r| r.image.clone())
+    else {
+        return;
+    };
+    let receivers = reference.iter().filter(|&&v| v >= 0.0).count().max(1) as f64;
+    for r in rows {
+        r.same_image = r.image == reference;
+        r.differing_pixels = r.image.iter().zip(&reference).filter(|(a, b)| a != b).count();
+        r.ao_difference = r
+            .image
+            .iter()
+            .zip(&reference)
+            .filter(|(_, &b)| b >= 0.0)
+            .map(|(&a, &b)| a.max(0.0) as f64 - b as f64)
+            .sum::<f64>()
+            / receivers;
+    }
 }
 
 /// What one mesh's unit measured: a row per structure and way of issuing rays, and the tuning
@@ -282,7 +316,6 @@ pub fn run_mesh(
     let on_gpu = backend.adapter().is_gpu();
     let bar = progress.bar(&format!("{}: structures", mesh.name), spec.structures.len() as u64);
     let mut out = MeshOutcome::default();
-    let mut first: Option<Vec<f32>> = None;
     let mut scenes = Vec::new();
     for (structure, candidates) in &spec.structures {
         bar.message(structure.to_string());
@@ -298,18 +331,13 @@ pub fn run_mesh(
                 issue,
                 ..spec.ao.clone()
             }));
-            out.rows.push(measure(
-                spec,
-                mesh,
-                (structure, &settings, issue),
-                &scene,
-                backend,
-                &mut first,
-            )?);
+            out.rows
+                .push(measure(spec, mesh, (structure, &settings, issue), &scene, backend)?);
             scenes.push(scene);
         }
         bar.inc(1);
     }
+    compare(&mut out.rows);
     bar.message(format!("timing {} rounds", schedule.repeats));
     let times = time_scenes(&scenes, (spec.width, spec.height), &schedule, backend, &|| {})?;
     for (row, t) in out.rows.iter_mut().zip(times) {

@@ -173,6 +173,10 @@ impl Declaration for FramesSpec {
         true
     }
 
+    fn gpu_gap(&self) -> Option<String> {
+        self.places.gpu_gap(self.structures.iter().map(|s| s.name))
+    }
+
     fn backend(&self) -> crate::render::BackendChoice {
         crate::render::BackendChoice::Cpu
     }

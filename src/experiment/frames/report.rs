@@ -63,8 +63,9 @@ struct FrameCost {
     reflection_rays: u64,
     ambient_rays: u64,
     queries: u64,
-    nodes_visited: u64,
-    primitive_tests: u64,
+    /// Empty where the structure exposes no counters (Embree).
+    nodes_visited: Option<u64>,
+    primitive_tests: Option<u64>,
     differing_pixels: usize,
 }
 
@@ -167,8 +168,8 @@ pub fn write_frames(
                     reflection_rays: r.rays.reflection,
                     ambient_rays: r.rays.ambient,
                     queries: r.work.queries,
-                    nodes_visited: r.work.nodes,
-                    primitive_tests: r.work.primitives,
+                    nodes_visited: counts_work(r).then_some(r.work.nodes),
+                    primitive_tests: counts_work(r).then_some(r.work.primitives),
                     differing_pixels: r.differing_pixels,
                 },
             )
@@ -523,6 +524,20 @@ impl Summary {
     }
 }
 
+/// Whether the row's structure counts its walk's nodes and tests (Embree's do not).
+fn counts_work(r: &FrameRow) -> bool {
+    crate::accel::registered(r.structure).is_none_or(|s| s.counts_work)
+}
+
+/// A median work count in the report's words: "n/a" where none was counted.
+fn count(x: f64) -> String {
+    if x.is_nan() {
+        "n/a".into()
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Every size x shading x structure of the rows, in scene, shading and first-seen order.
 fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
     let rows = &outcome.frames;
@@ -548,6 +563,8 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     over_frames(&upd, spec.cameras).0
                 };
                 let of = |f: fn(&FrameRow) -> u64| median(&sel.iter().map(|r| f(r) as f64).collect::<Vec<_>>());
+                // NaN (an empty field, "n/a") where the structure counts no work.
+                let counted = |f: fn(&FrameRow) -> u64| if counts_work(sel[0]) { of(f) } else { f64::NAN };
                 out.push(Summary {
                     triangles: t,
                     shading: shading.name(),
@@ -556,8 +573,8 @@ fn summarise(spec: &FramesSpec, outcome: &FramesOutcome) -> Vec<Summary> {
                     block_frames: block,
                     update,
                     rays: of(|r| r.rays.total()),
-                    nodes_visited: of(|r| r.work.nodes),
-                    primitive_tests: of(|r| r.work.primitives),
+                    nodes_visited: counted(|r| r.work.nodes),
+                    primitive_tests: counted(|r| r.work.primitives),
                     frames: sel.len(),
                 });
             }
@@ -669,7 +686,7 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, device: &str, seconds: f64
     let summaries = summarise(spec, outcome);
     for r in &summaries {
         md += &format!(
-            "| {} | {} | {} | {} | {} | {:.0} | {:.3e} | {:.3e} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.0} | {} | {} | {} |\n",
             r.triangles,
             r.shading,
             r.structure,
@@ -680,8 +697,8 @@ fn report(spec: &FramesSpec, outcome: &FramesOutcome, device: &str, seconds: f64
                 r.update.show(4)
             },
             r.rays,
-            r.nodes_visited,
-            r.primitive_tests,
+            count(r.nodes_visited),
+            count(r.primitive_tests),
             r.frames
         );
     }

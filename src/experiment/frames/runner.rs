@@ -58,7 +58,7 @@ pub struct FrameRow {
     pub rays: RayCounts,
     /// What the frame's queries cost.
     pub work: Work,
-    /// Pixels whose object or radiance differs from the first structure's frame.
+    /// Pixels whose object or radiance differs from the first exact structure's frame.
     pub differing_pixels: usize,
 }
 
@@ -429,7 +429,12 @@ pub fn run_block(
                     .into_iter()
                     .map(|f| f.expect("a frame experiment times every frame at least once"))
                     .collect();
-                let first = &frames[0];
+                // Compared with the first exact structure's frame (the first one's where none is).
+                let reference = variants
+                    .iter()
+                    .position(|v| crate::accel::registered(v.structure).is_none_or(|r| r.exact))
+                    .unwrap_or(0);
+                let first = &frames[reference];
                 for (i, v) in variants.iter().enumerate() {
                     outcome.frames.push(FrameRow {
                         triangles,

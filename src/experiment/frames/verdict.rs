@@ -201,34 +201,53 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
     let rows = &outcome.frames;
     let mut out = format!("{}\n\n", paper_claim(spec));
     let all = labels(rows);
-    let differing: Vec<String> = all
+    // Per structure label: (exact, "LABEL: N pixels on F frames (at most M)") where any differ.
+    let differing: Vec<(bool, String)> = all
         .iter()
         .filter_map(|l| {
-            let d: Vec<usize> = rows
-                .iter()
-                .filter(|r| label(r) == *l)
-                .map(|r| r.differing_pixels)
-                .collect();
+            let mine: Vec<&FrameRow> = rows.iter().filter(|r| label(r) == *l).collect();
+            let d: Vec<usize> = mine.iter().map(|r| r.differing_pixels).collect();
             let (total, frames) = (d.iter().sum::<usize>(), d.iter().filter(|&&x| x > 0).count());
+            let exact = crate::accel::registered(mine[0].structure).is_none_or(|r| r.exact);
             (total > 0).then(|| {
-                format!(
-                    "{l}: {total} pixels on {frames} frames (at most {})",
-                    d.iter().max().unwrap_or(&0)
+                (
+                    exact,
+                    format!(
+                        "{l}: {total} pixels on {frames} frames (at most {})",
+                        d.iter().max().unwrap_or(&0)
+                    ),
                 )
             })
         })
         .collect();
-    out += &if differing.is_empty() {
+    let (failed, inexact): (Vec<_>, Vec<_>) = differing.into_iter().partition(|(exact, _)| *exact);
+    // "exact" qualifies the words only where an inexact structure is among the rows.
+    let exact = if rows
+        .iter()
+        .any(|r| crate::accel::registered(r.structure).is_some_and(|r| !r.exact))
+    {
+        "exact "
+    } else {
+        ""
+    };
+    let listed = |v: Vec<(bool, String)>| v.into_iter().map(|(_, s)| s).collect::<Vec<_>>().join("; ");
+    out += &if failed.is_empty() {
         format!(
-            "- **Exactness**: every structure's frame equals the first structure's pixel for pixel (object and radiance bits), on all {} frames rendered.\n",
+            "- **Exactness**: every {exact}structure's frame equals the first {exact}structure's pixel for pixel (object and radiance bits), on all {} frames rendered.\n",
             rows.len()
         )
     } else {
         format!(
-            "- **Exactness FAILED**: frames differ from the first structure's ({}). Every structure runs one exact triangle test (in f64 on the CPU, the same f32 test on the GPU), so this should be 0: some ray was decided differently.\n",
-            differing.join("; ")
+            "- **Exactness FAILED**: frames differ from the first {exact}structure's ({}). Every {exact}structure runs one exact triangle test (in f64 on the CPU, the same f32 test on the GPU), so this should be 0: some ray was decided differently.\n",
+            listed(failed)
         )
     };
+    if !inexact.is_empty() {
+        out += &format!(
+            "- **Inexact structures** (their own f32 triangle tests: a ray that grazes an edge, or leaves a surface within f32 rounding of a neighbouring triangle, may be decided otherwise): frames differ from the first exact structure's ({}).\n",
+            listed(inexact)
+        );
+    }
     let sizes: Vec<usize> = outcome.builds.iter().map(|b| b.triangles).fold(Vec::new(), |mut v, t| {
         if !v.contains(&t) {
             v.push(t);
@@ -242,6 +261,14 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         .collect();
     let subject = spec.claim.subject.as_str();
     let work = |l: &str, shading: ShadingName| {
+        let counted = rows
+            .iter()
+            .find(|r| label(r) == l)
+            .and_then(|r| crate::accel::registered(r.structure))
+            .is_none_or(|s| s.counts_work);
+        if !counted {
+            return "no work counters".to_string();
+        }
         let of = |f: fn(&FrameRow) -> u64| {
             median(
                 &rows
