@@ -436,7 +436,7 @@ pub const REGISTRY: &[Registered] = &[
         gpu_buffers: 0,
         params: settings::validate::<embree::EmbreeSettings>,
         tuning: <embree::EmbreeSettings as settings::Params>::tuning,
-        build: |t, s| Ok(Arc::new(embree::Embree::build(t, s.typed())?)),
+        build: |t, _| Ok(Arc::new(embree::Embree::build(t, embree::Quality::High)?)),
         // Its vertex and index buffers (48 bytes a triangle), the f64 copy, and at least a
         // leaf reference per triangle.
         memory: |n, _| n as u64 * (48 + 72 + 4),

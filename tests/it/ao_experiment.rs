@@ -271,7 +271,7 @@ fn the_ci_experiment_runs_on_the_gpu() {
 /// Embree in the ao kind (CPU only): its rows leave the work counters empty (it exposes none)
 /// and count the pixels its f32 answers change against the first exact structure's image; the
 /// report sets every structure's per-thread throughput against Embree's from the same rounds;
-/// asked for on the GPU, the run is refused before any work at `[accel.embree]`.
+/// asked for on the GPU, the run is refused before any work at its place in `structures`.
 #[test]
 fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
     let dir = tempfile::tempdir().unwrap();
@@ -279,8 +279,7 @@ fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
         .unwrap()
         .replace("../assets/", &format!("{}/", common::repo("assets").display()))
         .replace("\"cwbvh\", \"brute\"]", "\"cwbvh\", \"brute\", \"embree\"]")
-        .replace("issue = [\"single\", \"bundled\"]", "issue = [\"single\"]")
-        + "\n[accel.embree]\nquality = \"medium\"\n";
+        .replace("issue = [\"single\", \"bundled\"]", "issue = [\"single\"]");
     let exp = dir.path().join("ao-embree.toml");
     std::fs::write(&exp, &text).unwrap();
     let out = dir.path().join("out");
@@ -295,7 +294,6 @@ fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
             ("", ""),
             "{r:?}"
         );
-        assert_eq!(&r[col("embree_quality")], "medium", "{r:?}");
         let (same, differing) = (
             &r[col("same_image_as_first")],
             r[col("differing_pixels")].parse::<usize>().unwrap(),
@@ -326,7 +324,7 @@ fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
         report.contains("| cow | vlf | ") && report.contains("| cow | embree | "),
         "{report}"
     );
-    // The GPU backend cannot run it: refused at its settings, nothing written.
+    // The GPU backend cannot run it: refused at its place in `structures`, nothing written.
     let refused = dir.path().join("gpu");
     let (code, err) = common::sweep(&[
         exp.as_os_str(),
@@ -337,7 +335,7 @@ fn embree_runs_beside_the_exact_structures_and_is_refused_on_the_gpu() {
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("ao-embree.toml:") && err.contains("accel.embree") && err.contains("no GPU form"),
+        err.contains("ao-embree.toml:") && err.contains("structures[6]") && err.contains("no GPU form"),
         "{err}"
     );
     assert!(!refused.exists());

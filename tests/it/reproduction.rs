@@ -86,8 +86,8 @@ fn kind_of(name: &str) -> Kind {
 }
 
 /// Columns whose values depend on the clock ([`common::from_clock`]), the device or the unit's
-/// neighbours (a filtered run's `same_image_as_first` compares with a different first
-/// structure).
+/// neighbours (a filtered run's `same_image_as_first`, `differing_pixels` and `ao_difference`
+/// compare with a different first structure, or with none).
 fn clock_dependent(column: &str) -> bool {
     common::from_clock(column)
         || [
@@ -99,6 +99,8 @@ fn clock_dependent(column: &str) -> bool {
             "run_key",
             "error",
             "same_image_as_first",
+            "differing_pixels",
+            "ao_difference",
         ]
         .contains(&column)
 }

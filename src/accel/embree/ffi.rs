@@ -49,6 +49,8 @@ pub struct RayHit {
 }
 
 const _: () = assert!(std::mem::size_of::<Ray>() == 48 && std::mem::size_of::<Hit>() == 32);
+const _: () = assert!(std::mem::size_of::<RayHit>() == 80);
+const _: () = assert!(std::mem::size_of::<IntersectContext>() == 24 && std::mem::size_of::<FilterArguments>() == 48);
 
 /// `struct RTCFilterFunctionNArguments`.
 #[repr(C)]
@@ -96,11 +98,12 @@ pub const BUFFER_TYPE_VERTEX: u32 = 1;
 /// `RTC_FORMAT_UINT3`, `RTC_FORMAT_FLOAT3`.
 pub const FORMAT_UINT3: u32 = 0x5003;
 pub const FORMAT_FLOAT3: u32 = 0x9003;
-/// `RTC_SCENE_FLAG_ROBUST`, `RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION`.
-pub const SCENE_FLAG_ROBUST: u32 = 1 << 2;
+/// `RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION`.
 pub const SCENE_FLAG_CONTEXT_FILTER_FUNCTION: u32 = 1 << 3;
-/// `RTC_DEVICE_PROPERTY_VERSION`, `RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED`.
+/// `RTC_DEVICE_PROPERTY_VERSION`, `RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED`,
+/// `RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED`.
 pub const DEVICE_PROPERTY_VERSION: u32 = 0;
+pub const DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED: u32 = 65;
 pub const DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED: u32 = 66;
 
 /// `RTCMemoryMonitorFunction`: bytes allocated (> 0) or freed (< 0); true lets it happen.
@@ -190,21 +193,24 @@ impl Api {
             return Err(format!("Embree refused to create a device (error {code})"));
         }
         // SAFETY: the device is live.
-        let (version, filters) = unsafe {
+        let (version, filters, culling) = unsafe {
             (
                 (self.get_device_property)(device, DEVICE_PROPERTY_VERSION),
                 (self.get_device_property)(device, DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED),
+                (self.get_device_property)(device, DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED),
             )
         };
-        if !(MIN_VERSION..4_00_00).contains(&version) || filters == 0 {
+        if !(MIN_VERSION..4_00_00).contains(&version) || filters == 0 || culling != 0 {
             unsafe { (self.release_device)(device) };
             return Err(format!(
-                "{LIBRARY} is Embree {}.{}.{}{}: the `embree` structure needs Embree 3.13 or a later 3.x \
-                 built with filter functions",
+                "{LIBRARY} is Embree {}.{}.{}{}{}: the `embree` structure needs Embree 3.13 or a later \
+                 3.x built with filter functions and without back-face culling (every structure \
+                 here hits both sides)",
                 version / 10000,
                 version / 100 % 100,
                 version % 100,
-                if filters == 0 { " without filter functions" } else { "" }
+                if filters == 0 { " without filter functions" } else { "" },
+                if culling != 0 { " with back-face culling" } else { "" }
             ));
         }
         Ok(device)

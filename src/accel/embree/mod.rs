@@ -31,9 +31,9 @@ use std::sync::atomic::{AtomicI64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Embree's build quality (`RTCBuildQuality`): `low` builds a Morton-code BVH, `medium` a
-/// binned-SAH BVH (Embree's default), `high` adds spatial splits.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
+/// binned-SAH BVH (Embree's default), `high` adds spatial splits. The registered structure
+/// builds at `high`, as renderers build static scenes; the others are for tests and benches.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Quality {
     /// `RTC_BUILD_QUALITY_LOW`.
     Low,
@@ -53,7 +53,7 @@ impl Quality {
         }
     }
 
-    /// Name as written in scene files.
+    /// `low`, `medium`, `high`.
     pub fn name(self) -> &'static str {
         match self {
             Quality::Low => "low",
@@ -63,26 +63,16 @@ impl Quality {
     }
 }
 
-/// Embree's parameters (`[accel.embree]`): build quality and the scene's robust flag.
+/// Embree has no parameters in scene and experiment files (`[accel.embree]` is empty): it
+/// builds at [`Quality::High`] without the robust flag. (Each parameter of a registered
+/// structure is a column of every table that lists build parameters.)
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct EmbreeSettings {
-    /// Build quality.
-    pub quality: Quality,
-    /// `RTC_SCENE_FLAG_ROBUST`: traversal without the optimisations that cost accuracy.
-    pub robust: bool,
-}
+pub struct EmbreeSettings {}
 
 impl super::settings::Params for EmbreeSettings {
     fn check(&self) -> Result<(), (&'static str, String)> {
         Ok(())
-    }
-
-    /// Every build quality, best tree first.
-    fn tuning() -> toml::Table {
-        toml::toml! {
-            quality = ["high", "medium", "low"]
-        }
     }
 }
 
@@ -138,9 +128,7 @@ pub struct Embree {
     world: Vec<[DVec3; 3]>,
     /// Origin of Embree's coordinates.
     centre: DVec3,
-    settings: EmbreeSettings,
-    /// Threads the device was created with.
-    threads: usize,
+    quality: Quality,
     build_time: Duration,
     /// Device bytes after the build, less the vertex and index buffers.
     bytes: u64,
@@ -156,12 +144,13 @@ unsafe impl Sync for Embree {}
 const BUFFER_BYTES_PER_TRIANGLE: u64 = 36 + 12;
 
 impl Embree {
-    /// Builds an Embree scene over `triangles` with `settings`, its device using as many
-    /// threads as the CPU backend's pool (so a one-thread run builds on one thread too).
-    pub fn build(triangles: &Triangles, settings: EmbreeSettings) -> anyhow::Result<Embree> {
+    /// Builds an Embree scene over `triangles` at `quality`, on one thread (queries then come
+    /// from as many threads as the CPU backend runs).
+    pub fn build(triangles: &Triangles, quality: Quality) -> anyhow::Result<Embree> {
         let api = ffi::api().map_err(anyhow::Error::msg)?;
-        let threads = rayon::current_num_threads();
-        let config = CString::new(format!("threads={threads},verbose=0")).expect("no NUL");
+        // One build thread: Embree's parallel builders may order a leaf's triangles otherwise
+        // from run to run, and a tie (two triangles at one t) would then be broken otherwise.
+        let config = CString::new("threads=1,verbose=0").expect("no NUL");
         let device = api.device(&config).map_err(anyhow::Error::msg)?;
         // The build is timed from here: a renderer makes its device once (the process's first
         // takes 0.6 s here, starting Embree's task scheduler; later ones milliseconds).
@@ -180,8 +169,7 @@ impl Embree {
             monitor,
             world: triangles.positions.clone(),
             centre,
-            settings,
-            threads,
+            quality,
             build_time: Duration::ZERO,
             bytes: 0,
         };
@@ -200,17 +188,11 @@ impl Embree {
             let scene = (api.new_scene)(self.device);
             api.check(self.device, "creating a scene")?;
             self.scene = scene;
-            let flags = ffi::SCENE_FLAG_CONTEXT_FILTER_FUNCTION
-                | if self.settings.robust {
-                    ffi::SCENE_FLAG_ROBUST
-                } else {
-                    0
-                };
-            (api.set_scene_flags)(scene, flags);
-            (api.set_scene_build_quality)(scene, self.settings.quality.code());
+            (api.set_scene_flags)(scene, ffi::SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+            (api.set_scene_build_quality)(scene, self.quality.code());
             let geometry = (api.new_geometry)(self.device, ffi::GEOMETRY_TYPE_TRIANGLE);
             api.check(self.device, "creating a triangle geometry")?;
-            (api.set_geometry_build_quality)(geometry, self.settings.quality.code());
+            (api.set_geometry_build_quality)(geometry, self.quality.code());
             let vertices =
                 (api.set_new_geometry_buffer)(geometry, ffi::BUFFER_TYPE_VERTEX, 0, ffi::FORMAT_FLOAT3, 12, 3 * n)
                     as *mut [f32; 3];
@@ -295,8 +277,9 @@ impl Accelerator for Embree {
             },
         };
         let mut context = Self::context(skip);
-        // SAFETY: the scene is committed; the context is a SkipContext, as the filter expects.
-        unsafe { (api.intersect1)(self.scene, &mut context.base, &mut rayhit) };
+        // SAFETY: the scene is committed; the context pointer is the whole SkipContext's, as
+        // the filter reads it.
+        unsafe { (api.intersect1)(self.scene, (&raw mut context).cast(), &mut rayhit) };
         if rayhit.hit.geom_id == ffi::INVALID_ID {
             return None;
         }
@@ -316,30 +299,25 @@ impl Accelerator for Embree {
         let api = ffi::api().expect("opened when built");
         let mut context = Self::context(skip);
         // SAFETY: as in `closest`; an occluded ray comes back with tfar = -inf.
-        unsafe { (api.occluded1)(self.scene, &mut context.base, &mut ray) };
+        unsafe { (api.occluded1)(self.scene, (&raw mut context).cast(), &mut ray) };
         ray.tfar == f32::NEG_INFINITY
     }
 
     fn stats(&self) -> BuildStats {
         let n = self.world.len();
         BuildStats {
-            parameters: format!(
-                "quality={}{}",
-                self.settings.quality.name(),
-                if self.settings.robust { " robust" } else { "" }
-            ),
+            parameters: format!("quality={}", self.quality.name()),
             build_time: self.build_time,
             gpu_bytes: 0,
             memory_bytes: self.bytes,
             triangles: n,
             description: format!(
-                "Embree 3 (system library, build quality `{}`{}, {} build threads; f32 traversal \
-                 and triangle tests, the chosen triangle's distance in f64; CPU only): {:.1} bytes \
-                 per triangle beyond its vertex and index buffers, built in {:.1} ms; no \
-                 traversal counters",
-                self.settings.quality.name(),
-                if self.settings.robust { ", robust" } else { "" },
-                self.threads,
+                "Embree 3 (system library, build quality `{}` on one thread; f32 traversal and \
+                 triangle tests, the chosen triangle's distance in f64; CPU only): {:.1} bytes per \
+                 triangle allocated by Embree beyond its vertex and index buffers (its allocator's \
+                 blocks, leaf triangle copies included; not the f64 copy every structure keeps), \
+                 built in {:.1} ms; no traversal counters",
+                self.quality.name(),
                 self.bytes as f64 / n.max(1) as f64,
                 self.build_time.as_secs_f64() * 1e3
             ),
@@ -364,7 +342,7 @@ impl Accelerator for Embree {
         _step: DVec3,
     ) -> anyhow::Result<super::Updated> {
         match method {
-            super::UpdateMethod::Rebuild => *self = Embree::build(moved, self.settings)?,
+            super::UpdateMethod::Rebuild => *self = Embree::build(moved, self.quality)?,
             m => return Err(super::unknown_update(self, m)),
         }
         Ok(super::Updated::Rebuilt)
@@ -391,7 +369,7 @@ impl std::fmt::Debug for Embree {
             f,
             "Embree({} triangles, quality {})",
             self.world.len(),
-            self.settings.quality.name()
+            self.quality.name()
         )
     }
 }
@@ -399,7 +377,7 @@ impl std::fmt::Debug for Embree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::{brute_force, settings::Params};
+    use crate::accel::brute_force;
     use rayon::prelude::*;
 
     fn random(seed: u32) -> impl FnMut() -> f64 {
@@ -446,7 +424,7 @@ mod tests {
     fn agrees_with_f64_brute_force_but_within_f32_rounding_of_edges() {
         let tris = soup();
         for quality in [Quality::High, Quality::Medium, Quality::Low] {
-            let e = Embree::build(&tris, EmbreeSettings { quality, robust: false }).unwrap();
+            let e = Embree::build(&tris, quality).unwrap();
             let mut next = random(2);
             let centre = DVec3::new(1000.5, -999.5, 500.5);
             let (mut hits, mut grazes) = (0, 0);
@@ -484,7 +462,7 @@ mod tests {
     #[test]
     fn corner_aimed_rays_differ_only_at_edges() {
         let tris = soup();
-        let e = Embree::build(&tris, EmbreeSettings::default()).unwrap();
+        let e = Embree::build(&tris, Quality::High).unwrap();
         let mut next = random(3);
         let mut differ = 0;
         for (k, tri) in tris.positions.iter().enumerate() {
@@ -518,7 +496,7 @@ mod tests {
             object_of: vec![0; 3],
             positions,
         };
-        let e = Embree::build(&tris, EmbreeSettings::default()).unwrap();
+        let e = Embree::build(&tris, Quality::High).unwrap();
         let (o, d) = (c(0.25, 0.25, -1.0), DVec3::Z);
         let first = e.closest(o, d, f64::INFINITY, u32::MAX).unwrap();
         assert_eq!((first.triangle, first.t), (0, 1.0));
@@ -529,7 +507,10 @@ mod tests {
         // From triangle 1's surface upwards: only triangle 2 is ahead; skipping 2 leaves none.
         let up = c(0.25, 0.25, 1.0);
         assert_eq!(e.closest(up, d, f64::INFINITY, 1).map(|h| h.triangle), Some(2));
-        assert!(!e.any_hit(up, d, f64::INFINITY, 2) || e.closest(up, d, f64::INFINITY, 2).unwrap().triangle == 1);
+        assert!(
+            !e.any_hit(up, d, f64::INFINITY, 2),
+            "triangle 1 at t = 0 is not ahead (t > 0)"
+        );
         assert!(!e.any_hit(c(0.25, 0.25, 1.5), d, f64::INFINITY, 2));
         assert!(e.any_hit(c(0.25, 0.25, 1.5), d, 0.50001, u32::MAX));
         assert!(!e.any_hit(c(0.25, 0.25, 1.5), d, 0.5, u32::MAX), "t = tmax is outside");
@@ -540,7 +521,7 @@ mod tests {
     #[test]
     fn concurrent_queries_answer_as_serial_ones() {
         let tris = soup();
-        let e = Embree::build(&tris, EmbreeSettings::default()).unwrap();
+        let e = Embree::build(&tris, Quality::High).unwrap();
         let mut next = random(2);
         let rays: Vec<(DVec3, DVec3)> = (0..4000)
             .map(|_| {
@@ -561,11 +542,11 @@ mod tests {
     }
 
     /// Its memory is what Embree allocated for the tree (more than nothing, less than a
-    /// kilobyte a triangle) and its settings read as the others' do.
+    /// kilobyte a triangle); `[accel.embree]` takes no keys.
     #[test]
     fn stats_and_settings() {
         let tris = soup();
-        let e = Embree::build(&tris, EmbreeSettings::default()).unwrap();
+        let e = Embree::build(&tris, Quality::High).unwrap();
         let s = e.stats();
         assert!(
             s.memory_bytes > 3000 * 8 && s.memory_bytes < 3000 * 1000,
@@ -574,16 +555,11 @@ mod tests {
         );
         assert_eq!((s.triangles, s.gpu_bytes), (3000, 0));
         assert!(e.gpu_refusal().is_some());
-        let parsed: EmbreeSettings = toml::from_str("quality = \"low\"\nrobust = true").unwrap();
-        assert_eq!(
-            parsed,
-            EmbreeSettings {
-                quality: Quality::Low,
-                robust: true
-            }
+        assert_eq!(s.parameters, "quality=high");
+        assert!(toml::from_str::<EmbreeSettings>("").is_ok());
+        assert!(
+            toml::from_str::<EmbreeSettings>("quality = \"low\"").is_err(),
+            "no keys"
         );
-        assert!(toml::from_str::<EmbreeSettings>("quality = \"best\"").is_err());
-        assert!(toml::from_str::<EmbreeSettings>("depth = 3").is_err());
-        assert_eq!(EmbreeSettings::tuning()["quality"].as_array().unwrap().len(), 3);
     }
 }

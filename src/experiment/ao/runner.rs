@@ -61,7 +61,8 @@ pub struct AoRow {
     #[serde(default)]
     pub differing_pixels: usize,
     /// Mean AO difference from the reference image over its receivers (this image's minus the
-    /// reference's; an inexact structure's extra or lost occluders in one number).
+    /// reference's, over pixels that are receivers in both; an inexact structure's extra or
+    /// lost occluders in one number).
     #[serde(default)]
     pub ao_difference: f64,
     /// The AO image (receivers in [0, 1], else -1).
@@ -266,14 +267,15 @@ fn measure(
     })
 }
 
-/// Compares every row's image of one mesh with the reference: the first exact structure's
-/// (every exact structure must equal it bit for bit; an inexact one, Embree's f32 tests, is
-/// measured against it), or the first row's where no structure is exact.
-fn compare(rows: &mut [AoRow]) {
+/// Compares every row's image of one mesh with the reference, the first exact structure's:
+/// every exact structure must equal it bit for bit; an inexact one (Embree's f32 tests) is
+/// measured against it. Where no exact structure ran (a run filtered to Embree) nothing is
+/// compared: rows keep `same_image` true and no differing pixels, and the report says that no
+/// exact image was there to compare with.
+pub fn compare(rows: &mut [AoRow]) {
     let Some(reference) = rows
         .iter()
         .find(|r| crate::accel::registered(r.structure).is_none_or(|s| s.exact))
-        .or(rows.first())
         .map(|r| r.image.clone())
     else {
         return;
@@ -286,8 +288,8 @@ fn compare(rows: &mut [AoRow]) {
             .image
             .iter()
             .zip(&reference)
-            .filter(|(_, &b)| b >= 0.0)
-            .map(|(&a, &b)| a.max(0.0) as f64 - b as f64)
+            .filter(|(&a, &b)| a >= 0.0 && b >= 0.0)
+            .map(|(&a, &b)| a as f64 - b as f64)
             .sum::<f64>()
             / receivers;
     }
@@ -362,4 +364,58 @@ pub fn run_ao(
         tuning.extend(out.tuning);
     }
     Ok((rows, tuning))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(structure: &'static str, image: Vec<f32>) -> AoRow {
+        AoRow {
+            mesh: "m".into(),
+            triangles: 1,
+            structure,
+            issue: Issue::Single,
+            settings: AccelSettings::named(structure).unwrap(),
+            build_seconds: 0.0,
+            memory_bytes: 0,
+            frame_seconds: vec![],
+            frame: Estimate::NAN,
+            rays: (0, 0),
+            work: Work::ZERO,
+            receivers: 0,
+            mean_ao: 0.0,
+            same_image: true,
+            differing_pixels: 0,
+            ao_difference: 0.0,
+            image,
+        }
+    }
+
+    /// The reference is the first exact structure's image even where an inexact one comes
+    /// first; the difference is taken over pixels that are receivers in both; with no exact
+    /// structure nothing is compared.
+    #[test]
+    fn images_are_compared_with_the_first_exact_structures() {
+        let exact = vec![0.5, 0.25, -1.0, 1.0];
+        let mut rows = vec![
+            row("embree", vec![0.25, 0.25, -1.0, -1.0]),
+            row("kdtree", exact.clone()),
+            row("bvh", vec![0.5, 0.25, -1.0, 0.75]),
+        ];
+        compare(&mut rows);
+        assert_eq!((rows[0].same_image, rows[0].differing_pixels), (false, 2));
+        // Receivers in both: pixels 0 and 1 (pixel 3 is a miss in Embree's image); over the
+        // reference's 3 receivers.
+        assert!(
+            (rows[0].ao_difference - (-0.25 / 3.0)).abs() < 1e-12,
+            "{}",
+            rows[0].ao_difference
+        );
+        assert_eq!((rows[1].same_image, rows[1].differing_pixels), (true, 0));
+        assert_eq!((rows[2].same_image, rows[2].differing_pixels), (false, 1));
+        let mut alone = vec![row("embree", vec![0.25, 0.5]), row("embree", vec![0.5, 0.5])];
+        compare(&mut alone);
+        assert!(alone.iter().all(|r| r.same_image && r.differing_pixels == 0));
+    }
 }
