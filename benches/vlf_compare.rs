@@ -16,7 +16,10 @@
 //! - `kdtree-sah`: the same nodes and walk with SAH planes (Wald & Havran 2006) at the best of
 //!   `-- --tune-kdtree --split sah` ([`SAH`]);
 //! - `cwbvh`: `accel::cwbvh`, the registry's CWBVH: obvhs' very-slow CWBVH over widened boxes,
-//!   obvhs' traversal, f64 exact tests.
+//!   obvhs' traversal, f64 exact tests;
+//! - `embree`: `accel::embree`, the system Embree 3 library at its high build quality, its own
+//!   f32 traversal and triangle tests (set it beside `cwbvh-obvhs` for f32 against f32); no
+//!   work counters (`-`).
 //!
 //! Ray kinds (64 seeded points on the mesh, 513 rays each, 32832 per kind): `ao-grid` (every
 //! stored direction oriented into the point's normal hemisphere, length 4, the start triangle
@@ -58,6 +61,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::BvhBuildParams;
 use penumbra::accel::cwbvh::{ray as cw_ray, Cwbvh};
+use penumbra::accel::embree::{Embree, Quality};
 use penumbra::accel::kdtree::{KdSettings, KdTree, Split};
 use penumbra::accel::vlf::{VisibilityField, VlfSettings};
 use penumbra::accel::work;
@@ -80,7 +84,7 @@ const KINDS: [&str; 6] = [
     "shadow",
     "camera",
 ];
-const STRUCTURES: [&str; 7] = [
+const STRUCTURES: [&str; 8] = [
     "vlf",
     "bvh",
     "bvh2-obvhs",
@@ -88,6 +92,7 @@ const STRUCTURES: [&str; 7] = [
     "kdtree",
     "kdtree-sah",
     "cwbvh",
+    "embree",
 ];
 
 /// The SAH kd-tree the table times: the best of `-- --tune-kdtree --split sah` summed over the
@@ -119,6 +124,7 @@ struct Mesh {
     kd: KdTree,
     kd_sah: KdTree,
     cwbvh: Cwbvh,
+    embree: Embree,
 }
 
 fn repo(p: &str) -> std::path::PathBuf {
@@ -150,6 +156,7 @@ fn build(name: &'static str) -> Mesh {
     let kd = KdTree::build(&tris, KdSettings::default());
     let kd_sah = KdTree::build(&tris, SAH);
     let cwbvh = Cwbvh::build(&tris, Preset::VerySlow);
+    let embree = Embree::build(&tris, Quality::High).expect("the system Embree 3 library");
     Mesh {
         tris,
         vlf,
@@ -159,6 +166,7 @@ fn build(name: &'static str) -> Mesh {
         kd,
         kd_sah,
         cwbvh,
+        embree,
     }
 }
 
@@ -236,6 +244,7 @@ fn accelerator(m: &Mesh, s: usize) -> Option<&dyn Accelerator> {
         4 => Some(&m.kd),
         5 => Some(&m.kd_sah),
         6 => Some(&m.cwbvh),
+        7 => Some(&m.embree),
         _ => None,
     }
 }
@@ -332,6 +341,8 @@ fn trace(m: &Mesh, s: usize, closest: bool, &(o, d, tmax, skip): &Q) -> bool {
         5 => penumbra::accel::Accelerator::any_hit(&m.kd_sah, o, d, tmax, skip),
         6 if closest => m.cwbvh.closest(o, d, tmax, skip).is_some(),
         6 => m.cwbvh.any_hit(o, d, tmax, skip),
+        7 if closest => m.embree.closest(o, d, tmax, skip).is_some(),
+        7 => m.embree.any_hit(o, d, tmax, skip),
         _ => {
             let ray = Ray::new(
                 Vec3A::from((o - m.bvh.centre).as_vec3()),
@@ -376,7 +387,7 @@ fn run(m: &Mesh, s: usize, closest: bool, rays: &[Q], parallel: bool) -> usize {
 }
 
 /// Structure bytes (no triangles) of each structure.
-fn bytes(m: &Mesh) -> [usize; 7] {
+fn bytes(m: &Mesh) -> [usize; 8] {
     let bvh2 = std::mem::size_of_val(m.bvh.tree.nodes.as_slice()) + 4 * m.bvh.tree.primitive_indices.len();
     let cw = std::mem::size_of_val(m.cw.nodes.as_slice()) + 4 * m.cw.primitive_indices.len();
     [
@@ -387,6 +398,7 @@ fn bytes(m: &Mesh) -> [usize; 7] {
         m.kd.bytes(),
         m.kd_sah.bytes(),
         m.cwbvh.bytes(),
+        Accelerator::stats(&m.embree).memory_bytes as usize,
     ]
 }
 
@@ -437,6 +449,7 @@ fn table() {
             penumbra::accel::Accelerator::stats(&m.kd).build_time.as_secs_f64(),
             penumbra::accel::Accelerator::stats(&m.kd_sah).build_time.as_secs_f64(),
             m.cwbvh.build_time.as_secs_f64(),
+            Accelerator::stats(&m.embree).build_time.as_secs_f64(),
         ];
         let n = m.tris.positions.len();
         for kind in listed("--kinds", &KINDS) {
@@ -492,6 +505,7 @@ fn table() {
         eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.kd).description);
         eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.kd_sah).description);
         eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.cwbvh).description);
+        eprintln!("{name}: {}", penumbra::accel::Accelerator::stats(&m.embree).description);
     }
 }
 

@@ -76,12 +76,6 @@ impl super::settings::Params for EmbreeSettings {
     }
 }
 
-/// Whether the system Embree library can be opened, or why not (a run or test checks it
-/// before it asks for the structure).
-pub fn available() -> Result<(), String> {
-    ffi::api().map(|_| ())
-}
-
 /// Bytes Embree's device holds, as its memory monitor reports them.
 struct Monitor {
     bytes: AtomicI64,
