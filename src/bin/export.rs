@@ -1,5 +1,5 @@
-//! `export SCENE --camera NAME --size WxH --to mitsuba|penumbra --out DIR`: one view of a
-//! penumbra scene for another renderer (a Mitsuba 3 scene file, meshes as PLY) or rendered by
+//! `export SCENE --camera NAME --size WxH --to mitsuba|pbrt|penumbra --out DIR`: one view of a
+//! penumbra scene for another renderer (a Mitsuba 3 or pbrt-v4 scene file, meshes as PLY) or rendered by
 //! penumbra's f64 CPU backend (radiance EXRs), with the `view.toml` record `judge` scores
 //! images of the view against. Exit status: 0 done, 2 bad input (a scene or view the format
 //! cannot hold as penumbra renders it), 1 else.
@@ -7,7 +7,7 @@
 use clap::{Parser, ValueEnum};
 use penumbra::experiment::cli::{print_out, report_error};
 use penumbra::files::Refused;
-use penumbra::peers::{mitsuba, view, write_files, write_folder};
+use penumbra::peers::{export::view_of, mitsuba, pbrt, view, write_files, write_folder};
 use penumbra::render::{cpu::CpuBackend, Backend, Sampling, View};
 use penumbra::sampling::{DiskScheme, Pattern};
 use penumbra::scene::{Light, Scene};
@@ -18,6 +18,8 @@ use std::path::PathBuf;
 enum Target {
     /// A Mitsuba 3 scene file (scene.xml) rendering the view with a box pixel filter.
     Mitsuba,
+    /// A pbrt-v4 scene file (scene.pbrt) rendering the view with a box pixel filter.
+    Pbrt,
     /// Penumbra's own radiance images of the view (pixel centres), one per sample count and seed.
     Penumbra,
 }
@@ -86,17 +88,17 @@ fn run(args: &Args) -> anyhow::Result<String> {
     penumbra::peers::refuse_unmatched_effects(&scene, &args.scene)?;
     let scene_path = std::path::absolute(&args.scene)?;
     let (w, h) = args.size;
-    let mut record = mitsuba::view_of(&scene_path, &bytes, &args.camera, w, h);
+    let (pixel, lift) = match args.to {
+        Target::Mitsuba => (view::PixelFilter::Box, "mitsuba3"),
+        Target::Pbrt => (view::PixelFilter::Box, "none"),
+        Target::Penumbra => (view::PixelFilter::Centre, "none"),
+    };
+    let record = view_of(&scene_path, &bytes, &args.camera, w, h, pixel, lift);
     let mut files = Vec::new();
     match args.to {
-        Target::Mitsuba => {
-            let export = mitsuba::export(&scene, camera, &record)?;
-            files.push(("scene.xml".to_string(), export.xml.into_bytes()));
-            files.extend(export.meshes);
-        }
+        Target::Mitsuba => files.extend(mitsuba::export(&scene, camera, &record)?.into_files()),
+        Target::Pbrt => files.extend(pbrt::export(&scene, camera, &record)?.into_files()),
         Target::Penumbra => {
-            record.pixel = view::PixelFilter::Centre;
-            record.lift = "none".into();
             let mut backend = CpuBackend::default();
             let mut times = csv::Writer::from_writer(Vec::new());
             times.write_record(["image", "spp", "seed", "scheme", "shadow_rays", "seconds", "threads"])?;

@@ -200,7 +200,7 @@ impl Reference {
                         if origin != hit.p {
                             whole = irradiance_fraction_estimate(hit.p, hit.n, d, &[], &[]).1;
                         }
-                        let l_free = plane.albedo / PI * super::mitsuba::radiance(d.power, d.radius) * whole;
+                        let l_free = plane.albedo / PI * super::export::disk_radiance(d.power, d.radius) * whole;
                         free += weight * l_free;
                         lit += weight * l_free * f.value;
                         limited += (f.depth_limited > 0) as u64;

@@ -8,12 +8,13 @@
 //!   are hidden from camera rays.
 //! - Disk light: a `disk` shape (unit disk in its xy plane, normal +z) mapped onto the light's
 //!   centre, basis and radius, with a one-sided `area` emitter of radiance
-//!   L_e = power / (pi^2 a^2), the Lambertian disk that emits `power` watts ([`radiance`]).
+//!   L_e = power / (pi^2 a^2), the Lambertian disk that emits `power` watts
+//!   ([`disk_radiance`](super::export::disk_radiance)).
 //!   Unlike penumbra's lights, it is a surface: it blocks camera rays and other lights' shadow
 //!   rays; [`export`] refuses views whose camera rays meet a light's disk.
 //! - Point light: a `point` emitter of intensity power / (4 pi).
 //! - Surfaces: diffuse, wrapped `twosided` (penumbra shades the side the camera sees); planes
-//!   are `rectangle`s reaching [`PLANE_REACH`] times the scene's extent.
+//!   are `rectangle`s reaching [`PLANE_REACH`](super::export::PLANE_REACH) times the scene's extent.
 //! - Camera: `perspective` with `fov_axis = y` (penumbra's field of view is vertical), or
 //!   `orthographic` scaled by half the view's width in both axes (Mitsuba's orthographic
 //!   view spans [-1, 1] horizontally and keeps the film's aspect).
@@ -23,41 +24,19 @@
 //! - Sampler: `independent`, `spp` and `seed` left as parameters with defaults, so one file
 //!   renders every sample count and seed.
 
-use super::view::{ExportedView, PixelFilter};
-use crate::files::Refused;
-use crate::render::cpu::closest_hit;
+use super::export::{disk_radiance, extent, mesh_triangles, refuse_visible_lights, Export, PLANE_REACH};
+use super::view::ExportedView;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Light, Scene, Shape};
 use glam::DVec3;
-use std::f64::consts::PI;
 use std::fmt::Write;
-
-/// Planes become squares reaching this many times the scene's extent from their point: past
-/// what the shipped views see, and no further, because Mitsuba places hits on a `rectangle`
-/// only to about its size x 2^-24 (measured on the sphere scene's measuring view: hits 1.2e-5 m
-/// off at 100 times the extent, 301 m, which moved the penumbra by 0.02 pixels and its mean
-/// signed error by +0.0008).
-pub const PLANE_REACH: f64 = 4.0;
-
-/// Radiance of a one-sided Lambertian disk of `radius` that emits `power` watts.
-pub fn radiance(power: f64, radius: f64) -> f64 {
-    power / (PI * PI * radius * radius)
-}
-
-/// An exported scene: the scene file's text and the meshes it names (file name, PLY bytes).
-pub struct Export {
-    /// `scene.xml`.
-    pub xml: String,
-    /// `meshes/NAME.ply` files.
-    pub meshes: Vec<(String, Vec<u8>)>,
-}
 
 /// The scene and `view` in Mitsuba 3's format, or why the scene cannot be one (effects Mitsuba's
 /// file would simulate differently: mirrors, ambient occlusion, shading without shadows; a view
 /// that sees a light's disk).
 pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<Export> {
     super::refuse_unmatched_effects(scene, &view.scene)?;
-    refuse_visible_lights(scene, camera, view)?;
+    refuse_visible_lights(scene, camera, view, "Mitsuba")?;
     let mut x = String::new();
     let f = |v: f64| format!("{v:?}");
     let v3 = |p: DVec3| format!("{}, {}, {}", f(p.x), f(p.y), f(p.z));
@@ -151,14 +130,7 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
                 );
             }
             Shape::Mesh(m) => {
-                let triangles: Vec<[DVec3; 3]> = scene
-                    .triangles
-                    .positions
-                    .iter()
-                    .zip(&scene.triangles.object_of)
-                    .filter(|(_, &o)| o as usize == id)
-                    .map(|(t, _)| *t)
-                    .collect();
+                let triangles = mesh_triangles(scene, id);
                 let name = format!("meshes/shape{id}.ply");
                 let _ = write!(
                     x,
@@ -173,7 +145,7 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
     for (k, light) in scene.lights.iter().enumerate() {
         match light {
             Light::Point { position, power } => {
-                let i = power / (4.0 * PI);
+                let i = power / (4.0 * std::f64::consts::PI);
                 let _ = write!(
                     x,
                     "    <emitter type=\"point\" id=\"light{k}\">\n        <point name=\"position\" value=\"{}\"/>\n        \
@@ -183,7 +155,7 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
             }
             Light::Disk(d) => {
                 let (u, v) = d.basis();
-                let l = radiance(d.power, d.radius);
+                let l = disk_radiance(d.power, d.radius);
                 let _ = write!(
                     x,
                     "    <shape type=\"disk\" id=\"light{k}\">\n        <transform name=\"to_world\">\n            \
@@ -195,7 +167,11 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
         }
     }
     x.push_str("</scene>\n");
-    Ok(Export { xml: x, meshes })
+    Ok(Export {
+        name: "scene.xml",
+        text: x,
+        meshes,
+    })
 }
 
 /// A 4 x 4 row-major matrix with columns a, b, c and translation t.
@@ -213,60 +189,6 @@ fn matrix(a: DVec3, b: DVec3, c: DVec3, t: DVec3) -> String {
         .join(" ")
 }
 
-/// The largest distance from the origin of anything the view or the lights involve (metres).
-fn extent(scene: &Scene, camera: &Camera) -> f64 {
-    let mut r = camera.position.length().max(camera.look_at.length());
-    for s in &scene.shapes {
-        r = r.max(match s {
-            Shape::Sphere(s) => s.center.length() + s.radius,
-            Shape::Plane(p) => p.point.length(),
-            Shape::Mesh(_) => 0.0,
-        });
-    }
-    for t in &scene.triangles.positions {
-        r = t.iter().fold(r, |r, v| r.max(v.length()));
-    }
-    for l in &scene.lights {
-        r = r.max(match l {
-            Light::Point { position, .. } => position.length(),
-            Light::Disk(d) => d.center.length() + d.radius,
-        });
-    }
-    r.max(1.0)
-}
-
-/// Refuses a view in which a pixel's camera ray meets a disk light before any surface: such a
-/// disk is a surface in Mitsuba and nothing in penumbra.
-fn refuse_visible_lights(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<()> {
-    for (k, light) in scene.lights.iter().enumerate() {
-        let Light::Disk(d) = light else { continue };
-        let mut seen = 0u64;
-        for y in 0..view.height {
-            for x in 0..view.width {
-                let ray = camera.ray(x, y, view.width, view.height);
-                let denom = ray.direction.dot(d.normal);
-                if denom == 0.0 {
-                    continue;
-                }
-                let t = (d.center - ray.origin).dot(d.normal) / denom;
-                let on_disk = t > 0.0 && (ray.origin + ray.direction * t - d.center).length() <= d.radius;
-                let before = closest_hit(scene, ray.origin, ray.direction)
-                    .is_none_or(|h| (h.p - ray.origin).dot(ray.direction) > t);
-                seen += (on_disk && before) as u64;
-            }
-        }
-        if seen > 0 {
-            return Err(Refused(format!(
-                "{}: {seen} pixels of camera `{}` see light {k}'s disk, which Mitsuba renders as a surface and penumbra does not; choose a view that does not see it",
-                view.scene.display(),
-                view.camera
-            ))
-            .into());
-        }
-    }
-    Ok(())
-}
-
 /// `s` with the characters XML comments and attributes cannot hold replaced.
 fn xml_text(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -274,24 +196,4 @@ fn xml_text(s: &str) -> String {
         .replace('>', "&gt;")
         .replace("--", "- -")
         .replace('"', "&quot;")
-}
-
-/// What an export of `camera` at this size records.
-pub fn view_of(
-    scene_path: &std::path::Path,
-    scene_bytes: &[u8],
-    camera: &str,
-    width: u32,
-    height: u32,
-) -> ExportedView {
-    ExportedView {
-        scene: scene_path.to_path_buf(),
-        scene_fnv1a: ExportedView::fingerprint(scene_bytes),
-        camera: camera.into(),
-        width,
-        height,
-        plane: 0,
-        pixel: PixelFilter::Box,
-        lift: "mitsuba3".into(),
-    }
 }

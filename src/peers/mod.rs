@@ -1,13 +1,15 @@
 //! Penumbra's scenes handed to the renderers researchers already trust, and their images judged
 //! against penumbra's exact reference: "does it agree with Mitsuba?" answered by measurement.
 //!
-//! [`mitsuba`] writes a scene and one of its views as a Mitsuba 3 scene file (meshes as PLY,
-//! [`ply`]); [`view::ExportedView`] records what was exported, so that [`judge`] can score any
+//! [`mitsuba`] and [`pbrt`] write a scene and one of its views as a Mitsuba 3 or pbrt-v4 scene
+//! file (meshes as PLY, [`ply`]; what both share in [`export`]); [`view::ExportedView`] records what was exported, so that [`judge`] can score any
 //! renderer's EXR of that view (Mitsuba's, penumbra's own, anyone's) with one code path.
 
+pub mod export;
 pub mod judge;
 pub mod mitsuba;
 pub mod panel;
+pub mod pbrt;
 pub mod ply;
 pub mod view;
 

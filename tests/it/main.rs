@@ -31,6 +31,7 @@ mod kdtree_work_counts;
 mod kinds_on_the_core;
 mod mesh_scene;
 mod pages;
+mod pbrt_export;
 mod peers;
 mod points_file;
 mod readme_figures;

@@ -148,22 +148,27 @@ fn scenes_the_file_would_render_otherwise_are_refused_naming_them() {
     );
     let scene = dir.path().join("up.toml");
     std::fs::write(&scene, looking_up).unwrap();
-    let (code, err) = run(
-        "export",
-        &[
-            path(&scene),
-            "--camera",
-            "up",
-            "--size",
-            "16x16",
-            "--to",
-            "mitsuba",
-            "--out",
-            path(&dir.path().join("o")),
-        ],
-    );
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("up.toml") && err.contains("see light 0's disk"), "{err}");
+    for (to, renderer) in [("mitsuba", "which Mitsuba renders"), ("pbrt", "which pbrt renders")] {
+        let (code, err) = run(
+            "export",
+            &[
+                path(&scene),
+                "--camera",
+                "up",
+                "--size",
+                "16x16",
+                "--to",
+                to,
+                "--out",
+                path(&dir.path().join("o")),
+            ],
+        );
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("up.toml") && err.contains("see light 0's disk") && err.contains(renderer),
+            "{err}"
+        );
+    }
     let (code, err) = run(
         "export",
         &[
