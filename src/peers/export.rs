@@ -1,12 +1,15 @@
 //! What every scene-file export shares: the files it writes, how far planes reach, a mesh's
-//! world-space triangles, the refusal of views that see a light's disk, and the view record.
+//! world-space triangles, the refusal of what
+//! renders otherwise where lights are surfaces, and the view record.
 
 use super::view::{ExportedView, PixelFilter};
 use crate::files::Refused;
 use crate::render::cpu::closest_hit;
+use crate::render::shading::disk_unreachable;
 use crate::scene::camera::Camera;
-use crate::scene::{Light, Scene, Shape};
+use crate::scene::{DiskLight, Light, Scene, Shape};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Planes become squares reaching this many times the scene's extent from their point: past
 /// what the shipped views see, and no further, because renderers place hits on a large flat
@@ -88,41 +91,176 @@ pub fn extent(scene: &Scene, camera: &Camera) -> f64 {
     r.max(1.0)
 }
 
-/// Refuses a view in which a pixel's camera ray meets a disk light before any surface: such a
-/// disk is a surface in `renderer` and nothing in penumbra.
+/// Refuses what a renderer whose disk lights are surfaces renders otherwise than penumbra,
+/// whose lights are neither seen nor block anything: a view that sees a light's disk
+/// ([`refuse_visible_lights`]) and a light that may shadow another on what the view sees
+/// ([`refuse_lights_shadowing_lights`]).
+pub fn refuse_lights_as_surfaces(
+    scene: &Scene,
+    camera: &Camera,
+    view: &ExportedView,
+    renderer: &str,
+) -> anyhow::Result<()> {
+    refuse_visible_lights(scene, camera, view, renderer)?;
+    refuse_lights_shadowing_lights(scene, camera, view, renderer)
+}
+
+/// Image positions (offsets from a pixel's top-left corner) a renderer with this pixel filter
+/// sends camera rays through: the centre, or under a box filter a 5 x 5 lattice over the
+/// square, edges and corners included.
+fn pixel_positions(filter: PixelFilter) -> Vec<(f64, f64)> {
+    match filter {
+        PixelFilter::Centre => vec![(0.5, 0.5)],
+        PixelFilter::Box => (0..25)
+            .map(|k| ((k % 5) as f64 * 0.25, (k / 5) as f64 * 0.25))
+            .collect(),
+    }
+}
+
+/// Whether the camera ray (origin, dir) meets disk light `d` before any surface.
+fn sees_disk(scene: &Scene, origin: DVec3, dir: DVec3, d: &DiskLight) -> bool {
+    let denom = dir.dot(d.normal);
+    if denom == 0.0 {
+        return false;
+    }
+    let t = (d.center - origin).dot(d.normal) / denom;
+    t > 0.0
+        && (origin + dir * t - d.center).length() <= d.radius
+        && closest_hit(scene, origin, dir).is_none_or(|h| (h.p - origin).dot(dir) > t)
+}
+
+/// Refuses a view in which a camera ray the pixel filter traces meets a disk light before any
+/// surface, or that sees the disk's centre (a disk smaller than the lattice's spacing is seen
+/// where its centre is): such a disk is a surface in `renderer` and nothing in penumbra.
 pub fn refuse_visible_lights(
     scene: &Scene,
     camera: &Camera,
     view: &ExportedView,
     renderer: &str,
 ) -> anyhow::Result<()> {
+    let (w, h) = (view.width, view.height);
+    let positions = pixel_positions(view.pixel);
     for (k, light) in scene.lights.iter().enumerate() {
         let Light::Disk(d) = light else { continue };
-        let mut seen = 0u64;
-        for y in 0..view.height {
-            for x in 0..view.width {
-                let ray = camera.ray(x, y, view.width, view.height);
-                let denom = ray.direction.dot(d.normal);
-                if denom == 0.0 {
-                    continue;
-                }
-                let t = (d.center - ray.origin).dot(d.normal) / denom;
-                let on_disk = t > 0.0 && (ray.origin + ray.direction * t - d.center).length() <= d.radius;
-                let before = closest_hit(scene, ray.origin, ray.direction)
-                    .is_none_or(|h| (h.p - ray.origin).dot(ray.direction) > t);
-                seen += (on_disk && before) as u64;
-            }
-        }
-        if seen > 0 {
+        let seen: usize = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .filter(|&x| {
+                        positions.iter().any(|&(dx, dy)| {
+                            let ray = camera.ray_at(x as f64 + dx, y as f64 + dy, w, h);
+                            sees_disk(scene, ray.origin, ray.direction, d)
+                        })
+                    })
+                    .count()
+            })
+            .sum();
+        let centre_seen = centre_in_view(camera, w, h, d.center).is_some_and(|(origin, dir)| {
+            closest_hit(scene, origin, dir).is_none_or(|hit| (hit.p - origin).dot(dir) > (d.center - origin).dot(dir))
+        });
+        if seen > 0 || centre_seen {
             return Err(Refused(format!(
-                "{}: {seen} pixels of camera `{}` see light {k}'s disk, which {renderer} renders as a surface and penumbra does not; choose a view that does not see it",
+                "{}: camera `{}` sees light {k}'s disk ({}), which {renderer} renders as a surface and penumbra does not; choose a view that does not see it",
                 view.scene.display(),
-                view.camera
+                view.camera,
+                if seen > 0 {
+                    format!("the camera rays of {seen} pixels meet it")
+                } else {
+                    "its centre, between the pixels' rays".to_string()
+                }
             ))
             .into());
         }
     }
     Ok(())
+}
+
+/// The camera ray (origin, unit direction) towards `p` when `p` lies in front of the camera and
+/// inside its view.
+fn centre_in_view(camera: &Camera, width: u32, height: u32, p: DVec3) -> Option<(DVec3, DVec3)> {
+    let (f, (hx, hy), orthographic) = camera.gpu_terms(width, height);
+    let d = p - camera.position;
+    let z = d.dot(f.forward);
+    if z <= 0.0 {
+        return None;
+    }
+    let (sx, sy) = if orthographic {
+        (d.dot(f.right), d.dot(f.up))
+    } else {
+        (d.dot(f.right) / z, d.dot(f.up) / z)
+    };
+    if sx.abs() > hx || sy.abs() > hy {
+        return None;
+    }
+    Some(if orthographic {
+        (camera.position + sx * f.right + sy * f.up, f.forward)
+    } else {
+        (camera.position, d.normalize())
+    })
+}
+
+/// Refuses a scene in which one disk light may shadow another on a receiver the view sees: in
+/// `renderer` a light is a surface that blocks the others' shadow rays, in penumbra it blocks
+/// nothing. Conservative: every segment from the receiver to light b's disk stays within b's
+/// radius of the segment to b's centre, so light a (within its radius of its centre) can block
+/// one only if its centre comes within the sum of the radii of that segment.
+pub fn refuse_lights_shadowing_lights(
+    scene: &Scene,
+    camera: &Camera,
+    view: &ExportedView,
+    renderer: &str,
+) -> anyhow::Result<()> {
+    let disks: Vec<(usize, &DiskLight)> = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter_map(|(k, l)| match l {
+            Light::Disk(d) => Some((k, d)),
+            Light::Point { .. } => None,
+        })
+        .collect();
+    if disks.len() < 2 {
+        return Ok(());
+    }
+    let (w, h) = (view.width, view.height);
+    let receivers: Vec<(DVec3, DVec3)> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).filter_map(move |x| {
+                let ray = camera.ray(x, y, w, h);
+                closest_hit(scene, ray.origin, ray.direction).map(|r| (r.p, r.n))
+            })
+        })
+        .collect();
+    for &(a, da) in &disks {
+        for &(b, db) in &disks {
+            if a == b {
+                continue;
+            }
+            let shadowed = receivers
+                .par_iter()
+                .filter(|&&(p, n)| {
+                    !disk_unreachable(p, n, db) && segment_distance(da.center, p, db.center) < da.radius + db.radius
+                })
+                .count();
+            if shadowed > 0 {
+                return Err(Refused(format!(
+                    "{}: light {a}'s disk may shadow light {b} on {shadowed} pixels of camera `{}`; {renderer}'s lights are surfaces that block other lights, penumbra's block nothing; move them apart or export one",
+                    view.scene.display(),
+                    view.camera
+                ))
+                .into());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Distance from `c` to the segment [p, q].
+fn segment_distance(c: DVec3, p: DVec3, q: DVec3) -> f64 {
+    let d = q - p;
+    let t = ((c - p).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    (p + d * t - c).length()
 }
 
 /// What an export of `camera` at this size records, for a renderer with this pixel filter and

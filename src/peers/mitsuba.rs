@@ -24,7 +24,7 @@
 //! - Sampler: `independent`, `spp` and `seed` left as parameters with defaults, so one file
 //!   renders every sample count and seed.
 
-use super::export::{disk_radiance, extent, mesh_triangles, refuse_visible_lights, Export, PLANE_REACH};
+use super::export::{disk_radiance, extent, mesh_triangles, refuse_lights_as_surfaces, Export, PLANE_REACH};
 use super::view::ExportedView;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Light, Scene, Shape};
@@ -36,7 +36,7 @@ use std::fmt::Write;
 /// that sees a light's disk).
 pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<Export> {
     super::refuse_unmatched_effects(scene, &view.scene)?;
-    refuse_visible_lights(scene, camera, view, "Mitsuba")?;
+    refuse_lights_as_surfaces(scene, camera, view, "Mitsuba")?;
     let mut x = String::new();
     let f = |v: f64| format!("{v:?}");
     let v3 = |p: DVec3| format!("{}, {}, {}", f(p.x), f(p.y), f(p.z));

@@ -6,7 +6,7 @@
 
 use crate::common;
 use glam::{DMat4, DVec3, DVec4};
-use penumbra::scene::{Light, Scene};
+use penumbra::scene::{Light, Scene, Shape};
 use std::path::Path;
 use std::process::Command;
 
@@ -143,19 +143,32 @@ fn look_at(pos: DVec3, look: DVec3, up: DVec3) -> DMat4 {
     DMat4::from_cols(right.extend(0.0), new_up.extend(0.0), dir.extend(0.0), pos.extend(1.0)).inverse()
 }
 
+/// A shape as pbrt's graphics state leaves it: its transform, the material and area light
+/// current when it was declared (pbrt binds both at `Shape`, scoped by attribute blocks).
+struct Bound {
+    shape: Directive,
+    transform: DMat4,
+    material: Option<std::rc::Rc<Directive>>,
+    area_light: Option<std::rc::Rc<Directive>>,
+}
+
 /// A scene exported to pbrt and interpreted: the world-from-camera matrix, the camera's kind,
-/// screen window and fov, and the world directives with the transform current at each.
+/// screen window and fov, the shapes with their state, and the other world directives.
 struct Interpreted {
     world_from_camera: DMat4,
     camera: Directive,
     film: Directive,
-    world: Vec<(Directive, DMat4)>,
+    shapes: Vec<Bound>,
+    world: Vec<Directive>,
     others: Vec<Directive>,
 }
 
 fn interpret(text: &str) -> Interpreted {
+    use std::rc::Rc;
     let mut ctm = DMat4::IDENTITY;
+    let (mut material, mut area_light): (Option<Rc<Directive>>, Option<Rc<Directive>>) = (None, None);
     let mut stack = Vec::new();
+    let mut shapes = Vec::new();
     let (mut camera, mut film, mut world_from_camera) = (None, None, None);
     let mut in_world = false;
     let mut world = Vec::new();
@@ -189,9 +202,17 @@ fn interpret(text: &str) -> Interpreted {
                 in_world = true;
                 ctm = DMat4::IDENTITY;
             }
-            "AttributeBegin" => stack.push(ctm),
-            "AttributeEnd" => ctm = stack.pop().expect("balanced attributes"),
-            _ if in_world => world.push((d, ctm)),
+            "AttributeBegin" => stack.push((ctm, material.clone(), area_light.clone())),
+            "AttributeEnd" => (ctm, material, area_light) = stack.pop().expect("balanced attributes"),
+            "Material" if in_world => material = Some(Rc::new(d)),
+            "AreaLightSource" if in_world => area_light = Some(Rc::new(d)),
+            "Shape" if in_world => shapes.push(Bound {
+                shape: d,
+                transform: ctm,
+                material: material.clone(),
+                area_light: area_light.clone(),
+            }),
+            _ if in_world => world.push(d),
             _ => others.push(d),
         }
     }
@@ -200,6 +221,7 @@ fn interpret(text: &str) -> Interpreted {
         world_from_camera: world_from_camera.expect("a camera"),
         camera: camera.unwrap(),
         film: film.expect("a film"),
+        shapes,
         world,
         others,
     }
@@ -226,6 +248,10 @@ impl Interpreted {
             ),
             other => panic!("camera {other}"),
         }
+    }
+
+    fn shapes(&self, kind: &str) -> Vec<&Bound> {
+        self.shapes.iter().filter(|b| b.shape.kind() == kind).collect()
     }
 
     fn other(&self, name: &str) -> &Directive {
@@ -297,17 +323,7 @@ fn the_pbrt_lights_and_surfaces_are_penumbras() {
     let out = dir.path().join("two");
     export(&path, "picture", "32x24", &out);
     let file = interpret(&std::fs::read_to_string(out.join("scene.pbrt")).unwrap());
-    let disks: Vec<&(Directive, DMat4)> = file
-        .world
-        .iter()
-        .filter(|(d, _)| d.name == "Shape" && d.kind() == "disk")
-        .collect();
-    let emitters: Vec<&Directive> = file
-        .world
-        .iter()
-        .map(|(d, _)| d)
-        .filter(|d| d.name == "AreaLightSource")
-        .collect();
+    let disks = file.shapes("disk");
     let lights: Vec<_> = scene
         .lights
         .iter()
@@ -316,9 +332,10 @@ fn the_pbrt_lights_and_surfaces_are_penumbras() {
             Light::Point { .. } => panic!("the scene's lights are disks"),
         })
         .collect();
-    assert_eq!((disks.len(), emitters.len()), (lights.len(), lights.len()));
-    for ((light, (disk, m)), emitter) in lights.iter().zip(&disks).zip(&emitters) {
-        let r = disk.floats("float radius")[0];
+    assert_eq!(disks.len(), lights.len());
+    for (light, disk) in lights.iter().zip(&disks) {
+        let m = disk.transform;
+        let r = disk.shape.floats("float radius")[0];
         assert_eq!(r, light.radius);
         assert!(
             (m.transform_point3(DVec3::ZERO) - light.center).length() < 1e-15,
@@ -332,6 +349,7 @@ fn the_pbrt_lights_and_surfaces_are_penumbras() {
         for axis in [DVec3::X, DVec3::Y] {
             assert!((m.transform_vector3(axis).length() - 1.0).abs() < 1e-12);
         }
+        let emitter = disk.area_light.as_ref().expect("the disk emits");
         assert_eq!(emitter.kind(), "diffuse");
         let l = emitter.floats("rgb L");
         let expected = light.power / (std::f64::consts::PI.powi(2) * r * r);
@@ -339,38 +357,72 @@ fn the_pbrt_lights_and_surfaces_are_penumbras() {
             l.iter().all(|&v| (v / expected - 1.0).abs() < 1e-12),
             "{l:?} vs {expected}"
         );
+        // pbrt-v4 divides an RGB emitter by its illuminant's luminance and nothing else unless
+        // told: no scale, power, two-sidedness or image may change what `L` says.
+        for key in ["float scale", "float power", "bool twosided", "string filename"] {
+            assert!(!emitter.params.iter().any(|(k, _)| k == key), "{key} on the light");
+        }
     }
-    let sphere = file
-        .world
-        .iter()
-        .find(|(d, _)| d.name == "Shape" && d.kind() == "sphere")
-        .unwrap();
-    assert_eq!(sphere.0.floats("float radius"), vec![0.25]);
-    assert_eq!(sphere.1.transform_point3(DVec3::ZERO), DVec3::new(0.0, 0.0, 0.5));
-    let plane = file
-        .world
-        .iter()
-        .find(|(d, _)| d.name == "Shape" && d.kind() == "trianglemesh")
-        .unwrap();
-    let p = plane.0.floats("point3 P");
+    // Nothing else on the film or camera rescales the pixels: sensor, ISO, white balance,
+    // clamping and exposure time keep pbrt's neutral defaults.
+    for key in [
+        "string sensor",
+        "float iso",
+        "float whitebalance",
+        "float maxcomponentvalue",
+    ] {
+        assert!(!file.film.params.iter().any(|(k, _)| k == key), "{key} on the film");
+    }
+    for key in ["float shutteropen", "float shutterclose"] {
+        assert!(!file.camera.params.iter().any(|(k, _)| k == key), "{key} on the camera");
+    }
+    let sphere = &file.shapes("sphere")[0];
+    assert_eq!(sphere.shape.floats("float radius"), vec![0.25]);
+    assert_eq!(
+        sphere.transform.transform_point3(DVec3::ZERO),
+        DVec3::new(0.0, 0.0, 0.5)
+    );
+    let plane = &file.shapes("trianglemesh")[0];
+    let p = plane.shape.floats("point3 P");
     let corners: Vec<DVec3> = p.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
-    assert_eq!(plane.0.floats("integer indices"), vec![0.0, 1.0, 2.0, 0.0, 2.0, 3.0]);
+    assert_eq!(
+        plane.shape.floats("integer indices"),
+        vec![0.0, 1.0, 2.0, 0.0, 2.0, 3.0]
+    );
     assert!(corners.iter().all(|c| c.z == 0.0), "on the ground plane");
     let half = corners
         .iter()
         .map(|c| c.x.abs().min(c.y.abs()))
         .fold(f64::INFINITY, f64::min);
     assert!(half > 2.0, "reaches past the view: {half}");
-    let materials: Vec<Vec<f64>> = file
-        .world
-        .iter()
-        .filter(|(d, _)| d.name == "Material")
-        .map(|(d, _)| {
-            assert_eq!(d.kind(), "diffuse");
-            d.floats("rgb reflectance")
-        })
-        .collect();
-    assert_eq!(materials, vec![vec![0.8; 3]; 2]);
+    for surface in [sphere, plane] {
+        let material = surface.material.as_ref().expect("a material of its own");
+        assert_eq!(material.kind(), "diffuse");
+        assert_eq!(material.floats("rgb reflectance"), vec![0.8; 3]);
+        assert!(surface.area_light.is_none(), "surfaces emit nothing");
+    }
+}
+
+#[test]
+fn a_point_light_goes_to_pbrt_with_its_intensity() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(common::repo("experiments/scenes/sphere.toml")).unwrap();
+    let start = base.find("[[lights]]").unwrap();
+    let point = format!(
+        "{}[[lights]]\ntype = \"point\"\nposition = [0.1, -0.2, 2.0]\npower = 60.0\n",
+        &base[..start]
+    );
+    let path = dir.path().join("point.toml");
+    std::fs::write(&path, point).unwrap();
+    let out = dir.path().join("point");
+    export(&path, "picture", "16x12", &out);
+    let file = interpret(&std::fs::read_to_string(out.join("scene.pbrt")).unwrap());
+    let light = file.world.iter().find(|d| d.name == "LightSource").unwrap();
+    assert_eq!(light.kind(), "point");
+    assert_eq!(light.floats("point3 from"), vec![0.1, -0.2, 2.0]);
+    let i = 60.0 / (4.0 * std::f64::consts::PI);
+    assert!(light.floats("rgb I").iter().all(|&v| (v / i - 1.0).abs() < 1e-12));
+    assert!(file.shapes("disk").is_empty());
 }
 
 #[test]
@@ -381,14 +433,23 @@ fn a_mesh_goes_to_pbrt_as_the_ply_it_names() {
     let out = dir.path().join("body");
     export(&path, "picture", "16x16", &out);
     let file = interpret(&std::fs::read_to_string(out.join("scene.pbrt")).unwrap());
-    let mesh = file
-        .world
-        .iter()
-        .find(|(d, _)| d.name == "Shape" && d.kind() == "plymesh")
-        .unwrap();
-    let ply = std::fs::read(out.join(mesh.0.word("string filename"))).unwrap();
-    let header = String::from_utf8_lossy(&ply[..400.min(ply.len())]).into_owned();
+    let mesh = &file.shapes("plymesh")[0];
+    let ply = std::fs::read(out.join(mesh.shape.word("string filename"))).unwrap();
+    let end = ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = std::str::from_utf8(&ply[..end]).unwrap();
     let faces = format!("element face {}\n", scene.triangles.positions.len());
     assert!(header.contains(&faces), "{faces} in {header}");
-    assert_eq!(mesh.1, DMat4::IDENTITY, "world-space vertices");
+    let vertex = |k: usize| f32::from_le_bytes(ply[end + 4 * k..end + 4 * k + 4].try_into().unwrap()) as f64;
+    let first = scene.triangles.positions[0][0];
+    assert_eq!(
+        DVec3::new(vertex(0), vertex(1), vertex(2)),
+        first.as_vec3().as_dvec3(),
+        "world-space vertices in f32"
+    );
+    assert_eq!(mesh.transform, DMat4::IDENTITY, "no transform on top");
+    let Shape::Mesh(m) = scene.shapes.iter().find(|s| matches!(s, Shape::Mesh(_))).unwrap() else {
+        unreachable!()
+    };
+    let material = mesh.material.as_ref().expect("the mesh's material");
+    assert_eq!(material.floats("rgb reflectance"), vec![m.albedo; 3]);
 }

@@ -165,7 +165,7 @@ fn scenes_the_file_would_render_otherwise_are_refused_naming_them() {
         );
         assert_eq!(code, 2, "{err}");
         assert!(
-            err.contains("up.toml") && err.contains("see light 0's disk") && err.contains(renderer),
+            err.contains("up.toml") && err.contains("sees light 0's disk") && err.contains(renderer),
             "{err}"
         );
     }
@@ -205,6 +205,101 @@ fn scenes_the_file_would_render_otherwise_are_refused_naming_them() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("WIDTHxHEIGHT"), "{err}");
     assert!(!dir.path().join("o").exists(), "a refused export writes nothing");
+}
+
+/// A box filter's rays cover the pixel's square, not its centre: a disk that reaches a fifth
+/// of a pixel into the view, or one smaller than the rays' spacing, is a surface the exported
+/// renderer sees; and a light between another light and the ground shadows it there and not
+/// in penumbra. Each export is refused, naming the light.
+#[test]
+fn lights_seen_between_pixel_centres_or_shadowing_others_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // A top-down view from `height`, over the ground.
+    let scene = |height: f64, lights: &str| {
+        format!(
+            "[cameras.top]\nprojection = \"orthographic\"\nposition = [0.0, 0.0, {height:?}]\nlook_at = [0.0, 0.0, 0.0]\n\
+             up = [0.0, 1.0, 0.0]\nwidth = 0.08\n\n[[planes]]\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+             albedo = 0.8\n{lights}"
+        )
+    };
+    let disk = |c: [f64; 3], r: f64| {
+        format!(
+            "\n[[lights]]\ntype = \"disk\"\ncenter = {c:?}\nnormal = [0.0, 0.0, -1.0]\nradius = {r}\npower = 60.0\nsamples = 16\n"
+        )
+    };
+    let cases = [
+        // The view spans x in [-0.04, 0.04] in 5 mm pixels; this disk's edge is at 0.039,
+        // 0.2 px into the last column of rows 6 to 9, far from its centres (0.0375).
+        (
+            "edge",
+            3.0,
+            disk([0.059, 0.0, 1.0], 0.02),
+            "the camera rays of 4 pixels meet it",
+        ),
+        // 0.4 mm across, 0.85 mm from the nearest ray of a 5 x 5 lattice of 1.25 mm spacing.
+        (
+            "tiny",
+            3.0,
+            disk([0.0006, 0.0006, 1.0], 0.0002),
+            "its centre, between the pixels' rays",
+        ),
+        // Seen from under both lights.
+        (
+            "stacked",
+            0.5,
+            disk([0.0, 0.0, 2.0], 0.02) + &disk([0.0, 0.0, 1.0], 0.05),
+            "light 1's disk may shadow light 0",
+        ),
+    ];
+    for (name, height, lights, says) in cases {
+        let file = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&file, scene(height, &lights)).unwrap();
+        for to in ["mitsuba", "pbrt"] {
+            let out = dir.path().join(format!("{name}-{to}"));
+            let (code, err) = run(
+                "export",
+                &[
+                    path(&file),
+                    "--camera",
+                    "top",
+                    "--size",
+                    "16x16",
+                    "--to",
+                    to,
+                    "--out",
+                    path(&out),
+                ],
+            );
+            assert_eq!(code, 2, "{name} {to}: {err}");
+            assert!(
+                err.contains(&format!("{name}.toml")) && err.contains(says),
+                "{name} {to}: {err}"
+            );
+            assert!(!out.exists());
+        }
+    }
+    // Apart, neither light shadows the other where the view looks.
+    let file = dir.path().join("apart.toml");
+    std::fs::write(
+        &file,
+        scene(0.5, &(disk([0.0, 0.0, 2.0], 0.02) + &disk([1.0, 0.0, 1.0], 0.05))),
+    )
+    .unwrap();
+    let (code, err) = run(
+        "export",
+        &[
+            path(&file),
+            "--camera",
+            "top",
+            "--size",
+            "16x16",
+            "--to",
+            "pbrt",
+            "--out",
+            path(&dir.path().join("apart")),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
 }
 
 /// Penumbra's own CPU render against the exact reference, two independent paths (Monte Carlo
