@@ -5,7 +5,7 @@
 //! cannot hold as penumbra renders it), 1 else.
 
 use clap::{Parser, ValueEnum};
-use penumbra::experiment::cli::{print_out, report_error};
+use penumbra::experiment::cli::{finish, print_out};
 use penumbra::files::Refused;
 use penumbra::peers::{export::view_of, mitsuba, pbrt, view, write_files, write_folder};
 use penumbra::render::{cpu::CpuBackend, Backend, Sampling, View};
@@ -153,15 +153,5 @@ fn run(args: &Args) -> anyhow::Result<String> {
 
 fn main() -> std::process::ExitCode {
     let args = Args::parse();
-    match run(&args).and_then(|text| print_out(&text).map_err(Into::into)) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            report_error(&e);
-            if e.is::<Refused>() || e.is::<penumbra::config::ConfigError>() {
-                std::process::ExitCode::from(2)
-            } else {
-                std::process::ExitCode::FAILURE
-            }
-        }
-    }
+    finish(run(&args).and_then(|text| print_out(&text).map_err(Into::into)))
 }

@@ -7,8 +7,7 @@
 //! a non-EXR; missing channels; a non-finite pixel; a scene without an exact answer), 1 else.
 
 use clap::Parser;
-use penumbra::experiment::cli::{print_out, report_error};
-use penumbra::files::Refused;
+use penumbra::experiment::cli::{finish, print_out};
 use penumbra::peers::panel::Panel;
 use penumbra::peers::write_folder;
 use std::path::PathBuf;
@@ -30,19 +29,10 @@ fn main() -> std::process::ExitCode {
     let args = Args::parse();
     let run = || -> anyhow::Result<()> {
         let panel = Panel::judge(&args.images)?;
-        write_folder(&args.out, |dir| panel.write(dir))?;
-        print_out(&panel.report(&panel.groups()))?;
+        let groups = panel.groups();
+        write_folder(&args.out, |dir| panel.write(dir, &groups))?;
+        print_out(&panel.report(&groups))?;
         Ok(())
     };
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            report_error(&e);
-            if e.is::<Refused>() || e.is::<penumbra::config::ConfigError>() {
-                std::process::ExitCode::from(2)
-            } else {
-                std::process::ExitCode::FAILURE
-            }
-        }
-    }
+    finish(run())
 }

@@ -6,7 +6,7 @@
 //! unreadable image), 1 else (standard output closed or full included).
 
 use clap::Parser;
-use penumbra::experiment::cli::{print_out, report_error};
+use penumbra::experiment::cli::{finish, print_out};
 use std::path::PathBuf;
 
 /// Rebuild results folders' comparison pages from their files.
@@ -20,18 +20,11 @@ struct Args {
 
 fn main() -> std::process::ExitCode {
     let args = Args::parse();
-    for dir in &args.folders {
-        let written = penumbra::output::page::rebuild(dir)
-            .and_then(|()| print_out(&format!("wrote {}\n", dir.join("index.html").display())).map_err(Into::into));
-        if let Err(e) = written {
-            report_error(&e);
-            // A folder whose files cannot be taken as they are is bad input (status 2).
-            return if e.is::<penumbra::files::Refused>() {
-                std::process::ExitCode::from(2)
-            } else {
-                std::process::ExitCode::FAILURE
-            };
-        }
-    }
-    std::process::ExitCode::SUCCESS
+    // A folder whose files cannot be taken as they are is bad input (status 2); the first
+    // failure ends the command.
+    finish(args.folders.iter().try_for_each(|dir| {
+        penumbra::output::page::rebuild(dir)?;
+        print_out(&format!("wrote {}\n", dir.join("index.html").display()))?;
+        Ok(())
+    }))
 }

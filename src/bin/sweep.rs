@@ -13,9 +13,5 @@ fn main() -> std::process::ExitCode {
     }
     let cli = Cli::parse();
     driver::init_logging(&cli);
-    let result = driver::run(&cli);
-    if let Err(e) = &result {
-        penumbra::experiment::cli::report_error(e);
-    }
-    driver::exit_status(&result)
+    penumbra::experiment::cli::finish(driver::run(&cli))
 }

@@ -123,6 +123,15 @@ pub fn print_out(text: &str) -> Result<(), StdoutFailed> {
         .map_err(StdoutFailed)
 }
 
+/// How every command ends: the error, if any, reported ([`report_error`]) and the exit status
+/// its kind calls for ([`crate::experiment::driver::exit_status`]: 2 for bad input).
+pub fn finish(result: anyhow::Result<()>) -> std::process::ExitCode {
+    if let Err(e) = &result {
+        report_error(e);
+    }
+    crate::experiment::driver::exit_status(&result)
+}
+
 /// Prints the error a command ends on to standard error where it can still be written there
 /// (a full or closed standard error loses the message, never the exit status), except a closed
 /// standard output, whose reader asked for no more.

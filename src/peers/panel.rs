@@ -229,9 +229,8 @@ impl Panel {
         r
     }
 
-    /// Writes everything into `dir` (a staging folder).
-    pub fn write(&self, dir: &Path) -> anyhow::Result<()> {
-        let groups = self.groups();
+    /// Writes everything into `dir` (a staging folder), with the panel's [`Panel::groups`].
+    pub fn write(&self, dir: &Path, groups: &[Group]) -> anyhow::Result<()> {
         let mut rows = csv::Writer::from_writer(Vec::new());
         for (_, j, _) in &self.judged {
             rows.serialize(j)?;
@@ -249,7 +248,7 @@ impl Panel {
         // and the plot draws the first LOOKS groups (profile.csv holds every one).
         let mut names: Vec<&str> = Vec::new();
         let mut panels: Vec<PlotPanel> = Vec::new();
-        for (k, s, curve) in &groups {
+        for (k, s, curve) in groups {
             let (filter, lift, _) = &self.references[*k];
             for (d, e) in curve {
                 profile.write_record([
@@ -297,7 +296,7 @@ impl Panel {
                 ("judge.csv".into(), rows.into_inner()?),
                 ("groups.csv".into(), summary.into_inner()?),
                 ("profile.csv".into(), profile.into_inner()?),
-                ("report.md".into(), self.report(&groups).into_bytes()),
+                ("report.md".into(), self.report(groups).into_bytes()),
                 (PROVENANCE.into(), toml::to_string(&provenance)?.into_bytes()),
             ],
         )?;
