@@ -1,6 +1,6 @@
-//! What every scene-file export shares: the files it writes, how far planes reach, a mesh's
-//! world-space triangles, the refusal of what
-//! renders otherwise where lights are surfaces, and the view record.
+//! What every scene-file export shares: the files it writes and the line they open with, how
+//! far planes reach, a mesh's world-space triangles, the refusal of what renders otherwise
+//! where lights are surfaces, and the view record.
 
 use super::view::{ExportedView, PixelFilter};
 use crate::files::Refused;
@@ -42,6 +42,21 @@ impl Export {
         files.extend(self.meshes);
         files
     }
+}
+
+/// The line both scene files open with (as a comment): which scene file and its fingerprint,
+/// camera and size.
+pub fn provenance(view: &ExportedView) -> String {
+    format!(
+        "penumbra export of {} (FNV-1a {}), camera `{}`, {} x {}",
+        view.scene
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+        view.scene_fnv1a,
+        view.camera,
+        view.width,
+        view.height
+    )
 }
 
 /// The world-space triangles of shape `id` (a mesh), as penumbra traces them.
@@ -199,11 +214,12 @@ fn centre_in_view(camera: &Camera, width: u32, height: u32, p: DVec3) -> Option<
     })
 }
 
-/// Refuses a scene in which one disk light may shadow another on a receiver the view sees: in
-/// `renderer` a light is a surface that blocks the others' shadow rays, in penumbra it blocks
-/// nothing. Conservative: every segment from the receiver to light b's disk stays within b's
-/// radius of the segment to b's centre, so light a (within its radius of its centre) can block
-/// one only if its centre comes within the sum of the radii of that segment.
+/// Refuses a scene in which a disk light may shadow another light (disk or point) on a receiver
+/// the view sees: in `renderer` a disk light is a surface that blocks the others' shadow rays,
+/// in penumbra it blocks nothing. Conservative: every segment from the receiver to light b's
+/// disk stays within b's radius of the segment to b's centre, so disk a (within its radius of
+/// its centre) can block one only if its centre comes within the sum of the radii of that
+/// segment.
 pub fn refuse_lights_shadowing_lights(
     scene: &Scene,
     camera: &Camera,
@@ -219,7 +235,7 @@ pub fn refuse_lights_shadowing_lights(
             Light::Point { .. } => None,
         })
         .collect();
-    if disks.len() < 2 {
+    if disks.is_empty() || scene.lights.len() < 2 {
         return Ok(());
     }
     let (w, h) = (view.width, view.height);
@@ -233,15 +249,22 @@ pub fn refuse_lights_shadowing_lights(
         })
         .collect();
     for &(a, da) in &disks {
-        for &(b, db) in &disks {
+        for (b, source) in scene.lights.iter().enumerate() {
             if a == b {
                 continue;
             }
+            // Where light b's shadow rays end: its disk (centre, radius) or its point.
+            let (centre, radius) = match source {
+                Light::Disk(d) => (d.center, d.radius),
+                Light::Point { position, .. } => (*position, 0.0),
+            };
+            let lit = |p: DVec3, n: DVec3| match source {
+                Light::Disk(d) => !disk_unreachable(p, n, d),
+                Light::Point { position, .. } => n.dot(*position - p) > 0.0,
+            };
             let shadowed = receivers
                 .par_iter()
-                .filter(|&&(p, n)| {
-                    !disk_unreachable(p, n, db) && segment_distance(da.center, p, db.center) < da.radius + db.radius
-                })
+                .filter(|&&(p, n)| lit(p, n) && segment_distance(da.center, p, centre) < da.radius + radius)
                 .count();
             if shadowed > 0 {
                 return Err(Refused(format!(

@@ -24,7 +24,9 @@
 //! - Sampler: `independent`, `spp` and `seed` left as parameters with defaults, so one file
 //!   renders every sample count and seed.
 
-use super::export::{disk_radiance, extent, mesh_triangles, refuse_lights_as_surfaces, Export, PLANE_REACH};
+use super::export::{
+    disk_radiance, extent, mesh_triangles, provenance, refuse_lights_as_surfaces, Export, PLANE_REACH,
+};
 use super::view::ExportedView;
 use crate::scene::camera::{Camera, Projection};
 use crate::scene::{Light, Scene, Shape};
@@ -40,20 +42,7 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
     let mut x = String::new();
     let f = |v: f64| format!("{v:?}");
     let v3 = |p: DVec3| format!("{}, {}, {}", f(p.x), f(p.y), f(p.z));
-    let _ = writeln!(
-        x,
-        "<!-- penumbra export of {} (FNV-1a {}), camera `{}`, {} x {} -->",
-        xml_text(
-            &view
-                .scene
-                .file_name()
-                .map_or(String::new(), |n| n.to_string_lossy().into_owned())
-        ),
-        view.scene_fnv1a,
-        xml_text(&view.camera),
-        view.width,
-        view.height
-    );
+    let _ = writeln!(x, "<!-- {} -->", xml_text(&provenance(view)));
     x.push_str("<scene version=\"3.0.0\">\n");
     x.push_str("    <default name=\"spp\" value=\"64\"/>\n    <default name=\"seed\" value=\"0\"/>\n");
     x.push_str(

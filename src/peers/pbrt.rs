@@ -42,7 +42,7 @@
 //!   than penumbra's where the light is unoccluded. The mean is unaffected.
 
 use super::export::{
-    disk_radiance, extent, mesh_triangles, plane_square, refuse_lights_as_surfaces, Export, PLANE_REACH,
+    disk_radiance, extent, mesh_triangles, plane_square, provenance, refuse_lights_as_surfaces, Export, PLANE_REACH,
 };
 use super::view::ExportedView;
 use crate::scene::camera::{Camera, Projection};
@@ -61,17 +61,8 @@ pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Re
     let v3 = |p: DVec3| format!("{} {} {}", f(p.x), f(p.y), f(p.z));
     let _ = writeln!(
         x,
-        "# penumbra export of {} (FNV-1a {}), camera `{}`, {} x {}\n# render: pbrt --spp N --seed S scene.pbrt",
-        comment_text(
-            &view
-                .scene
-                .file_name()
-                .map_or(String::new(), |n| n.to_string_lossy().into_owned())
-        ),
-        view.scene_fnv1a,
-        comment_text(&view.camera),
-        view.width,
-        view.height
+        "# {}\n# render: pbrt --spp N --seed S scene.pbrt",
+        comment_text(&provenance(view))
     );
     let _ = writeln!(
         x,

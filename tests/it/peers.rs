@@ -250,6 +250,14 @@ fn lights_seen_between_pixel_centres_or_shadowing_others_are_refused() {
             disk([0.0, 0.0, 2.0], 0.02) + &disk([0.0, 0.0, 1.0], 0.05),
             "light 1's disk may shadow light 0",
         ),
+        // A disk blocks a point light's rays too.
+        (
+            "under-point",
+            0.5,
+            "\n[[lights]]\ntype = \"point\"\nposition = [0.0, 0.0, 2.0]\npower = 60.0\n".to_string()
+                + &disk([0.0, 0.0, 1.0], 0.05),
+            "light 1's disk may shadow light 0",
+        ),
     ];
     for (name, height, lights, says) in cases {
         let file = dir.path().join(format!("{name}.toml"));
