@@ -22,7 +22,7 @@
 //!   `diffuse` area light of radiance L_e = power / (pi^2 a^2)
 //!   ([`disk_radiance`](super::export::disk_radiance)); pbrt divides an RGB emitter by its
 //!   illuminant's luminance, so `rgb L [l l l]` is seen as l. Like Mitsuba's, it is a surface:
-//!   views that see it are refused.
+//!   views that see it, and scenes where it may shadow another light, are refused.
 //! - Point light: `point` with intensity power / (4 pi).
 //! - Surfaces: `diffuse` (pbrt's BSDFs reflect on both sides, as penumbra shades the side the
 //!   camera sees).
