@@ -259,25 +259,28 @@ fn lights_seen_between_pixel_centres_or_shadowing_others_are_refused() {
             "light 1's disk may shadow light 0",
         ),
     ];
+    let export = |file: &Path, to: &str, out: &Path| {
+        run(
+            "export",
+            &[
+                path(file),
+                "--camera",
+                "top",
+                "--size",
+                "16x16",
+                "--to",
+                to,
+                "--out",
+                path(out),
+            ],
+        )
+    };
     for (name, height, lights, says) in cases {
         let file = dir.path().join(format!("{name}.toml"));
         std::fs::write(&file, scene(height, &lights)).unwrap();
         for to in ["mitsuba", "pbrt"] {
             let out = dir.path().join(format!("{name}-{to}"));
-            let (code, err) = run(
-                "export",
-                &[
-                    path(&file),
-                    "--camera",
-                    "top",
-                    "--size",
-                    "16x16",
-                    "--to",
-                    to,
-                    "--out",
-                    path(&out),
-                ],
-            );
+            let (code, err) = export(&file, to, &out);
             assert_eq!(code, 2, "{name} {to}: {err}");
             assert!(
                 err.contains(&format!("{name}.toml")) && err.contains(says),
@@ -293,20 +296,7 @@ fn lights_seen_between_pixel_centres_or_shadowing_others_are_refused() {
         scene(0.5, &(disk([0.0, 0.0, 2.0], 0.02) + &disk([1.0, 0.0, 1.0], 0.05))),
     )
     .unwrap();
-    let (code, err) = run(
-        "export",
-        &[
-            path(&file),
-            "--camera",
-            "top",
-            "--size",
-            "16x16",
-            "--to",
-            "pbrt",
-            "--out",
-            path(&dir.path().join("apart")),
-        ],
-    );
+    let (code, err) = export(&file, "pbrt", &dir.path().join("apart"));
     assert_eq!(code, 0, "{err}");
 }
 
