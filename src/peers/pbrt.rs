@@ -52,7 +52,7 @@ use std::fmt::Write;
 
 /// The scene and `view` in pbrt-v4's format, or why the scene cannot be one (effects pbrt's
 /// file would simulate differently: mirrors, ambient occlusion, shading without shadows; a view
-/// that sees a light's disk).
+/// that sees a light's disk, a light that may shadow another).
 pub fn export(scene: &Scene, camera: &Camera, view: &ExportedView) -> anyhow::Result<Export> {
     super::refuse_unmatched_effects(scene, &view.scene)?;
     refuse_lights_as_surfaces(scene, camera, view, "pbrt")?;
