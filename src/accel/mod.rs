@@ -452,6 +452,18 @@ pub fn registered(name: &str) -> Option<&'static Registered> {
     REGISTRY.iter().find(|r| r.name == name)
 }
 
+/// Whether structure `name` answers as the f64 reference does ([`Registered::exact`]); a name
+/// outside the registry is taken as exact, so nothing is excused from the bit-for-bit check.
+pub fn is_exact(name: &str) -> bool {
+    registered(name).is_none_or(|r| r.exact)
+}
+
+/// Whether structure `name` counts its walk's nodes and tests ([`Registered::counts_work`]); a
+/// name outside the registry is taken as counting.
+pub fn counts_work(name: &str) -> bool {
+    registered(name).is_none_or(|r| r.counts_work)
+}
+
 /// Registered names, for messages.
 pub fn names() -> Vec<&'static str> {
     REGISTRY.iter().map(|r| r.name).collect()

@@ -251,6 +251,9 @@ fn below(t: f64) -> f32 {
     }
 }
 
+/// Why Embree has no GPU form, as both GPU refusals say it.
+const NO_GPU: &str = "`embree` has no GPU form (Embree is a CPU library)";
+
 impl Accelerator for Embree {
     fn name(&self) -> &'static str {
         "embree"
@@ -319,13 +322,11 @@ impl Accelerator for Embree {
     }
 
     fn gpu(&self, _frame: &LocalFrame) -> anyhow::Result<GpuStructure> {
-        anyhow::bail!(
-            "`embree` has no GPU form (Embree is a CPU library); choose bvh, cwbvh, kdtree or vlf for the GPU backend"
-        )
+        anyhow::bail!("{NO_GPU}; choose bvh, cwbvh, kdtree or vlf for the GPU backend")
     }
 
     fn gpu_refusal(&self) -> Option<String> {
-        Some("`embree` has no GPU form (Embree is a CPU library)".into())
+        Some(NO_GPU.into())
     }
 
     fn update(

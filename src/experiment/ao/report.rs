@@ -5,7 +5,7 @@
 use super::runner::{AoRow, TuningRow};
 use super::spec::AoSpec;
 use crate::accel::settings::ParameterColumns;
-use crate::accel::{registered, Issue};
+use crate::accel::Issue;
 use crate::experiment::outputs::Outputs;
 use crate::experiment::tuning::{round_rows, REUSED};
 use crate::files::write_atomic;
@@ -98,12 +98,12 @@ struct Candidate<'a> {
 
 /// Whether the row's structure counts its walk's nodes and tests (Embree's do not).
 fn counts_work(r: &AoRow) -> bool {
-    registered(r.structure).is_none_or(|s| s.counts_work)
+    crate::accel::counts_work(r.structure)
 }
 
 /// Whether the row's structure answers as the f64 reference does (Embree's f32 tests do not).
 fn exact(r: &AoRow) -> bool {
-    registered(r.structure).is_none_or(|s| s.exact)
+    crate::accel::is_exact(r.structure)
 }
 
 /// The row of `structure` on `mesh` with single rays (the paper's measurement).

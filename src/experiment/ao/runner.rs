@@ -275,7 +275,7 @@ fn measure(
 pub fn compare(rows: &mut [AoRow]) {
     let Some(reference) = rows
         .iter()
-        .find(|r| crate::accel::registered(r.structure).is_none_or(|s| s.exact))
+        .find(|r| crate::accel::is_exact(r.structure))
         .map(|r| r.image.clone())
     else {
         return;

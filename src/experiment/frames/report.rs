@@ -526,7 +526,7 @@ impl Summary {
 
 /// Whether the row's structure counts its walk's nodes and tests (Embree's do not).
 fn counts_work(r: &FrameRow) -> bool {
-    crate::accel::registered(r.structure).is_none_or(|s| s.counts_work)
+    crate::accel::counts_work(r.structure)
 }
 
 /// A median work count in the report's words: "n/a" where none was counted.

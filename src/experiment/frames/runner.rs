@@ -432,7 +432,7 @@ pub fn run_block(
                 // Compared with the first exact structure's frame (the first one's where none is).
                 let reference = variants
                     .iter()
-                    .position(|v| crate::accel::registered(v.structure).is_none_or(|r| r.exact))
+                    .position(|v| crate::accel::is_exact(v.structure))
                     .unwrap_or(0);
                 let first = &frames[reference];
                 for (i, v) in variants.iter().enumerate() {

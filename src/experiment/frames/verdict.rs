@@ -208,7 +208,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
             let mine: Vec<&FrameRow> = rows.iter().filter(|r| label(r) == *l).collect();
             let d: Vec<usize> = mine.iter().map(|r| r.differing_pixels).collect();
             let (total, frames) = (d.iter().sum::<usize>(), d.iter().filter(|&&x| x > 0).count());
-            let exact = crate::accel::registered(mine[0].structure).is_none_or(|r| r.exact);
+            let exact = crate::accel::is_exact(mine[0].structure);
             (total > 0).then(|| {
                 (
                     exact,
@@ -222,10 +222,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         .collect();
     let (failed, inexact): (Vec<_>, Vec<_>) = differing.into_iter().partition(|(exact, _)| *exact);
     // "exact" qualifies the words only where an inexact structure is among the rows.
-    let exact = if rows
-        .iter()
-        .any(|r| crate::accel::registered(r.structure).is_some_and(|r| !r.exact))
-    {
+    let exact = if rows.iter().any(|r| !crate::accel::is_exact(r.structure)) {
         "exact "
     } else {
         ""
@@ -264,8 +261,7 @@ pub fn verdict(spec: &FramesSpec, outcome: &FramesOutcome) -> String {
         let counted = rows
             .iter()
             .find(|r| label(r) == l)
-            .and_then(|r| crate::accel::registered(r.structure))
-            .is_none_or(|s| s.counts_work);
+            .is_none_or(|r| crate::accel::counts_work(r.structure));
         if !counted {
             return "no work counters".to_string();
         }
